@@ -1,0 +1,53 @@
+/*
+ * dense.c — storage helpers for the column-major dmat used by the core.
+ */
+#include "dense.h"
+#include "spinmodal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+int dm_alloc(dmat *m, int rows, int cols)
+{
+    size_t n = (size_t)(rows > 0 ? rows : 0) * (size_t)(cols > 0 ? cols : 0);
+    m->rows = rows;
+    m->cols = cols;
+    m->a = calloc(n ? n : 1, sizeof(double));
+    return m->a ? SM_OK : SM_NOMEM;
+}
+
+void dm_free(dmat *m)
+{
+    free(m->a);
+    m->a = NULL;
+    m->rows = m->cols = 0;
+}
+
+void dm_zero(dmat *m)
+{
+    memset(m->a, 0, (size_t)m->rows * (size_t)m->cols * sizeof(double));
+}
+
+double *dm_vec(size_t n)
+{
+    return calloc(n ? n : 1, sizeof(double));
+}
+
+double dm_norm(const double *x, int n)
+{
+    /* scaled sum of squares, safe from overflow */
+    double scale = 0.0, ssq = 1.0;
+    for (int i = 0; i < n; i++) {
+        double a = fabs(x[i]);
+        if (a == 0.0)
+            continue;
+        if (scale < a) {
+            ssq = 1.0 + ssq * (scale / a) * (scale / a);
+            scale = a;
+        } else {
+            ssq += (a / scale) * (a / scale);
+        }
+    }
+    return scale * sqrt(ssq);
+}

@@ -1,0 +1,30 @@
+/*
+ * dense.h — a tiny column-major dense matrix used inside the core, and the
+ * few helpers the numerics need.  LAPACK/BLAS are called on these directly
+ * (leading dimension = rows).
+ */
+#ifndef SM_DENSE_H
+#define SM_DENSE_H
+
+#include <stddef.h>
+
+typedef struct dmat {
+    int rows;       /* number of rows (= leading dimension) */
+    int cols;       /* number of columns */
+    double *a;      /* rows*cols values, column-major; owned */
+} dmat;
+
+#define DM(M, i, j) ((M)->a[(size_t)(j) * (size_t)(M)->rows + (size_t)(i)])
+
+/** Allocate a zeroed rows x cols matrix; returns SM_OK or SM_NOMEM. */
+int dm_alloc(dmat *m, int rows, int cols);
+/** Free the storage; safe on a zeroed struct. */
+void dm_free(dmat *m);
+/** Set all entries to zero. */
+void dm_zero(dmat *m);
+/** calloc wrapper for n doubles (NULL on failure or n == 0 gives a 1-element block). */
+double *dm_vec(size_t n);
+/** Euclidean norm of x[0..n). */
+double dm_norm(const double *x, int n);
+
+#endif

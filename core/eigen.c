@@ -1,0 +1,442 @@
+/*
+ * eigen.c — the eigen-analysis of the linearised equations (DESIGN.md 1.4):
+ *
+ *   coriolis on:   (lambda^2 M + lambda C + K) x = 0
+ *   coriolis off:  K x = w^2 M x
+ *
+ * M may be singular (lumped mass + augmented basis: RF-1 massless
+ * directions).  A pivoted Cholesky of M splits the coordinates into a range
+ * part Y (the pivots) and an exact null space Z = P [-U11^-1 U12; I]; C Z = 0
+ * there, so the Z rows give K_zy a + K_zz b = 0 and the problem condenses to
+ *   K_red = K_yy - K_yz K_zz^-1 K_zy,   M_yy = U11' U11,   C_yy.
+ * With K_red positive definite (K_red = L L') the gyroscopic problem is the
+ * Hermitian eigenproblem of size 2r of  -i H,  H = [[0, B], [-B', -G]],
+ * B = L' U11^-1, G = U11^-T C_yy U11^-1 (skew): exactly real frequencies.
+ * Otherwise the companion form goes to dgeev.
+ */
+#include "internal.h"
+
+#include <cblas.h>
+#include <complex.h>
+#include <lapacke.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+void eig_out_free(sm_eig_out *o)
+{
+    free(o->wre);
+    free(o->wim);
+    free(o->xre);
+    free(o->xim);
+    memset(o, 0, sizeof *o);
+}
+
+/* Number of negative eigenvalues of the symmetric matrix A (n x n, destroyed). */
+static int eig_inertia(int n, double *A)
+{
+    if (n == 0)
+        return 0;
+    int *ipiv = malloc((size_t)n * sizeof(int)), neg = 0;
+    if (!ipiv)
+        return -1;
+    if (LAPACKE_dsytrf(LAPACK_COL_MAJOR, 'L', n, A, n, ipiv) < 0) {
+        free(ipiv);
+        return -1;
+    }
+    for (int k = 0; k < n; k++) {
+        double a = A[(size_t)k * n + k];
+        if (ipiv[k] > 0 || k + 1 == n) {
+            neg += a < 0;
+        } else {
+            double b = A[(size_t)k * n + k + 1], c = A[(size_t)(k + 1) * n + k + 1];
+            double det = a * c - b * b;
+            neg += det < 0 ? 1 : (a < 0 ? 2 : 0);
+            k++;
+        }
+    }
+    free(ipiv);
+    return neg;
+}
+
+/* Negative eigenvalue count of symmetric A; *chol receives 1 and the lower
+ * Cholesky factor in L when A is positive definite. */
+static int eig_definite(int n, const double *A, double *L, int *chol)
+{
+    memcpy(L, A, (size_t)n * n * sizeof(double));
+    *chol = n == 0 || LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', n, L, n) == 0;
+    if (*chol)
+        return 0;
+    memcpy(L, A, (size_t)n * n * sizeof(double));
+    return eig_inertia(n, L);
+}
+
+typedef struct eig_split {
+    int r, z;        /* range and null dimensions */
+    int *yi, *zi;    /* coordinate indices */
+    double *U;       /* r x r upper Cholesky factor of M_yy */
+    double *Z;       /* n x z null-space basis */
+    double *S;       /* z x r: K_zz^-1 K_zy  (b = -S a) */
+    double *Kr;      /* r x r condensed stiffness */
+    int neg_zz;      /* negative eigenvalues of K_zz */
+} eig_split;
+
+static void eig_split_free(eig_split *sp)
+{
+    free(sp->yi);
+    free(sp->zi);
+    free(sp->U);
+    free(sp->Z);
+    free(sp->S);
+    free(sp->Kr);
+}
+
+/* Pivoted Cholesky of M, null space, condensation of K on it. */
+static int eig_condense(int n, const dmat *M, const dmat *K, eig_split *sp)
+{
+    int rc = SM_NOMEM, rank = 0;
+    double *W = dm_vec((size_t)n * n), *KZ = NULL, *Kzz = NULL, *Lzz = NULL;
+    int *piv = malloc((size_t)n * sizeof(int));
+    memset(sp, 0, sizeof *sp);
+    if (!W || !piv)
+        goto done;
+    memcpy(W, M->a, (size_t)n * n * sizeof(double));
+    double dmax = 0;
+    for (int i = 0; i < n; i++)
+        dmax = fmax(dmax, DM(M, i, i));
+    rc = SM_LAPACK_FAILED;
+    if (LAPACKE_dpstrf(LAPACK_COL_MAJOR, 'U', n, W, n, piv, &rank, 1e-10 * dmax) < 0 || rank < 1)
+        goto done;
+    int r = rank, z = n - r;
+    sp->r = r;
+    sp->z = z;
+    rc = SM_NOMEM;
+    sp->yi = malloc((size_t)r * sizeof(int));
+    sp->zi = malloc((size_t)(z ? z : 1) * sizeof(int));
+    sp->U = dm_vec((size_t)r * r);
+    sp->Z = dm_vec((size_t)n * z);
+    sp->S = dm_vec((size_t)z * r);
+    sp->Kr = dm_vec((size_t)r * r);
+    KZ = dm_vec((size_t)n * z);
+    Kzz = dm_vec((size_t)z * z);
+    Lzz = dm_vec((size_t)z * z);
+    if (!sp->yi || !sp->zi || !sp->U || !sp->Z || !sp->S || !sp->Kr || !KZ || !Kzz || !Lzz)
+        goto done;
+    for (int i = 0; i < r; i++)
+        sp->yi[i] = piv[i] - 1;
+    for (int j = 0; j < z; j++)
+        sp->zi[j] = piv[r + j] - 1;
+    for (int j = 0; j < r; j++)
+        for (int i = 0; i <= j; i++)
+            sp->U[(size_t)j * r + i] = W[(size_t)j * n + i];
+    for (int i = 0; i < r; i++)
+        for (int j = 0; j < r; j++)
+            sp->Kr[(size_t)j * r + i] = DM(K, sp->yi[i], sp->yi[j]);
+    if (z > 0) {
+        /* Z = P [-U11^-1 U12; I] */
+        double *T = dm_vec((size_t)r * z);
+        if (!T)
+            goto done;
+        for (int j = 0; j < z; j++)
+            for (int i = 0; i < r; i++)
+                T[(size_t)j * r + i] = W[(size_t)(r + j) * n + i];
+        cblas_dtrsm(CblasColMajor, CblasLeft, CblasUpper, CblasNoTrans, CblasNonUnit, r, z, 1.0,
+                    sp->U, r, T, r);
+        for (int j = 0; j < z; j++) {
+            for (int i = 0; i < r; i++)
+                sp->Z[(size_t)j * n + sp->yi[i]] = -T[(size_t)j * r + i];
+            sp->Z[(size_t)j * n + sp->zi[j]] = 1.0;
+        }
+        free(T);
+        /* KZ = K Z, Kzz = Z' K Z */
+        cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, n, z, n, 1.0, K->a, n, sp->Z, n,
+                    0.0, KZ, n);
+        cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, z, z, n, 1.0, sp->Z, n, KZ, n, 0.0,
+                    Kzz, z);
+        for (int j = 0; j < z; j++)
+            for (int i = 0; i < j; i++)
+                Kzz[(size_t)j * z + i] = Kzz[(size_t)i * z + j] =
+                    0.5 * (Kzz[(size_t)j * z + i] + Kzz[(size_t)i * z + j]);
+        /* S = Kzz^-1 K_zy, K_zy = (Y' K Z)' = rows yi of KZ, transposed */
+        for (int i = 0; i < r; i++)
+            for (int j = 0; j < z; j++)
+                sp->S[(size_t)i * z + j] = KZ[(size_t)j * n + sp->yi[i]];
+        int chol;
+        sp->neg_zz = eig_definite(z, Kzz, Lzz, &chol);
+        rc = SM_SINGULAR;
+        if (chol) {
+            LAPACKE_dpotrs(LAPACK_COL_MAJOR, 'L', z, r, Lzz, z, sp->S, z);
+        } else {
+            int *ip = malloc((size_t)z * sizeof(int));
+            int bad = !ip || LAPACKE_dgesv(LAPACK_COL_MAJOR, z, r, Kzz, z, ip, sp->S, z) != 0;
+            free(ip);
+            if (bad)
+                goto done;
+        }
+        /* Kr -= K_yz S */
+        for (int j = 0; j < r; j++)
+            for (int i = 0; i < r; i++) {
+                double t = 0;
+                for (int p = 0; p < z; p++)
+                    t += KZ[(size_t)p * n + sp->yi[i]] * sp->S[(size_t)j * z + p];
+                sp->Kr[(size_t)j * r + i] -= t;
+            }
+    }
+    for (int j = 0; j < r; j++)
+        for (int i = 0; i < j; i++)
+            sp->Kr[(size_t)j * r + i] = sp->Kr[(size_t)i * r + j] =
+                0.5 * (sp->Kr[(size_t)j * r + i] + sp->Kr[(size_t)i * r + j]);
+    rc = SM_OK;
+done:
+    free(W);
+    free(piv);
+    free(KZ);
+    free(Kzz);
+    free(Lzz);
+    return rc;
+}
+
+/* x = Y a + Z b, b = -S a, for the real vector a (r) into x (n). */
+static void eig_expand(int n, const eig_split *sp, const double *a, double *x)
+{
+    memset(x, 0, (size_t)n * sizeof(double));
+    for (int i = 0; i < sp->r; i++)
+        x[sp->yi[i]] = a[i];
+    for (int j = 0; j < sp->z; j++) {
+        double b = 0;
+        for (int i = 0; i < sp->r; i++)
+            b -= sp->S[(size_t)i * sp->z + j] * a[i];
+        for (int i = 0; i < n; i++)
+            x[i] += sp->Z[(size_t)j * n + i] * b;
+    }
+}
+
+static int eig_alloc_out(sm_eig_out *o, int n, int k)
+{
+    o->n_modes = k;
+    o->wre = dm_vec((size_t)k);
+    o->wim = dm_vec((size_t)k);
+    o->xre = dm_vec((size_t)n * k);
+    o->xim = dm_vec((size_t)n * k);
+    return o->wre && o->wim && o->xre && o->xim ? SM_OK : SM_NOMEM;
+}
+
+/* K x = w^2 M x on the condensed problem. */
+static int eig_undamped(int n, const eig_split *sp, int k, sm_eig_out *o)
+{
+    int r = sp->r, found = 0, rc = SM_NOMEM;
+    double *A = dm_vec((size_t)r * r), *w = dm_vec((size_t)r), *V = dm_vec((size_t)r * k);
+    int *sup = malloc(2 * (size_t)k * sizeof(int));
+    if (!A || !w || !V || !sup || eig_alloc_out(o, n, k))
+        goto done;
+    /* A = U^-T Kr U^-1 */
+    memcpy(A, sp->Kr, (size_t)r * r * sizeof(double));
+    cblas_dtrsm(CblasColMajor, CblasLeft, CblasUpper, CblasTrans, CblasNonUnit, r, r, 1.0, sp->U, r, A, r);
+    cblas_dtrsm(CblasColMajor, CblasRight, CblasUpper, CblasNoTrans, CblasNonUnit, r, r, 1.0, sp->U, r, A, r);
+    rc = SM_LAPACK_FAILED;
+    if (LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', r, A, r, 0, 0, 1, k, 0.0, &found, w, V, r, sup) != 0 ||
+        found != k)
+        goto done;
+    /* a = U^-1 v */
+    cblas_dtrsm(CblasColMajor, CblasLeft, CblasUpper, CblasNoTrans, CblasNonUnit, r, k, 1.0, sp->U, r, V, r);
+    o->max_re = -INFINITY;
+    for (int j = 0; j < k; j++) {
+        if (w[j] >= 0) {
+            o->wre[j] = 0;
+            o->wim[j] = sqrt(w[j]);
+        } else {
+            o->wre[j] = sqrt(-w[j]);
+            o->wim[j] = 0;
+        }
+        o->max_re = fmax(o->max_re, o->wre[j]);
+        eig_expand(n, sp, V + (size_t)j * r, o->xre + (size_t)j * n);
+    }
+    rc = SM_OK;
+done:
+    free(A);
+    free(w);
+    free(V);
+    free(sup);
+    return rc;
+}
+
+/* Gyroscopic problem with K_red = L L' positive definite: Hermitian form. */
+static int eig_gyro_hermitian(int n, const eig_split *sp, const double *L, const double *Cy, int k,
+                              sm_eig_out *o)
+{
+    int r = sp->r, N2 = 2 * r, found = 0, rc = SM_NOMEM;
+    double *B = dm_vec((size_t)r * r), *G = dm_vec((size_t)r * r), *w = dm_vec((size_t)N2);
+    double *ar = dm_vec((size_t)r), *ai = dm_vec((size_t)r);
+    double complex *H = calloc((size_t)N2 * N2, sizeof(double complex));
+    double complex *Y = calloc((size_t)N2 * k, sizeof(double complex));
+    int *sup = malloc(2 * (size_t)k * sizeof(int));
+    if (!B || !G || !w || !ar || !ai || !H || !Y || !sup || eig_alloc_out(o, n, k))
+        goto done;
+    /* B = L' U^-1 */
+    for (int j = 0; j < r; j++)
+        for (int i = 0; i <= j; i++)
+            B[(size_t)j * r + i] = L[(size_t)i * r + j];
+    cblas_dtrsm(CblasColMajor, CblasRight, CblasUpper, CblasNoTrans, CblasNonUnit, r, r, 1.0, sp->U, r, B, r);
+    /* G = U^-T C U^-1 */
+    memcpy(G, Cy, (size_t)r * r * sizeof(double));
+    cblas_dtrsm(CblasColMajor, CblasLeft, CblasUpper, CblasTrans, CblasNonUnit, r, r, 1.0, sp->U, r, G, r);
+    cblas_dtrsm(CblasColMajor, CblasRight, CblasUpper, CblasNoTrans, CblasNonUnit, r, r, 1.0, sp->U, r, G, r);
+    /* -i H, lower triangle: [[0, -iB], [iB', iG]] */
+    for (int j = 0; j < r; j++)
+        for (int i = 0; i < r; i++) {
+            H[(size_t)j * N2 + (r + i)] = I * B[(size_t)i * r + j];          /* (r+i, j) = i B'(i,j) */
+            if (i >= j)
+                H[(size_t)(r + j) * N2 + (r + i)] = I * G[(size_t)j * r + i]; /* (r+i, r+j) */
+        }
+    rc = SM_LAPACK_FAILED;
+    if (LAPACKE_zheevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', N2, H, N2, 0, 0, r + 1, r + k, 0.0, &found, w,
+                       Y, N2, sup) != 0 ||
+        found != k)
+        goto done;
+    o->max_re = 0;
+    for (int j = 0; j < k; j++) {
+        o->wre[j] = 0;
+        o->wim[j] = w[j];
+        /* a = L^-T y1 (real and imaginary parts) */
+        for (int i = 0; i < r; i++) {
+            ar[i] = creal(Y[(size_t)j * N2 + i]);
+            ai[i] = cimag(Y[(size_t)j * N2 + i]);
+        }
+        cblas_dtrsv(CblasColMajor, CblasLower, CblasTrans, CblasNonUnit, r, L, r, ar, 1);
+        cblas_dtrsv(CblasColMajor, CblasLower, CblasTrans, CblasNonUnit, r, L, r, ai, 1);
+        eig_expand(n, sp, ar, o->xre + (size_t)j * n);
+        eig_expand(n, sp, ai, o->xim + (size_t)j * n);
+    }
+    rc = SM_OK;
+done:
+    free(B);
+    free(G);
+    free(w);
+    free(ar);
+    free(ai);
+    free(H);
+    free(Y);
+    free(sup);
+    return rc;
+}
+
+typedef struct eig_root {
+    double re, im, key;
+    int col;
+} eig_root;
+
+static int eig_root_cmp(const void *a, const void *b)
+{
+    double x = ((const eig_root *)a)->key, y = ((const eig_root *)b)->key;
+    return x < y ? -1 : x > y;
+}
+
+/* General gyroscopic problem (K_red indefinite): companion form and dgeev. */
+static int eig_gyro_general(int n, const eig_split *sp, const double *Cy, int k, sm_eig_out *o)
+{
+    int r = sp->r, N2 = 2 * r, rc = SM_NOMEM, nr = 0;
+    double *A = dm_vec((size_t)N2 * N2), *wr = dm_vec((size_t)N2), *wi = dm_vec((size_t)N2);
+    double *VR = dm_vec((size_t)N2 * N2), *T = dm_vec((size_t)r * N2);
+    double *ar = dm_vec((size_t)r), *ai = dm_vec((size_t)r);
+    eig_root *roots = calloc((size_t)N2, sizeof(eig_root));
+    if (!A || !wr || !wi || !VR || !T || !ar || !ai || !roots)
+        goto done;
+    /* T = M^-1 [K C] */
+    for (int j = 0; j < r; j++)
+        for (int i = 0; i < r; i++) {
+            T[(size_t)j * r + i] = sp->Kr[(size_t)j * r + i];
+            T[(size_t)(r + j) * r + i] = Cy[(size_t)j * r + i];
+        }
+    LAPACKE_dpotrs(LAPACK_COL_MAJOR, 'U', r, N2, sp->U, r, T, r);
+    for (int i = 0; i < r; i++) {
+        A[(size_t)(r + i) * N2 + i] = 1.0;
+        for (int j = 0; j < N2; j++)
+            A[(size_t)j * N2 + r + i] = -T[(size_t)j * r + i];
+    }
+    rc = SM_LAPACK_FAILED;
+    if (LAPACKE_dgeev(LAPACK_COL_MAJOR, 'N', 'V', N2, A, N2, wr, wi, NULL, 1, VR, N2) != 0)
+        goto done;
+    o->max_re = -INFINITY;
+    for (int j = 0; j < N2; j++) {
+        o->max_re = fmax(o->max_re, wr[j]);
+        double mag = hypot(wr[j], wi[j]);
+        int take = wi[j] > 1e-12 * mag || (fabs(wi[j]) <= 1e-12 * mag && wr[j] >= 0);
+        if (!take)
+            continue;
+        roots[nr].re = wr[j];
+        roots[nr].im = fabs(wi[j]);
+        roots[nr].key = wi[j] * wi[j] - wr[j] * wr[j];
+        roots[nr].col = j;
+        nr++;
+    }
+    qsort(roots, (size_t)nr, sizeof *roots, eig_root_cmp);
+    k = k < nr ? k : nr;
+    rc = eig_alloc_out(o, n, k);
+    if (rc < 0)
+        goto done;
+    for (int t = 0; t < k; t++) {
+        int j = roots[t].col;
+        o->wre[t] = roots[t].re;
+        o->wim[t] = roots[t].im;
+        for (int i = 0; i < r; i++) {
+            if (wi[j] > 0) {
+                ar[i] = VR[(size_t)j * N2 + i];
+                ai[i] = VR[(size_t)(j + 1) * N2 + i];
+            } else {
+                ar[i] = VR[(size_t)j * N2 + i];
+                ai[i] = 0;
+            }
+        }
+        eig_expand(n, sp, ar, o->xre + (size_t)t * n);
+        eig_expand(n, sp, ai, o->xim + (size_t)t * n);
+    }
+    rc = SM_OK;
+done:
+    free(A);
+    free(wr);
+    free(wi);
+    free(VR);
+    free(T);
+    free(ar);
+    free(ai);
+    free(roots);
+    return rc;
+}
+
+/**
+ * Solve the linearised problem; out receives min(modes, r) modes ordered by
+ * Im^2 - Re^2 of lambda (ascending w^2; divergent roots first), the
+ * modal-coordinate vectors and the inertia of K.  Returns SM_OK,
+ * SM_NOMEM, SM_SINGULAR or SM_LAPACK_FAILED.
+ */
+int eig_solve(int n, const dmat *M, const dmat *C, const dmat *K, int coriolis, int modes,
+              sm_eig_out *out)
+{
+    eig_split sp;
+    memset(out, 0, sizeof *out);
+    int rc = eig_condense(n, M, K, &sp);
+    double *L = NULL, *Cy = NULL;
+    if (rc < 0)
+        goto done;
+    int r = sp.r, k = modes < r ? modes : r, chol = 0;
+    rc = SM_NOMEM;
+    L = dm_vec((size_t)r * r);
+    Cy = dm_vec((size_t)r * r);
+    if (!L || !Cy)
+        goto done;
+    int neg = eig_definite(r, sp.Kr, L, &chol);
+    out->negative = sp.neg_zz + neg;
+    if (!coriolis) {
+        rc = eig_undamped(n, &sp, k, out);
+    } else {
+        for (int j = 0; j < r; j++)
+            for (int i = 0; i < r; i++)
+                Cy[(size_t)j * r + i] = DM(C, sp.yi[i], sp.yi[j]);
+        rc = chol ? eig_gyro_hermitian(n, &sp, L, Cy, k, out) : eig_gyro_general(n, &sp, Cy, k, out);
+    }
+done:
+    free(L);
+    free(Cy);
+    eig_split_free(&sp);
+    return rc;
+}

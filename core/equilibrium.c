@@ -1,0 +1,240 @@
+/*
+ * equilibrium.c — the dynamic equilibrium (steady deflected state) in the
+ * hub frame, DESIGN.md 1.3:
+ *
+ *   F(q) = K q + f_g(q) - Omega^2 g(q) = 0,     g = sum m_k J_k' r_k
+ *
+ * solved by Newton-Raphson with the exact tangent
+ *   Kt = K + d f_g/dq - Omega^2 (M* + H)        (frames.c, linearize.c)
+ * along a continuation in s = Omega^2: tangent predictor, damped Newton
+ * corrector, step halving when Newton fails or the corrector lands far from
+ * the predictor (a jump to another branch), step growth when it converges
+ * fast.  Running out of step size is the reported "no equilibrium" outcome.
+ */
+#include "internal.h"
+
+#include <lapacke.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define EQ_MAX_INCREMENTS 400
+#define EQ_MAX_TOTAL_ITER 4000
+
+typedef struct eq_ws {
+    sm_kin kin;
+    double *F, *g, *dq, *qt, *q0, *qp, *work;
+    dmat Kt, M, H, W;
+    int *ipiv;
+    int iterations;          /* total Newton iterations */
+    double residual;
+} eq_ws;
+
+static void eq_ws_free(eq_ws *w)
+{
+    frames_kin_free(&w->kin);
+    free(w->F);
+    free(w->g);
+    free(w->dq);
+    free(w->qt);
+    free(w->q0);
+    free(w->qp);
+    free(w->work);
+    free(w->ipiv);
+    dm_free(&w->Kt);
+    dm_free(&w->M);
+    dm_free(&w->H);
+    dm_free(&w->W);
+}
+
+static int eq_ws_alloc(const sm_model *m, eq_ws *w)
+{
+    int n = m->n, mx = 1;
+    memset(w, 0, sizeof *w);
+    for (int s = 0; s < m->n_subs; s++)
+        mx = m->subs[s].m > mx ? m->subs[s].m : mx;
+    w->F = dm_vec((size_t)n);
+    w->g = dm_vec((size_t)n);
+    w->dq = dm_vec((size_t)n);
+    w->qt = dm_vec((size_t)n);
+    w->q0 = dm_vec((size_t)n);
+    w->qp = dm_vec((size_t)n);
+    w->work = dm_vec((size_t)(4 * mx + n));
+    w->ipiv = malloc((size_t)n * sizeof(int));
+    if (!w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp || !w->work || !w->ipiv ||
+        frames_kin_alloc(m, &w->kin) || dm_alloc(&w->Kt, n, n) || dm_alloc(&w->M, n, n) ||
+        dm_alloc(&w->H, n, n) || dm_alloc(&w->W, n, 2 * m->n_mp)) {
+        eq_ws_free(w);
+        return SM_NOMEM;
+    }
+    return SM_OK;
+}
+
+/* F(q) at s = Omega^2; leaves the kinematics of q in w->kin.  Returns ||F||. */
+static double eq_residual(const sm_model *m, const double *q, double s, eq_ws *w)
+{
+    int n = m->n;
+    frames_eval(m, q, &w->kin);
+    frames_centrifugal(m, &w->kin, w->g);
+    memset(w->F, 0, (size_t)n * sizeof(double));
+    lin_elastic_force(m, q, w->F);
+    if (m->opt.geometric_stiffening)
+        lin_geometric_force(m, q, w->F);
+    for (int i = 0; i < n; i++)
+        w->F[i] -= s * w->g[i];
+    return dm_norm(w->F, n);
+}
+
+/* Kt = K + df_g/dq - s (M* + H) at the kinematics in w->kin, then LU. */
+static int eq_tangent(const sm_model *m, const double *q, double s, eq_ws *w)
+{
+    int n = m->n;
+    lin_mass(m, &w->kin, &w->M, &w->W);
+    dm_zero(&w->H);
+    frames_hessian(m, q, &w->kin, &w->H, w->work);
+    for (size_t i = 0; i < (size_t)n * n; i++)
+        w->Kt.a[i] = -s * (w->M.a[i] + w->H.a[i]);
+    lin_elastic_add(m, &w->Kt);
+    if (m->opt.geometric_stiffening)
+        lin_geometric_tangent(m, q, 0, &w->Kt, w->work);
+    return LAPACKE_dgetrf(LAPACK_COL_MAJOR, n, n, w->Kt.a, n, w->ipiv) == 0 ? SM_OK : SM_SINGULAR;
+}
+
+static int eq_progress(sm_progress *pr)
+{
+    return pr && pr->cb && pr->cb(pr->user, pr->done, pr->total);
+}
+
+/*
+ * Newton-Raphson at fixed s from q (in/out).  Returns 1 converged, 0 not,
+ * -1 canceled.  On return w->kin holds the kinematics of q and w->Kt the LU
+ * of the last tangent.
+ */
+static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progress *pr)
+{
+    int n = m->n;
+    double tol = m->opt.tolerance;
+    double r = eq_residual(m, q, s, w), prev_step = INFINITY;
+    for (int it = 0; it < m->opt.max_iterations; it++) {
+        if (!isfinite(r) || eq_tangent(m, q, s, w) != SM_OK)
+            return 0;
+        for (int i = 0; i < n; i++)
+            w->dq[i] = -w->F[i];
+        LAPACKE_dgetrs(LAPACK_COL_MAJOR, 'N', n, 1, w->Kt.a, n, w->ipiv, w->dq, n);
+        double step = dm_norm(w->dq, n), alpha = 1.0, rt = 0;
+        /* damped step: halve while the residual grows */
+        for (int tries = 0; tries < 8; tries++) {
+            for (int i = 0; i < n; i++)
+                w->qt[i] = q[i] + alpha * w->dq[i];
+            rt = eq_residual(m, w->qt, s, w);
+            if (isfinite(rt) && (rt <= r || step <= 1e-6 * fmax(1.0, dm_norm(q, n))))
+                break;
+            alpha *= 0.5;
+        }
+        memcpy(q, w->qt, (size_t)n * sizeof(double));
+        w->iterations++;
+        w->residual = rt;
+        if (eq_progress(pr))
+            return -1;
+        double qn = fmax(1.0, dm_norm(q, n));
+        if (!isfinite(rt) || qn > 1e12)
+            return 0;
+        if (alpha == 1.0 && step <= tol * qn)
+            return 1;
+        /* stagnation at round-off: the step no longer shrinks */
+        if (alpha == 1.0 && step <= 1e-8 * qn && step >= 0.5 * prev_step)
+            return 1;
+        prev_step = step;
+        r = rt;
+    }
+    return 0;
+}
+
+/*
+ * Continuation from (q, s_from) to s_to in s = Omega^2.  q is the converged
+ * state at s_from (zero at rest).  On success q is the equilibrium at s_to.
+ * On failure q is the last converged state and out->last_s its s.
+ */
+int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_rest,
+             sm_progress *pr, sm_eq_out *out)
+{
+    eq_ws w;
+    int n = m->n, rc = eq_ws_alloc(m, &w), incr = 0;
+    memset(out, 0, sizeof *out);
+    out->last_s = s_from;
+    if (rc < 0)
+        return rc;
+    double range = s_to - s_from;
+    double hmax = from_rest ? range / (m->opt.min_increments > 0 ? m->opt.min_increments : 1) : range;
+    double h = hmax, hmin = 1e-7 * fmax(s_to, 1e-12), s = s_from;
+    const char *why = "";
+    /* tangent at the start for the first predictor */
+    eq_residual(m, q, s, &w);
+    int have_lu = eq_tangent(m, q, s, &w) == SM_OK;
+    while (s < s_to) {
+        if (incr++ >= EQ_MAX_INCREMENTS || w.iterations >= EQ_MAX_TOTAL_ITER) {
+            why = "too many continuation steps";
+            break;
+        }
+        double sn = s + h >= s_to - 1e-12 * s_to ? s_to : s + h;
+        /* predictor: Kt dq = g ds */
+        memcpy(w.q0, q, (size_t)n * sizeof(double));
+        frames_eval(m, q, &w.kin);
+        frames_centrifugal(m, &w.kin, w.g);
+        memcpy(w.qp, q, (size_t)n * sizeof(double));
+        if (have_lu) {
+            memcpy(w.dq, w.g, (size_t)n * sizeof(double));
+            LAPACKE_dgetrs(LAPACK_COL_MAJOR, 'N', n, 1, w.Kt.a, n, w.ipiv, w.dq, n);
+            for (int i = 0; i < n; i++)
+                w.qp[i] += (sn - s) * w.dq[i];
+        }
+        memcpy(q, w.qp, (size_t)n * sizeof(double));
+        int it0 = w.iterations;
+        int ok = eq_newton(m, q, sn, &w, pr);
+        if (ok < 0) {
+            memcpy(q, w.q0, (size_t)n * sizeof(double));
+            out->canceled = 1;
+            break;
+        }
+        if (ok) {
+            /* branch check: the corrector must stay within the predicted step */
+            double step = 0, corr = 0;
+            for (int i = 0; i < n; i++) {
+                step += (w.qp[i] - w.q0[i]) * (w.qp[i] - w.q0[i]);
+                corr += (q[i] - w.qp[i]) * (q[i] - w.qp[i]);
+            }
+            step = sqrt(step);
+            corr = sqrt(corr);
+            if (have_lu && corr > fmax(step, 1e-6 * fmax(1.0, dm_norm(q, n)))) {
+                ok = 0;
+                why = "the solution jumped to another branch";
+            }
+        } else {
+            why = "Newton-Raphson did not converge";
+        }
+        if (ok) {
+            s = sn;
+            out->last_s = s;
+            have_lu = 1; /* the LU of the last Newton tangent, at s */
+            if (w.iterations - it0 <= 4)
+                h = fmin(2.0 * h, hmax);
+        } else {
+            memcpy(q, w.q0, (size_t)n * sizeof(double));
+            eq_residual(m, q, s, &w);
+            have_lu = eq_tangent(m, q, s, &w) == SM_OK;
+            h *= 0.5;
+            if (h < hmin)
+                break;
+        }
+    }
+    out->iterations = w.iterations;
+    out->converged = s >= s_to && !out->canceled;
+    out->residual = eq_residual(m, q, out->converged ? s_to : out->last_s, &w);
+    if (!out->converged && !out->canceled)
+        snprintf(out->message, sizeof out->message,
+                 "no equilibrium beyond Omega = %.6g rad/s (target %.6g rad/s): %s",
+                 sqrt(out->last_s), sqrt(s_to), why);
+    eq_ws_free(&w);
+    return SM_OK;
+}

@@ -1,0 +1,172 @@
+/*
+ * linearize.c — the terms of the equilibrium residual and of the linearised
+ * equations (DESIGN.md 1.3-1.4, Kim & Yoo eqs. 11, 22-26, 42-44):
+ *
+ *   elastic      f_e = K q,            K = blockdiag(N_s' Kbar_s N_s)
+ *   geometric    f_g = sum_e P_e T_e' G_e T_e q_s,   P_e = d_e . q_s   (eqs. 22, 24, 26)
+ *   mass         M*  = sum_p m_p J_p' J_p                                (eq. 42)
+ *   gyroscopic   C*  = 2 Omega sum_p m_p J_p' S J_p,  S = [[0,-1],[1,0]]  (eq. 43)
+ *
+ * The geometric tangent has two forms: with P frozen at P(q*) (the paper's
+ * K*, symmetric) and the full derivative that Newton-Raphson needs.
+ */
+#include "internal.h"
+
+#include <cblas.h>
+#include <math.h>
+#include <string.h>
+
+/** f += blockdiag(K_s) q. */
+void lin_elastic_force(const sm_model *m, const double *q, double *f)
+{
+    for (int s = 0; s < m->n_subs; s++) {
+        const sm_sub *b = &m->subs[s];
+        for (int i = 0; i < b->m; i++) {
+            double t = 0;
+            for (int j = 0; j < b->m; j++)
+                t += DM(&b->K, i, j) * q[b->q0 + j];
+            f[b->q0 + i] += t;
+        }
+    }
+}
+
+/** Kt += blockdiag(K_s). */
+void lin_elastic_add(const sm_model *m, dmat *Kt)
+{
+    for (int s = 0; s < m->n_subs; s++) {
+        const sm_sub *b = &m->subs[s];
+        for (int j = 0; j < b->m; j++)
+            for (int i = 0; i < b->m; i++)
+                DM(Kt, b->q0 + i, b->q0 + j) += DM(&b->K, i, j);
+    }
+}
+
+/* Bending rows (v1, phi1, v2, phi2) of T_e q_s, and P_e = d_e . q_s. */
+static double lin_element_state(const sm_sub *b, int j, const double *qs, double tb[4])
+{
+    static const int rows[4] = {1, 2, 4, 5};
+    const double *d = b->d + (size_t)j * b->m;
+    double P = 0;
+    for (int r = 0; r < 4; r++)
+        tb[r] = 0;
+    for (int c = 0; c < b->m; c++) {
+        P += d[c] * qs[c];
+        for (int r = 0; r < 4; r++)
+            tb[r] += DM(&b->T, 6 * j + rows[r], c) * qs[c];
+    }
+    return P;
+}
+
+/** f += f_g(q) = sum_e P_e T_e' G_e T_e q_s (eqs. 22, 26). */
+void lin_geometric_force(const sm_model *m, const double *q, double *f)
+{
+    static const int rows[4] = {1, 2, 4, 5};
+    for (int s = 0; s < m->n_subs; s++) {
+        const sm_sub *b = &m->subs[s];
+        const double *qs = q + b->q0;
+        for (int j = 0; j < b->nel; j++) {
+            double tb[4], gt[4];
+            double P = lin_element_state(b, j, qs, tb);
+            const double *g = b->gq + 16 * j;
+            for (int r = 0; r < 4; r++)
+                gt[r] = P * (g[r] * tb[0] + g[r + 4] * tb[1] + g[r + 8] * tb[2] + g[r + 12] * tb[3]);
+            for (int c = 0; c < b->m; c++) {
+                double t = 0;
+                for (int r = 0; r < 4; r++)
+                    t += DM(&b->T, 6 * j + rows[r], c) * gt[r];
+                f[b->q0 + c] += t;
+            }
+        }
+    }
+}
+
+/**
+ * Kt += d f_g / dq.  frozen != 0: P_e held at P_e(q) (K*, symmetric);
+ * otherwise the full derivative, adding (T' G T q) d_e'.  work: >= 4*max m.
+ */
+void lin_geometric_tangent(const sm_model *m, const double *q, int frozen, dmat *Kt, double *work)
+{
+    static const int rows[4] = {1, 2, 4, 5};
+    for (int s = 0; s < m->n_subs; s++) {
+        const sm_sub *b = &m->subs[s];
+        const double *qs = q + b->q0;
+        int mm = b->m, q0 = b->q0;
+        double *V = work; /* 4 x mm: V = G Tb */
+        for (int j = 0; j < b->nel; j++) {
+            double tb[4];
+            double P = lin_element_state(b, j, qs, tb);
+            const double *g = b->gq + 16 * j, *d = b->d + (size_t)j * mm;
+            for (int c = 0; c < mm; c++)
+                for (int r = 0; r < 4; r++) {
+                    double t = 0;
+                    for (int p = 0; p < 4; p++)
+                        t += g[r + 4 * p] * DM(&b->T, 6 * j + rows[p], c);
+                    V[r + 4 * c] = t;
+                }
+            /* Kt_s += P Tb' V */
+            for (int jc = 0; jc < mm; jc++)
+                for (int ic = 0; ic < mm; ic++) {
+                    double t = 0;
+                    for (int r = 0; r < 4; r++)
+                        t += DM(&b->T, 6 * j + rows[r], ic) * V[r + 4 * jc];
+                    DM(Kt, q0 + ic, q0 + jc) += P * t;
+                }
+            if (!frozen) {
+                /* + (Tb' G tb) d' */
+                double gt[4];
+                for (int r = 0; r < 4; r++)
+                    gt[r] = g[r] * tb[0] + g[r + 4] * tb[1] + g[r + 8] * tb[2] + g[r + 12] * tb[3];
+                for (int ic = 0; ic < mm; ic++) {
+                    double t = 0;
+                    for (int r = 0; r < 4; r++)
+                        t += DM(&b->T, 6 * j + rows[r], ic) * gt[r];
+                    for (int jc = 0; jc < mm; jc++)
+                        DM(Kt, q0 + ic, q0 + jc) += t * d[jc];
+                }
+            }
+        }
+    }
+}
+
+/* W = J_p columns scaled by sqrt(m_p), (n x 2 n_mp). */
+static void lin_weighted(const sm_model *m, const sm_kin *k, dmat *W)
+{
+    for (int p = 0; p < m->n_mp; p++) {
+        double w = sqrt(m->mp[p].mass);
+        for (int h = 0; h < 2; h++) {
+            const double *src = &DM(&k->Jp, 0, 2 * p + h);
+            double *dst = &DM(W, 0, 2 * p + h);
+            for (int i = 0; i < m->n; i++)
+                dst[i] = w * src[i];
+        }
+    }
+}
+
+/** M = sum_p m_p J_p' J_p (eq. 42), full symmetric.  W: n x 2 n_mp scratch. */
+void lin_mass(const sm_model *m, const sm_kin *k, dmat *M, dmat *W)
+{
+    int n = m->n;
+    lin_weighted(m, k, W);
+    /* M = W W' */
+    cblas_dsyrk(CblasColMajor, CblasUpper, CblasNoTrans, n, W->cols, 1.0, W->a, n, 0.0, M->a, n);
+    for (int j = 0; j < n; j++)
+        for (int i = j + 1; i < n; i++)
+            DM(M, i, j) = DM(M, j, i);
+}
+
+/**
+ * C = 2 Omega sum_p m_p J_p' S J_p (eq. 43): with columns jx, jy of J_p',
+ * J'SJ = jy jx' - jx jy', so C = 2 Omega (X - X'), X = Wy Wx'.
+ * W: n x 2 n_mp scratch, X: n x n scratch.
+ */
+void lin_gyro(const sm_model *m, const sm_kin *k, double omega, dmat *C, dmat *W, dmat *X)
+{
+    int n = m->n, np = m->n_mp;
+    lin_weighted(m, k, W);
+    /* columns 2p are x, 2p+1 are y: stride 2n in the column-major W */
+    cblas_dgemm(CblasColMajor, CblasNoTrans, CblasTrans, n, n, np, 1.0, W->a + n, 2 * n,
+                W->a, 2 * n, 0.0, X->a, n);
+    for (int j = 0; j < n; j++)
+        for (int i = 0; i < n; i++)
+            DM(C, i, j) = 2.0 * omega * (DM(X, i, j) - DM(X, j, i));
+}

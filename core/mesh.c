@@ -1,0 +1,354 @@
+/*
+ * mesh.c — from the user's structure (joints, members, sections) to the FE
+ * mesh and the substructures (DESIGN.md 1.1-1.2).
+ *
+ * The members must form a tree rooted at the clamp joint.  A breadth-first
+ * walk from the clamp orients every member away from it; nodes and elements
+ * are numbered in that order, so every non-clamp node is the far node (n2) of
+ * exactly one element.  The frame scheme then cuts the elements into runs
+ * (substructures); a substructure's root is the near node of its first
+ * element and its parent is the substructure holding that node.
+ */
+#include "internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define MESH_MAX_ITEMS 1000000
+
+static int mesh_fail(sm_diag *d, sm_item item, int index, const char *field,
+                     const char *msg)
+{
+    if (d) {
+        d->status = SM_INVALID_INPUT;
+        d->item = item;
+        d->item_index = index;
+        snprintf(d->field, sizeof d->field, "%s", field ? field : "");
+        snprintf(d->message, sizeof d->message, "%s", msg);
+    }
+    return SM_INVALID_INPUT;
+}
+
+static int mesh_positive(double v)
+{
+    return isfinite(v) && v > 0.0;
+}
+
+/* Check numbers, indices and options; topology is checked by mesh_walk. */
+static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
+{
+    if (st->n_joints < 1 || st->n_joints > MESH_MAX_ITEMS || !st->joint_xy)
+        return mesh_fail(d, SM_ITEM_NONE, -1, "", "the structure has no joints");
+    if (st->n_members < 1 || st->n_members > MESH_MAX_ITEMS || !st->members)
+        return mesh_fail(d, SM_ITEM_NONE, -1, "", "the structure has no members");
+    if (st->n_sections < 1 || !st->sections)
+        return mesh_fail(d, SM_ITEM_NONE, -1, "", "the structure has no sections");
+    if (st->clamp < 0 || st->clamp >= st->n_joints)
+        return mesh_fail(d, SM_ITEM_CLAMP, -1, "", "the clamp is not a joint of the structure");
+    for (int j = 0; j < st->n_joints; j++)
+        if (!isfinite(st->joint_xy[2 * j]) || !isfinite(st->joint_xy[2 * j + 1]))
+            return mesh_fail(d, SM_ITEM_JOINT, j, "", "joint coordinates must be finite numbers");
+    for (int s = 0; s < st->n_sections; s++) {
+        const sm_section *c = &st->sections[s];
+        if (!mesh_positive(c->E))
+            return mesh_fail(d, SM_ITEM_SECTION, s, "E", "E must be a positive number (Pa)");
+        if (!mesh_positive(c->A))
+            return mesh_fail(d, SM_ITEM_SECTION, s, "A", "A must be a positive number (m^2)");
+        if (!mesh_positive(c->I))
+            return mesh_fail(d, SM_ITEM_SECTION, s, "I", "I must be a positive number (m^4)");
+        if (!mesh_positive(c->mu))
+            return mesh_fail(d, SM_ITEM_SECTION, s, "mass_per_length",
+                             "mass_per_length must be a positive number (kg/m)");
+    }
+    long total = 0;
+    for (int i = 0; i < st->n_members; i++) {
+        const sm_member *b = &st->members[i];
+        if (b->from < 0 || b->from >= st->n_joints)
+            return mesh_fail(d, SM_ITEM_MEMBER, i, "from", "unknown joint");
+        if (b->to < 0 || b->to >= st->n_joints)
+            return mesh_fail(d, SM_ITEM_MEMBER, i, "to", "unknown joint");
+        if (b->section < 0 || b->section >= st->n_sections)
+            return mesh_fail(d, SM_ITEM_MEMBER, i, "section", "unknown section");
+        if (b->elements < 1 || b->elements > MESH_MAX_ITEMS)
+            return mesh_fail(d, SM_ITEM_MEMBER, i, "elements", "elements must be a positive integer");
+        total += b->elements;
+        if (total > MESH_MAX_ITEMS)
+            return mesh_fail(d, SM_ITEM_MEMBER, i, "elements", "too many elements");
+        double dx = st->joint_xy[2 * b->to] - st->joint_xy[2 * b->from];
+        double dy = st->joint_xy[2 * b->to + 1] - st->joint_xy[2 * b->from + 1];
+        if (b->from == b->to || !(hypot(dx, dy) > 0.0))
+            return mesh_fail(d, SM_ITEM_MEMBER, i, "", "zero-length member: its joints coincide");
+    }
+    for (int i = 0; i < st->n_point_masses; i++) {
+        const sm_point_mass *p = &st->point_masses[i];
+        if (p->joint < 0 || p->joint >= st->n_joints)
+            return mesh_fail(d, SM_ITEM_POINT_MASS, i, "joint", "unknown joint");
+        if (!isfinite(p->mass) || p->mass < 0.0)
+            return mesh_fail(d, SM_ITEM_POINT_MASS, i, "mass", "mass must be a non-negative number (kg)");
+    }
+    if (o->modes < 1)
+        return mesh_fail(d, SM_ITEM_OPTIONS, -1, "modes", "modes must be a positive integer");
+    if ((o->frames == SM_FRAMES_PER_MEMBER || o->frames == SM_FRAMES_ELEMENTS_PER_FRAME) &&
+        o->frames_param < 1)
+        return mesh_fail(d, SM_ITEM_OPTIONS, -1, "frames", "the frame count must be a positive integer");
+    if (o->frames < SM_FRAMES_SINGLE || o->frames > SM_FRAMES_PER_ELEMENT)
+        return mesh_fail(d, SM_ITEM_OPTIONS, -1, "frames", "unknown frame scheme");
+    if (o->modes_per_frame < 0)
+        return mesh_fail(d, SM_ITEM_OPTIONS, -1, "modes_per_frame", "modes_per_frame must be positive or all");
+    return SM_OK;
+}
+
+/*
+ * Breadth-first walk from the clamp: order[] receives the members in visit
+ * order, near[] the joint each member is entered from.  Detects cycles,
+ * members not connected to the clamp and joints on no member.
+ */
+static int mesh_walk(const sm_structure *st, int *order, int *near, sm_diag *d)
+{
+    int nj = st->n_joints, nm = st->n_members, rc = SM_NOMEM;
+    int *seen = calloc((size_t)nj, sizeof(int));
+    int *used = calloc((size_t)nm, sizeof(int));
+    int *queue = malloc((size_t)nj * sizeof(int));
+    if (!seen || !used || !queue)
+        goto done;
+    int head = 0, tail = 0, count = 0;
+    queue[tail++] = st->clamp;
+    seen[st->clamp] = 1;
+    while (head < tail) {
+        int j = queue[head++];
+        for (int i = 0; i < nm; i++) {
+            const sm_member *b = &st->members[i];
+            if (used[i] || (b->from != j && b->to != j))
+                continue;
+            int other = b->from == j ? b->to : b->from;
+            if (seen[other]) {
+                rc = mesh_fail(d, SM_ITEM_MEMBER, i, "",
+                               "this member closes a cycle: members must form a tree rooted at the clamp");
+                goto done;
+            }
+            used[i] = 1;
+            seen[other] = 1;
+            order[count] = i;
+            near[count] = j;
+            count++;
+            queue[tail++] = other;
+        }
+    }
+    if (count == 0) {
+        rc = mesh_fail(d, SM_ITEM_CLAMP, -1, "", "the clamp joint is not on any member");
+        goto done;
+    }
+    for (int i = 0; i < nm; i++)
+        if (!used[i]) {
+            rc = mesh_fail(d, SM_ITEM_MEMBER, i, "",
+                           "this member is not connected to the clamp joint");
+            goto done;
+        }
+    for (int j = 0; j < nj; j++)
+        if (!seen[j]) {
+            rc = mesh_fail(d, SM_ITEM_JOINT, j, "", "this joint is not on any member");
+            goto done;
+        }
+    rc = SM_OK;
+done:
+    free(seen);
+    free(used);
+    free(queue);
+    return rc;
+}
+
+/* Nodes and elements along the walk order. */
+static int mesh_nodes(sm_model *m, const sm_structure *st, const int *order, const int *near)
+{
+    int ne = 0;
+    for (int i = 0; i < st->n_members; i++)
+        ne += st->members[i].elements;
+    m->n_elems = ne;
+    m->n_nodes = ne + 1; /* a tree */
+    m->n_joints = st->n_joints;
+    m->nodes = calloc((size_t)m->n_nodes, sizeof(sm_node));
+    m->elems = calloc((size_t)ne, sizeof(sm_elem));
+    m->joint_node = malloc((size_t)st->n_joints * sizeof(int));
+    if (!m->nodes || !m->elems || !m->joint_node)
+        return SM_NOMEM;
+    for (int j = 0; j < st->n_joints; j++)
+        m->joint_node[j] = -1;
+    int nn = 0, e = 0;
+    sm_node *c = &m->nodes[nn++];
+    c->x = st->joint_xy[2 * st->clamp];
+    c->y = st->joint_xy[2 * st->clamp + 1];
+    c->joint = st->clamp;
+    c->sub = c->local = -1;
+    m->joint_node[st->clamp] = 0;
+    m->clamp_node = 0;
+    for (int k = 0; k < st->n_members; k++) {
+        const sm_member *b = &st->members[order[k]];
+        const sm_section *sec = &st->sections[b->section];
+        int a = near[k], z = b->from == a ? b->to : b->from;
+        double x0 = st->joint_xy[2 * a], y0 = st->joint_xy[2 * a + 1];
+        double dx = st->joint_xy[2 * z] - x0, dy = st->joint_xy[2 * z + 1] - y0;
+        double len = hypot(dx, dy), ang = atan2(dy, dx);
+        int prev = m->joint_node[a];
+        for (int i = 1; i <= b->elements; i++) {
+            sm_node *nd = &m->nodes[nn];
+            double t = (double)i / b->elements;
+            nd->x = x0 + t * dx;
+            nd->y = y0 + t * dy;
+            nd->joint = i == b->elements ? z : -1;
+            nd->sub = nd->local = -1;
+            if (i == b->elements) {
+                nd->x = st->joint_xy[2 * z]; /* exact joint position */
+                nd->y = st->joint_xy[2 * z + 1];
+                m->joint_node[z] = nn;
+            }
+            sm_elem *el = &m->elems[e++];
+            el->n1 = prev;
+            el->n2 = nn;
+            el->member = order[k];
+            el->l = len / b->elements;
+            el->angle = ang;
+            el->EA = sec->E * sec->A;
+            el->EI = sec->E * sec->I;
+            el->mu = sec->mu;
+            el->sub = -1;
+            prev = nn++;
+        }
+    }
+    /* lumped masses: mu*(l_left + l_right)/2 on each node, each node once */
+    for (int i = 0; i < ne; i++) {
+        double h = 0.5 * m->elems[i].mu * m->elems[i].l;
+        m->nodes[m->elems[i].n1].mass += h;
+        m->nodes[m->elems[i].n2].mass += h;
+    }
+    for (int i = 0; i < st->n_point_masses; i++) {
+        int k = m->joint_node[st->point_masses[i].joint];
+        m->nodes[k].mass += st->point_masses[i].mass;
+        m->nodes[k].point_mass += st->point_masses[i].mass;
+    }
+    return SM_OK;
+}
+
+/* Number of elements in each run of a member of ne elements under the scheme. */
+static int mesh_run_start(const sm_options *o, int i, int ne)
+{
+    switch (o->frames) {
+    case SM_FRAMES_SINGLE:
+        return 0;
+    case SM_FRAMES_PER_ELEMENT:
+        return 1;
+    case SM_FRAMES_ELEMENTS_PER_FRAME:
+        return i % o->frames_param == 0;
+    case SM_FRAMES_PER_MEMBER: {
+        int k = o->frames_param < ne ? o->frames_param : ne;
+        /* run r covers elements [floor(r*ne/k), floor((r+1)*ne/k)) */
+        for (int r = 0; r < k; r++)
+            if ((int)(((long)r * ne) / k) == i)
+                return 1;
+        return 0;
+    }
+    }
+    return 0;
+}
+
+/* Cut the elements into substructures and fill their topology. */
+static int mesh_subs(sm_model *m, const sm_structure *st)
+{
+    int ne = m->n_elems, ns = 0;
+    int *start = calloc((size_t)ne, sizeof(int));
+    if (!start)
+        return SM_NOMEM;
+    for (int e = 0, i = 0; e < ne; e++, i++) {
+        if (e > 0 && m->elems[e].member != m->elems[e - 1].member)
+            i = 0;
+        int nel = st->members[m->elems[e].member].elements;
+        start[e] = e == 0 || (i == 0 && m->opt.frames != SM_FRAMES_SINGLE) ||
+                   mesh_run_start(&m->opt, i, nel);
+        ns += start[e];
+    }
+    m->n_subs = ns;
+    m->subs = calloc((size_t)ns, sizeof(sm_sub));
+    if (!m->subs) {
+        free(start);
+        return SM_NOMEM;
+    }
+    int s = -1;
+    for (int e = 0; e < ne; e++) {
+        if (start[e])
+            s++;
+        m->elems[e].sub = s;
+        m->subs[s].nel++;
+    }
+    free(start);
+    for (int k = 0; k < ns; k++) {
+        sm_sub *b = &m->subs[k];
+        b->elems = malloc((size_t)b->nel * sizeof(int));
+        b->free_nodes = malloc((size_t)b->nel * sizeof(int));
+        b->ubar = malloc((size_t)b->nel * 2 * sizeof(double));
+        b->attach = malloc((size_t)b->nel * sizeof(int));
+        if (!b->elems || !b->free_nodes || !b->ubar || !b->attach)
+            return SM_NOMEM;
+        b->nel = 0;
+    }
+    for (int e = 0; e < ne; e++) {
+        sm_elem *el = &m->elems[e];
+        sm_sub *b = &m->subs[el->sub];
+        if (b->nel == 0) {
+            b->root = el->n1;
+            b->theta0 = el->angle;
+        }
+        b->elems[b->nel++] = e;
+        m->nodes[el->n2].sub = el->sub;
+        m->nodes[el->n2].local = b->nfree;
+        b->free_nodes[b->nfree++] = el->n2;
+    }
+    for (int k = 0; k < ns; k++) {
+        sm_sub *b = &m->subs[k];
+        const sm_node *r = &m->nodes[b->root];
+        double c = cos(b->theta0), si = sin(b->theta0);
+        for (int i = 0; i < b->nfree; i++) {
+            const sm_node *nd = &m->nodes[b->free_nodes[i]];
+            double dx = nd->x - r->x, dy = nd->y - r->y;
+            b->ubar[2 * i] = c * dx + si * dy; /* A(theta0)' (X - X_root) */
+            b->ubar[2 * i + 1] = -si * dx + c * dy;
+        }
+        b->parent = r->sub;
+        b->attach_local = r->local;
+        if (b->parent >= 0) {
+            sm_sub *p = &m->subs[b->parent];
+            b->beta = b->theta0 - p->theta0;
+            int dup = 0;
+            for (int a = 0; a < p->n_attach; a++)
+                dup |= p->attach[a] == r->local;
+            if (!dup)
+                p->attach[p->n_attach++] = r->local;
+        } else {
+            b->beta = b->theta0;
+        }
+    }
+    return SM_OK;
+}
+
+int mesh_build(sm_model *m, const sm_structure *st, sm_diag *d)
+{
+    int rc = mesh_check(st, &m->opt, d);
+    if (rc < 0)
+        return rc;
+    int *order = malloc((size_t)st->n_members * sizeof(int));
+    int *near = malloc((size_t)st->n_members * sizeof(int));
+    rc = SM_NOMEM;
+    if (!order || !near)
+        goto done;
+    rc = mesh_walk(st, order, near, d);
+    if (rc < 0)
+        goto done;
+    rc = mesh_nodes(m, st, order, near);
+    if (rc < 0)
+        goto done;
+    rc = mesh_subs(m, st);
+done:
+    free(order);
+    free(near);
+    return rc;
+}

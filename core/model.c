@@ -1,0 +1,113 @@
+/*
+ * model.c — the sm_model lifecycle: defaults, construction (mesh.c then
+ * modes.c), queries and destruction.
+ */
+#include "internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void sm_default_options(sm_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->frames = SM_FRAMES_PER_ELEMENT;
+    o->frames_param = 1;
+    o->mass = SM_MASS_LUMPED;
+    o->basis = SM_BASIS_AUGMENTED;
+    o->modes_per_frame = 0;
+    o->modes = 3;
+    o->geometric_stiffening = 1;
+    o->coriolis = 1;
+    o->mode_shapes = 1;
+    o->min_increments = 5;
+    o->max_iterations = 40;
+    o->tolerance = 1e-10;
+}
+
+void sm_model_free(sm_model *m)
+{
+    if (!m)
+        return;
+    for (int s = 0; m->subs && s < m->n_subs; s++) {
+        sm_sub *b = &m->subs[s];
+        free(b->free_nodes);
+        free(b->ubar);
+        free(b->elems);
+        free(b->attach);
+        dm_free(&b->N);
+        dm_free(&b->K);
+        dm_free(&b->T);
+        free(b->d);
+        free(b->gq);
+        free(b->qpN);
+    }
+    free(m->subs);
+    free(m->nodes);
+    free(m->elems);
+    free(m->joint_node);
+    free(m->mp);
+    free(m);
+}
+
+int sm_model_new(sm_model **out, const sm_structure *st, const sm_options *opt, sm_diag *diag)
+{
+    sm_diag scratch;
+    sm_diag *d = diag ? diag : &scratch;
+    memset(d, 0, sizeof *d);
+    d->item_index = -1;
+    *out = NULL;
+    sm_model *m = calloc(1, sizeof *m);
+    if (!m) {
+        d->status = SM_NOMEM;
+        return SM_NOMEM;
+    }
+    if (opt)
+        m->opt = *opt;
+    else
+        sm_default_options(&m->opt);
+    if (m->opt.min_increments < 1)
+        m->opt.min_increments = 1;
+    if (m->opt.max_iterations < 1)
+        m->opt.max_iterations = 40;
+    if (!(m->opt.tolerance > 0))
+        m->opt.tolerance = 1e-10;
+    int rc = mesh_build(m, st, d);
+    if (rc == SM_OK)
+        rc = modes_build(m, d);
+    if (rc < 0) {
+        if (rc == SM_NOMEM && !d->message[0])
+            strcpy(d->message, "out of memory while building the model");
+        d->status = rc;
+        sm_model_free(m);
+        return rc;
+    }
+    *out = m;
+    return SM_OK;
+}
+
+void sm_model_get_info(const sm_model *m, sm_model_info *info)
+{
+    info->nodes = m->n_nodes;
+    info->elements = m->n_elems;
+    info->frames = m->n_subs;
+    info->coordinates = m->n;
+}
+
+int sm_model_joint_node(const sm_model *m, int joint)
+{
+    return joint >= 0 && joint < m->n_joints ? m->joint_node[joint] : -1;
+}
+
+int sm_model_element_member(const sm_model *m, int element)
+{
+    return element >= 0 && element < m->n_elems ? m->elems[element].member : -1;
+}
+
+int sm_model_node_position(const sm_model *m, int node, double xy[2])
+{
+    if (node < 0 || node >= m->n_nodes)
+        return SM_INVALID_INPUT;
+    xy[0] = m->nodes[node].x;
+    xy[1] = m->nodes[node].y;
+    return SM_OK;
+}

@@ -1,0 +1,424 @@
+/*
+ * modes.c — component-mode bases N_s of the substructures (DESIGN.md 1.2,
+ * Kim & Yoo eqs. 2, 11, 18, 24) and the mass points that carry the inertia.
+ *
+ * Each substructure is clamped at its root node.  Its free-node DOFs are
+ * (u, v, phi) per node in the substructure frame.
+ *  - lumped mass, basis "paper": the rotations are massless and are condensed
+ *    statically, X = -Krr^-1 Krt, Kc = Ktt + Ktr X; Kc phi = w^2 Mt phi;
+ *    N = [phi; X phi] (all 2F modes by default).
+ *  - basis "augmented": in addition, for every attachment node (where a child
+ *    frame sits) one column with zero translations, unit rotation at that
+ *    node and the other rotations condensed.  Together with the paper modes it
+ *    spans {(t, a, c(t, a))}: the attachment rotations are free coordinates.
+ *  - consistent mass: modes of the full consistent-mass substructure; with a
+ *    truncation and the augmented basis, unit-moment static modes are added
+ *    (M-orthogonalised against the kept modes).
+ * Then per element: T_e = C(alpha) L_e N, d_e (P_e = d_e . q_s) and the
+ * bending block of G_e; and the mass points (nodes, or Gauss points of every
+ * element for consistent mass, plus point masses).
+ */
+#include "internal.h"
+
+#include <lapacke.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int modes_fail(sm_diag *d, int rc, const char *msg)
+{
+    if (d) {
+        d->status = rc;
+        snprintf(d->message, sizeof d->message, "%s", msg);
+    }
+    return rc;
+}
+
+/* Local DOF index (0..3F) of component c of FE node k in substructure b, or -1. */
+static int modes_dof(const sm_model *m, const sm_sub *b, int k, int c)
+{
+    const sm_node *nd = &m->nodes[k];
+    if (k == b->root || nd->sub != (int)(b - m->subs))
+        return -1;
+    return 3 * nd->local + c;
+}
+
+/* Kbar (and Mbar for consistent mass) of a substructure in its frame. */
+static void modes_assemble(const sm_model *m, const sm_sub *b, dmat *K, dmat *M)
+{
+    double kl[36], kf[36];
+    for (int j = 0; j < b->nel; j++) {
+        const sm_elem *e = &m->elems[b->elems[j]];
+        double alpha = e->angle - b->theta0;
+        int idx[6];
+        for (int c = 0; c < 3; c++) {
+            idx[c] = modes_dof(m, b, e->n1, c);
+            idx[3 + c] = modes_dof(m, b, e->n2, c);
+        }
+        fe_stiffness_local(e->EA, e->EI, e->l, kl);
+        fe_to_frame(kl, alpha, kf);
+        for (int r = 0; r < 6; r++)
+            for (int c = 0; c < 6; c++)
+                if (idx[r] >= 0 && idx[c] >= 0)
+                    DM(K, idx[r], idx[c]) += kf[r + 6 * c];
+        if (M && M->a) {
+            fe_mass_consistent_local(e->mu, e->l, kl);
+            fe_to_frame(kl, alpha, kf);
+            for (int r = 0; r < 6; r++)
+                for (int c = 0; c < 6; c++)
+                    if (idx[r] >= 0 && idx[c] >= 0)
+                        DM(M, idx[r], idx[c]) += kf[r + 6 * c];
+        }
+    }
+    if (M && M->a) /* point masses (translations) */
+        for (int i = 0; i < b->nfree; i++) {
+            double pm = m->nodes[b->free_nodes[i]].point_mass;
+            DM(M, 3 * i, 3 * i) += pm;
+            DM(M, 3 * i + 1, 3 * i + 1) += pm;
+        }
+}
+
+static int modes_is_attach(const sm_sub *b, int i)
+{
+    for (int a = 0; a < b->n_attach; a++)
+        if (b->attach[a] == i)
+            return 1;
+    return 0;
+}
+
+/*
+ * Lumped mass: paper basis (condensed rotations) + attachment columns.
+ * Fills b->N with 3F rows.
+ */
+static int modes_lumped(const sm_model *m, sm_sub *b, const dmat *K)
+{
+    int F = b->nfree, T = 2 * F, rc = SM_NOMEM;
+    int nm = m->opt.modes_per_frame > 0 && m->opt.modes_per_frame < T ? m->opt.modes_per_frame : T;
+    int na = m->opt.basis == SM_BASIS_AUGMENTED ? b->n_attach : 0;
+    dmat Krr = {0}, X = {0}, Kc = {0}, Kcc = {0}, Y = {0};
+    double *w = dm_vec((size_t)T), *sq = dm_vec((size_t)T);
+    int *cidx = malloc((size_t)F * sizeof(int));
+    if (!w || !sq || !cidx || dm_alloc(&Krr, F, F) || dm_alloc(&X, F, T) || dm_alloc(&Kc, T, T))
+        goto done;
+    for (int i = 0; i < F; i++)
+        for (int j = 0; j < F; j++)
+            DM(&Krr, i, j) = DM(K, 3 * i + 2, 3 * j + 2);
+    /* X = -Krr^-1 Krt */
+    for (int i = 0; i < F; i++)
+        for (int j = 0; j < T; j++)
+            DM(&X, i, j) = -DM(K, 3 * i + 2, 3 * (j / 2) + j % 2);
+    rc = SM_SINGULAR;
+    if (LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', F, T, Krr.a, F, X.a, F) != 0)
+        goto done;
+    /* Kc = Ktt + Ktr X, scaled: D^-1/2 Kc D^-1/2 with D the node masses */
+    for (int i = 0; i < T; i++)
+        sq[i] = 1.0 / sqrt(m->nodes[b->free_nodes[i / 2]].mass);
+    for (int i = 0; i < T; i++)
+        for (int j = 0; j < T; j++) {
+            double s = DM(K, 3 * (i / 2) + i % 2, 3 * (j / 2) + j % 2);
+            for (int p = 0; p < F; p++)
+                s += DM(K, 3 * (i / 2) + i % 2, 3 * p + 2) * DM(&X, p, j);
+            DM(&Kc, i, j) = s * sq[i] * sq[j];
+        }
+    rc = SM_LAPACK_FAILED;
+    if (LAPACKE_dsyevd(LAPACK_COL_MAJOR, 'V', 'U', T, Kc.a, T, w) != 0)
+        goto done;
+    rc = SM_NOMEM;
+    b->m = nm + na;
+    if (dm_alloc(&b->N, 3 * F, b->m))
+        goto done;
+    for (int j = 0; j < nm; j++) {
+        /* phi = D^-1/2 v (mass-normalised); rotations = X phi */
+        for (int i = 0; i < T; i++)
+            DM(&b->N, 3 * (i / 2) + i % 2, j) = sq[i] * DM(&Kc, i, j);
+        for (int p = 0; p < F; p++) {
+            double s = 0;
+            for (int i = 0; i < T; i++)
+                s += DM(&X, p, i) * sq[i] * DM(&Kc, i, j);
+            DM(&b->N, 3 * p + 2, j) = s;
+        }
+    }
+    if (na > 0) {
+        /* attachment columns: t = 0, phi_a = 1, phi_c = -Kcc^-1 Kca */
+        int nc = 0;
+        for (int i = 0; i < F; i++)
+            if (!modes_is_attach(b, i))
+                cidx[nc++] = i;
+        if (dm_alloc(&Kcc, nc, nc) || dm_alloc(&Y, nc, na))
+            goto done;
+        for (int i = 0; i < nc; i++) {
+            for (int j = 0; j < nc; j++)
+                DM(&Kcc, i, j) = DM(K, 3 * cidx[i] + 2, 3 * cidx[j] + 2);
+            for (int a = 0; a < na; a++)
+                DM(&Y, i, a) = -DM(K, 3 * cidx[i] + 2, 3 * b->attach[a] + 2);
+        }
+        rc = SM_SINGULAR;
+        if (nc > 0 && LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', nc, na, Kcc.a, nc, Y.a, nc) != 0)
+            goto done;
+        for (int a = 0; a < na; a++) {
+            DM(&b->N, 3 * b->attach[a] + 2, nm + a) = 1.0;
+            for (int i = 0; i < nc; i++)
+                DM(&b->N, 3 * cidx[i] + 2, nm + a) = DM(&Y, i, a);
+        }
+    }
+    rc = SM_OK;
+done:
+    dm_free(&Krr);
+    dm_free(&X);
+    dm_free(&Kc);
+    dm_free(&Kcc);
+    dm_free(&Y);
+    free(w);
+    free(sq);
+    free(cidx);
+    return rc;
+}
+
+/* Consistent mass: modes of the full substructure (+ static attachment modes). */
+static int modes_consistent(const sm_model *m, sm_sub *b, const dmat *K, const dmat *M)
+{
+    int D = 3 * b->nfree, rc = SM_NOMEM;
+    int nm = m->opt.modes_per_frame > 0 && m->opt.modes_per_frame < D ? m->opt.modes_per_frame : D;
+    int na = (m->opt.basis == SM_BASIS_AUGMENTED && nm < D) ? b->n_attach : 0;
+    dmat A = {0}, B = {0}, F = {0};
+    double *w = dm_vec((size_t)D), *mx = dm_vec((size_t)D);
+    if (!w || !mx || dm_alloc(&A, D, D) || dm_alloc(&B, D, D))
+        goto done;
+    memcpy(A.a, K->a, (size_t)D * D * sizeof(double));
+    memcpy(B.a, M->a, (size_t)D * D * sizeof(double));
+    rc = SM_LAPACK_FAILED;
+    if (LAPACKE_dsygvd(LAPACK_COL_MAJOR, 1, 'V', 'U', D, A.a, D, B.a, D, w) != 0)
+        goto done;
+    rc = SM_NOMEM;
+    b->m = nm + na;
+    if (dm_alloc(&b->N, D, b->m))
+        goto done;
+    memcpy(b->N.a, A.a, (size_t)D * nm * sizeof(double));
+    if (na > 0) {
+        if (dm_alloc(&F, D, D))
+            goto done;
+        memcpy(F.a, K->a, (size_t)D * D * sizeof(double));
+        double *rhs = b->N.a + (size_t)D * nm;
+        for (int a = 0; a < na; a++)
+            rhs[(size_t)D * a + 3 * b->attach[a] + 2] = 1.0;
+        rc = SM_SINGULAR;
+        if (LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', D, na, F.a, D, rhs, D) != 0)
+            goto done;
+        /* M-orthogonalise each static mode against the kept modes and earlier ones */
+        for (int a = 0; a < nm + na; a++) {
+            if (a < nm)
+                continue;
+            double *x = b->N.a + (size_t)D * a;
+            for (int pass = 0; pass < 2; pass++)
+                for (int j = 0; j < a; j++) {
+                    const double *v = b->N.a + (size_t)D * j;
+                    double s = 0;
+                    for (int r = 0; r < D; r++) {
+                        double t = 0;
+                        for (int c = 0; c < D; c++)
+                            t += DM(M, r, c) * x[c];
+                        s += v[r] * t;
+                    }
+                    for (int r = 0; r < D; r++)
+                        x[r] -= s * v[r];
+                }
+            double nrm = 0;
+            for (int r = 0; r < D; r++) {
+                double t = 0;
+                for (int c = 0; c < D; c++)
+                    t += DM(M, r, c) * x[c];
+                nrm += x[r] * t;
+            }
+            rc = SM_SINGULAR;
+            if (!(nrm > 1e-24))
+                goto done;
+            for (int r = 0; r < D; r++)
+                x[r] /= sqrt(nrm);
+        }
+    }
+    rc = SM_OK;
+done:
+    dm_free(&A);
+    dm_free(&B);
+    dm_free(&F);
+    free(w);
+    free(mx);
+    return rc;
+}
+
+/* K_s = N' Kbar N (eq. 11). */
+static int modes_reduced_stiffness(sm_sub *b, const dmat *K)
+{
+    int D = 3 * b->nfree, mm = b->m;
+    dmat KN = {0};
+    if (dm_alloc(&KN, D, mm) || dm_alloc(&b->K, mm, mm)) {
+        dm_free(&KN);
+        return SM_NOMEM;
+    }
+    for (int i = 0; i < D; i++)
+        for (int j = 0; j < mm; j++) {
+            double s = 0;
+            for (int p = 0; p < D; p++)
+                s += DM(K, i, p) * DM(&b->N, p, j);
+            DM(&KN, i, j) = s;
+        }
+    for (int i = 0; i < mm; i++)
+        for (int j = 0; j < mm; j++) {
+            double s = 0;
+            for (int p = 0; p < D; p++)
+                s += DM(&b->N, p, i) * DM(&KN, p, j);
+            DM(&b->K, i, j) = s;
+        }
+    for (int i = 0; i < mm; i++) /* exact symmetry */
+        for (int j = 0; j < i; j++) {
+            double s = 0.5 * (DM(&b->K, i, j) + DM(&b->K, j, i));
+            DM(&b->K, i, j) = DM(&b->K, j, i) = s;
+        }
+    dm_free(&KN);
+    return SM_OK;
+}
+
+/* T_e = C(alpha) L_e N (eq. 18), d_e (eq. 24) and the bending block of G_e (eq. 23). */
+static int modes_elements(const sm_model *m, sm_sub *b)
+{
+    int mm = b->m;
+    if (dm_alloc(&b->T, 6 * b->nel, mm))
+        return SM_NOMEM;
+    b->d = dm_vec((size_t)b->nel * mm);
+    b->gq = dm_vec((size_t)b->nel * 16);
+    if (!b->d || !b->gq)
+        return SM_NOMEM;
+    for (int j = 0; j < b->nel; j++) {
+        const sm_elem *e = &m->elems[b->elems[j]];
+        double alpha = e->angle - b->theta0, co = cos(alpha), si = sin(alpha);
+        int ends[2] = {e->n1, e->n2};
+        for (int h = 0; h < 2; h++) {
+            int r0 = modes_dof(m, b, ends[h], 0);
+            if (r0 < 0)
+                continue; /* the root: clamped in this basis */
+            for (int c = 0; c < mm; c++) {
+                double u = DM(&b->N, r0, c), v = DM(&b->N, r0 + 1, c);
+                DM(&b->T, 6 * j + 3 * h + 0, c) = co * u + si * v;
+                DM(&b->T, 6 * j + 3 * h + 1, c) = -si * u + co * v;
+                DM(&b->T, 6 * j + 3 * h + 2, c) = DM(&b->N, r0 + 2, c);
+            }
+        }
+        for (int c = 0; c < mm; c++)
+            b->d[(size_t)j * mm + c] =
+                e->EA / e->l * (DM(&b->T, 6 * j + 3, c) - DM(&b->T, 6 * j + 0, c));
+        fe_geometric_bending(e->l, b->gq + 16 * j);
+    }
+    return SM_OK;
+}
+
+/* Mass points: lumped nodes, or 4 Gauss points per element + point masses. */
+static int modes_mass_points(sm_model *m)
+{
+    static const double gx[4] = {-0.86113631159405258, -0.33998104358485626,
+                                 0.33998104358485626, 0.86113631159405258};
+    static const double gw[4] = {0.34785484513745386, 0.65214515486254614,
+                                 0.65214515486254614, 0.34785484513745386};
+    int consistent = m->opt.mass == SM_MASS_CONSISTENT, np = 0;
+    for (int k = 0; k < m->n_nodes; k++)
+        if (m->nodes[k].sub >= 0 && (consistent ? m->nodes[k].point_mass : m->nodes[k].mass) > 0)
+            np++;
+    if (consistent)
+        np += 4 * m->n_elems;
+    m->mp = calloc((size_t)(np ? np : 1), sizeof(sm_mpoint));
+    if (!m->mp)
+        return SM_NOMEM;
+    m->n_mp = 0;
+    for (int k = 0; k < m->n_nodes; k++) {
+        const sm_node *nd = &m->nodes[k];
+        double mass = consistent ? nd->point_mass : nd->mass;
+        if (nd->sub < 0 || !(mass > 0))
+            continue;
+        sm_sub *b = &m->subs[nd->sub];
+        sm_mpoint *p = &m->mp[m->n_mp++];
+        p->sub = nd->sub;
+        p->node = k;
+        p->ub[0] = b->ubar[2 * nd->local];
+        p->ub[1] = b->ubar[2 * nd->local + 1];
+        p->mass = mass;
+        p->N = b->N.a + 3 * nd->local;
+        p->ldn = b->N.rows;
+    }
+    if (!consistent)
+        return SM_OK;
+    for (int s = 0; s < m->n_subs; s++) {
+        sm_sub *b = &m->subs[s];
+        int mm = b->m;
+        b->qpN = dm_vec((size_t)b->nel * 4 * 2 * mm);
+        if (!b->qpN)
+            return SM_NOMEM;
+        for (int j = 0; j < b->nel; j++) {
+            const sm_elem *e = &m->elems[b->elems[j]];
+            double alpha = e->angle - b->theta0, co = cos(alpha), si = sin(alpha);
+            double u1[2] = {0, 0}, u2[2];
+            if (e->n1 != b->root) {
+                u1[0] = b->ubar[2 * m->nodes[e->n1].local];
+                u1[1] = b->ubar[2 * m->nodes[e->n1].local + 1];
+            }
+            u2[0] = b->ubar[2 * m->nodes[e->n2].local];
+            u2[1] = b->ubar[2 * m->nodes[e->n2].local + 1];
+            for (int g = 0; g < 4; g++) {
+                double xi = 0.5 * (1.0 + gx[g]), S[12];
+                double *Nq = b->qpN + (size_t)(4 * j + g) * 2 * mm;
+                fe_shape(xi, e->l, S);
+                for (int c = 0; c < mm; c++) {
+                    double ua = 0, ut = 0; /* element-local axial, transverse */
+                    for (int r = 0; r < 6; r++) {
+                        ua += S[0 + 2 * r] * DM(&b->T, 6 * j + r, c);
+                        ut += S[1 + 2 * r] * DM(&b->T, 6 * j + r, c);
+                    }
+                    Nq[2 * c] = co * ua - si * ut; /* R(alpha) u_loc */
+                    Nq[2 * c + 1] = si * ua + co * ut;
+                }
+                sm_mpoint *p = &m->mp[m->n_mp++];
+                p->sub = s;
+                p->node = -1;
+                p->ub[0] = u1[0] + xi * (u2[0] - u1[0]);
+                p->ub[1] = u1[1] + xi * (u2[1] - u1[1]);
+                p->mass = e->mu * e->l * 0.5 * gw[g];
+                p->N = Nq;
+                p->ldn = 2;
+            }
+        }
+    }
+    return SM_OK;
+}
+
+int modes_build(sm_model *m, sm_diag *d)
+{
+    int rc = SM_OK, q0 = 0;
+    for (int s = 0; s < m->n_subs && rc == SM_OK; s++) {
+        sm_sub *b = &m->subs[s];
+        int D = 3 * b->nfree;
+        dmat K = {0}, M = {0};
+        rc = dm_alloc(&K, D, D);
+        if (rc == SM_OK && m->opt.mass == SM_MASS_CONSISTENT)
+            rc = dm_alloc(&M, D, D);
+        if (rc == SM_OK) {
+            modes_assemble(m, b, &K, &M);
+            rc = m->opt.mass == SM_MASS_CONSISTENT ? modes_consistent(m, b, &K, &M)
+                                                   : modes_lumped(m, b, &K);
+        }
+        if (rc == SM_OK)
+            rc = modes_reduced_stiffness(b, &K);
+        if (rc == SM_OK)
+            rc = modes_elements(m, b);
+        b->q0 = q0;
+        q0 += b->m;
+        dm_free(&K);
+        dm_free(&M);
+    }
+    m->n = q0;
+    if (rc == SM_OK)
+        rc = modes_mass_points(m);
+    if (rc < 0 && rc != SM_NOMEM)
+        return modes_fail(d, rc, "could not compute the component modes of a substructure");
+    if (rc == SM_NOMEM)
+        return modes_fail(d, rc, "out of memory while building the component modes");
+    return SM_OK;
+}

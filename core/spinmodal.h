@@ -1,0 +1,265 @@
+/*
+ * spinmodal.h — public API of libspinmodal, the numerical core.
+ *
+ * Modal analysis of planar beam structures spinning at a constant speed about
+ * the hub (z) axis with the multi-reference-frame method of Kim & Yoo (2006),
+ * see DESIGN.md section 1.  The core does no I/O, keeps no global state and is
+ * re-entrant: distinct sm_model objects may be used from distinct threads, and
+ * one sm_model may be solved from several threads at once (sm_solve only reads
+ * the model).
+ *
+ * Usage:
+ *   sm_structure st = {...};          // joints, sections, members, clamp
+ *   sm_options opt; sm_default_options(&opt);
+ *   sm_model *m; sm_diag d;
+ *   if (sm_model_new(&m, &st, &opt, &d) < 0) { report d.message, d.item }
+ *   sm_result *r;
+ *   sm_solve(m, omegas, n, NULL, NULL, &r, &d);
+ *   ... r->cases[i] ...
+ *   sm_result_free(r); sm_model_free(m);
+ *
+ * Indices are 0-based.  Units are SI; angles in radians; frequencies rad/s.
+ */
+#ifndef SPINMODAL_H
+#define SPINMODAL_H
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define SM_VERSION "0.1.0"
+
+/* One status table for the whole project (X-macro: name, value, text). */
+#define SM_STATUS_MAP(X)                                                       \
+    X(OK, 0, "success")                                                        \
+    X(NOMEM, -1, "out of memory")                                              \
+    X(INVALID_INPUT, -2, "invalid input")                                      \
+    X(SINGULAR, -3, "singular matrix")                                         \
+    X(NOT_CONVERGED, -4, "Newton-Raphson did not converge")                    \
+    X(NO_EQUILIBRIUM, -5, "no dynamic equilibrium")                            \
+    X(LAPACK_FAILED, -6, "LAPACK routine failed")                              \
+    X(UNSTABLE, -7, "steady state is unstable")                                \
+    X(CANCELED, -8, "canceled")                                                \
+    X(LIMIT, -9, "size limit exceeded")
+
+typedef enum sm_status {
+#define SM_STATUS_ENUM(name, value, text) SM_##name = value,
+    SM_STATUS_MAP(SM_STATUS_ENUM)
+#undef SM_STATUS_ENUM
+} sm_status;
+
+/** Text for a status code; never NULL ("unknown status" for foreign codes). */
+const char *sm_strerror(int status);
+
+/** Library version string (SM_VERSION). */
+const char *sm_version(void);
+
+/* ---------------------------------------------------------------- input */
+
+/** Section properties of a member. */
+typedef struct sm_section {
+    double E;   /* Young's modulus, Pa, > 0 */
+    double A;   /* area, m^2, > 0 */
+    double I;   /* in-plane second moment, m^4, > 0 */
+    double mu;  /* mass per length, kg/m, > 0 (masses use mu*l) */
+} sm_section;
+
+/** A straight member between two joints, split into equal elements. */
+typedef struct sm_member {
+    int from;      /* joint index */
+    int to;        /* joint index */
+    int section;   /* section index */
+    int elements;  /* number of equal elements, >= 1 */
+} sm_member;
+
+/** A point mass attached to a joint (adds to the lumped/consistent mass). */
+typedef struct sm_point_mass {
+    int joint;     /* joint index */
+    double mass;   /* kg, >= 0 */
+} sm_point_mass;
+
+/** The structure.  Arrays are borrowed; sm_model_new copies what it needs. */
+typedef struct sm_structure {
+    int n_joints;
+    const double *joint_xy;          /* 2*n_joints, hub frame, m */
+    int n_sections;
+    const sm_section *sections;      /* n_sections */
+    int n_members;
+    const sm_member *members;        /* n_members */
+    int n_point_masses;
+    const sm_point_mass *point_masses; /* n_point_masses, may be NULL if 0 */
+    int clamp;                       /* joint index rigidly attached to the hub */
+} sm_structure;
+
+typedef enum sm_frame_scheme {
+    SM_FRAMES_SINGLE = 0,            /* one frame for the whole structure */
+    SM_FRAMES_PER_MEMBER,            /* frames_param runs per member */
+    SM_FRAMES_ELEMENTS_PER_FRAME,    /* runs of frames_param elements */
+    SM_FRAMES_PER_ELEMENT            /* one frame per element */
+} sm_frame_scheme;
+
+typedef enum sm_mass_model {
+    SM_MASS_LUMPED = 0,              /* mu*(l_left+l_right)/2 per node, no rotary inertia */
+    SM_MASS_CONSISTENT               /* consistent beam mass (extension) */
+} sm_mass_model;
+
+typedef enum sm_basis {
+    SM_BASIS_AUGMENTED = 0,          /* paper basis + attachment rotations (default) */
+    SM_BASIS_PAPER                   /* Kim & Yoo's condensed component modes */
+} sm_basis;
+
+/** Analysis options; fill with sm_default_options first. */
+typedef struct sm_options {
+    sm_frame_scheme frames;          /* default SM_FRAMES_PER_ELEMENT */
+    int frames_param;                /* k for PER_MEMBER, n for ELEMENTS_PER_FRAME */
+    sm_mass_model mass;              /* default lumped */
+    sm_basis basis;                  /* default augmented */
+    int modes_per_frame;             /* 0 = all component modes */
+    int modes;                       /* number of modes reported, default 3 */
+    int geometric_stiffening;        /* default 1 */
+    int coriolis;                    /* default 1 */
+    int mode_shapes;                 /* default 1: fill shape_re/shape_im */
+    /* Newton-Raphson / continuation */
+    int min_increments;              /* increments in Omega^2 from rest, default 5 */
+    int max_iterations;              /* Newton iterations per increment, default 40 */
+    double tolerance;                /* ||dq|| <= tol*max(1,||q||), default 1e-10 */
+} sm_options;
+
+/** Fill *o with the defaults of DESIGN.md section 3. */
+void sm_default_options(sm_options *o);
+
+/* ----------------------------------------------------------- diagnostics */
+
+/** Which input item an INVALID_INPUT error refers to. */
+typedef enum sm_item {
+    SM_ITEM_NONE = 0,
+    SM_ITEM_JOINT,
+    SM_ITEM_SECTION,
+    SM_ITEM_MEMBER,
+    SM_ITEM_POINT_MASS,
+    SM_ITEM_CLAMP,
+    SM_ITEM_OPTIONS
+} sm_item;
+
+/** Optional diagnostics out-parameter (like jansson's json_error_t). */
+typedef struct sm_diag {
+    int status;            /* sm_status of the failure */
+    sm_item item;          /* offending input item, for INVALID_INPUT */
+    int item_index;        /* its index (member, joint, ...) or -1 */
+    char field[32];        /* offending field name ("to", "elements", "E"...) or "" */
+    int iterations;        /* Newton iterations spent (equilibrium failures) */
+    double residual;       /* last residual norm */
+    double last_omega;     /* last speed with a converged equilibrium */
+    char message[256];     /* a sentence for a user */
+} sm_diag;
+
+/* ---------------------------------------------------------------- model */
+
+typedef struct sm_model sm_model;   /* opaque, immutable after sm_model_new */
+
+/**
+ * Build the FE mesh, the substructures (frames) and their component-mode
+ * bases.  *out receives a new model owned by the caller (sm_model_free).
+ * Returns SM_OK, SM_INVALID_INPUT (diag names the item: cycle, disconnected
+ * member, zero-length member, non-positive property, bad index), SM_NOMEM,
+ * SM_SINGULAR or SM_LAPACK_FAILED.  diag may be NULL.
+ */
+int sm_model_new(sm_model **out, const sm_structure *st, const sm_options *opt,
+                 sm_diag *diag);
+
+/** Free a model; NULL is a no-op. */
+void sm_model_free(sm_model *m);
+
+/** Sizes of a model, as reported in the result's "model" object. */
+typedef struct sm_model_info {
+    int nodes;          /* FE nodes, clamp node included */
+    int elements;       /* FE elements */
+    int frames;         /* substructures (reference frames) */
+    int coordinates;    /* modal coordinates n */
+} sm_model_info;
+
+void sm_model_get_info(const sm_model *m, sm_model_info *info);
+
+/** FE node index of joint j (joints are FE nodes), or -1 if out of range. */
+int sm_model_joint_node(const sm_model *m, int joint);
+
+/** Member index that FE element e belongs to, or -1 if out of range. */
+int sm_model_element_member(const sm_model *m, int element);
+
+/** Undeformed position of FE node k: xy[0], xy[1]. Returns SM_OK or SM_INVALID_INPUT. */
+int sm_model_node_position(const sm_model *m, int node, double xy[2]);
+
+/* ---------------------------------------------------------------- solve */
+
+/**
+ * Progress/cancel callback: called after each Newton iteration and after each
+ * speed with done = speeds finished, total = speeds requested.  Return
+ * nonzero to cancel; sm_solve then returns SM_CANCELED.  Called from the
+ * thread running sm_solve.
+ */
+typedef int (*sm_progress_fn)(void *user, int done, int total);
+
+typedef enum sm_case_status {
+    SM_CASE_SOLVED = 0,       /* equilibrium found, steady state stable */
+    SM_CASE_UNSTABLE,         /* equilibrium found, K* has negative eigenvalues or Re(lambda) > 0 */
+    SM_CASE_NO_EQUILIBRIUM    /* continuation/Newton failed: see diagnostics */
+} sm_case_status;
+
+/** Result of one speed.  Arrays are owned by the sm_result. */
+typedef struct sm_case {
+    double omega;             /* rad/s */
+    sm_case_status status;
+    /* equilibrium */
+    int converged;            /* 1 when Newton converged at omega */
+    int iterations;           /* Newton iterations spent for this speed */
+    double residual;          /* ||F(q*)|| */
+    double last_omega;        /* last speed reached (== omega when converged) */
+    char message[256];        /* diagnostics sentence ("" when solved) */
+    int n_nodes;
+    double *nodes;            /* 3*n_nodes: deformed x, y and rotation phi (rad) */
+    int n_elements;
+    double *axial_force;      /* n_elements: P_e, N (eq. 24) */
+    /* stability */
+    int stable;
+    int negative_eigenvalues; /* of K* */
+    double max_real_part;     /* max Re(lambda) over computed roots */
+    /* modes (0 when no equilibrium) */
+    int n_modes;
+    double *frequency;        /* n_modes: |Im lambda|, rad/s */
+    double *eig_re;           /* n_modes */
+    double *eig_im;           /* n_modes */
+    double *mac_to_previous;  /* n_modes: MAC to the tracked mode of the previous speed, -1 for the first speed */
+    int *previous_index;      /* n_modes: index of that mode at the previous speed, -1 if none */
+    double *shape_re;         /* n_modes * 3*n_nodes (dx,dy,dphi per node), or NULL */
+    double *shape_im;         /* same, NULL without Coriolis or mode shapes */
+    /* timing, ms */
+    double t_equilibrium, t_linearize, t_eigen;
+} sm_case;
+
+typedef struct sm_result {
+    int n_cases;
+    sm_case *cases;           /* n_cases, in the order of the requested speeds */
+} sm_result;
+
+/**
+ * Solve at each speed of omegas (rad/s, finite, >= 0 in any order: they are
+ * processed in ascending order with continuation, reported in input order).
+ * A speed without equilibrium is a reported case (SM_CASE_NO_EQUILIBRIUM),
+ * not an error; continuation restarts from rest for the next speed.
+ * Returns SM_OK (every case has a status), SM_CANCELED, SM_NOMEM,
+ * SM_INVALID_INPUT (bad speeds) or SM_LAPACK_FAILED.  *out is set only on
+ * SM_OK and is owned by the caller (sm_result_free).  cb and diag may be NULL.
+ */
+int sm_solve(const sm_model *m, const double *omegas, int n_omegas,
+             sm_progress_fn cb, void *user, sm_result **out, sm_diag *diag);
+
+/** Free a result; NULL is a no-op. */
+void sm_result_free(sm_result *r);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SPINMODAL_H */

@@ -1,0 +1,387 @@
+/*
+ * sweep.c — sm_solve: speeds in ascending order with continuation
+ * (equilibrium.c), linearisation at each equilibrium (M*, C*, K* with P
+ * frozen), the eigen-analysis (eigen.c), mode shapes in the hub frame and
+ * mode tracking across speeds by MAC (DESIGN.md 1.3-1.4).
+ */
+#include "internal.h"
+
+#include <complex.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double sweep_ms(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return 1e3 * (double)t.tv_sec + 1e-6 * (double)t.tv_nsec;
+}
+
+void sm_result_free(sm_result *r)
+{
+    if (!r)
+        return;
+    for (int i = 0; i < r->n_cases; i++) {
+        sm_case *c = &r->cases[i];
+        free(c->nodes);
+        free(c->axial_force);
+        free(c->frequency);
+        free(c->eig_re);
+        free(c->eig_im);
+        free(c->mac_to_previous);
+        free(c->previous_index);
+        free(c->shape_re);
+        free(c->shape_im);
+    }
+    free(r->cases);
+    free(r);
+}
+
+/* Linearised matrices at q: M*, C* (coriolis), K* = K + Kg(P frozen) - s (M* + H). */
+typedef struct sweep_lin {
+    sm_kin kin;
+    dmat M, C, K, H, W, X;
+    double *work;
+} sweep_lin;
+
+static void sweep_lin_free(sweep_lin *L)
+{
+    frames_kin_free(&L->kin);
+    dm_free(&L->M);
+    dm_free(&L->C);
+    dm_free(&L->K);
+    dm_free(&L->H);
+    dm_free(&L->W);
+    dm_free(&L->X);
+    free(L->work);
+}
+
+static int sweep_lin_alloc(const sm_model *m, sweep_lin *L)
+{
+    int n = m->n, mx = 1;
+    memset(L, 0, sizeof *L);
+    for (int s = 0; s < m->n_subs; s++)
+        mx = m->subs[s].m > mx ? m->subs[s].m : mx;
+    L->work = dm_vec((size_t)(4 * mx + n));
+    if (!L->work || frames_kin_alloc(m, &L->kin) || dm_alloc(&L->M, n, n) || dm_alloc(&L->C, n, n) ||
+        dm_alloc(&L->K, n, n) || dm_alloc(&L->H, n, n) || dm_alloc(&L->W, n, 2 * m->n_mp) ||
+        dm_alloc(&L->X, n, n)) {
+        sweep_lin_free(L);
+        return SM_NOMEM;
+    }
+    return SM_OK;
+}
+
+static void sweep_linearize(const sm_model *m, const double *q, double omega, sweep_lin *L)
+{
+    int n = m->n;
+    double s = omega * omega;
+    frames_eval(m, q, &L->kin);
+    lin_mass(m, &L->kin, &L->M, &L->W);
+    if (m->opt.coriolis)
+        lin_gyro(m, &L->kin, omega, &L->C, &L->W, &L->X);
+    dm_zero(&L->H);
+    frames_hessian(m, q, &L->kin, &L->H, L->work);
+    for (size_t i = 0; i < (size_t)n * n; i++)
+        L->K.a[i] = -s * (L->M.a[i] + L->H.a[i]);
+    lin_elastic_add(m, &L->K);
+    if (m->opt.geometric_stiffening)
+        lin_geometric_tangent(m, q, 1, &L->K, L->work);
+    for (int j = 0; j < n; j++) /* symmetric up to round-off: make it exact */
+        for (int i = 0; i < j; i++)
+            DM(&L->K, i, j) = DM(&L->K, j, i) = 0.5 * (DM(&L->K, i, j) + DM(&L->K, j, i));
+}
+
+/* Nodal shapes (dx, dy, dphi) = J_k x in the hub frame; largest translation = 1. */
+static void sweep_shapes(const sm_model *m, const sm_kin *k, const sm_eig_out *e, double *sr, double *si)
+{
+    int n = m->n, nn = m->n_nodes;
+    for (int j = 0; j < e->n_modes; j++) {
+        const double *xr = e->xre + (size_t)j * n, *xi = e->xim + (size_t)j * n;
+        double *yr = sr + (size_t)j * 3 * nn, *yi = si + (size_t)j * 3 * nn;
+        double best = -1;
+        double complex piv = 1;
+        for (int c = 0; c < 3 * nn; c++) {
+            const double *jc = &DM(&k->Jn, 0, c);
+            double a = 0, b = 0;
+            for (int i = 0; i < n; i++) {
+                a += jc[i] * xr[i];
+                b += jc[i] * xi[i];
+            }
+            yr[c] = a;
+            yi[c] = b;
+            if (c % 3 != 2 && hypot(a, b) > best) {
+                best = hypot(a, b);
+                piv = a + I * b;
+            }
+        }
+        if (!(best > 0))
+            continue;
+        for (int c = 0; c < 3 * nn; c++) {
+            double complex v = (yr[c] + I * yi[c]) / piv;
+            yr[c] = creal(v);
+            yi[c] = cimag(v);
+        }
+    }
+}
+
+/* MAC between mode a of case A and mode b of case B (translations only). */
+static double sweep_mac(const sm_case *A, int a, const sm_case *B, int b)
+{
+    int nn = A->n_nodes;
+    const double *ar = A->shape_re + (size_t)a * 3 * nn, *ai = A->shape_im + (size_t)a * 3 * nn;
+    const double *br = B->shape_re + (size_t)b * 3 * nn, *bi = B->shape_im + (size_t)b * 3 * nn;
+    double complex dot = 0;
+    double na = 0, nb = 0;
+    for (int c = 0; c < 3 * nn; c++) {
+        if (c % 3 == 2)
+            continue;
+        double complex u = ar[c] + I * ai[c], v = br[c] + I * bi[c];
+        dot += conj(u) * v;
+        na += creal(conj(u) * u);
+        nb += creal(conj(v) * v);
+    }
+    return na > 0 && nb > 0 ? creal(dot * conj(dot)) / (na * nb) : 0.0;
+}
+
+/* Greedy MAC assignment of the modes of cur to those of prev. */
+static void sweep_track(sm_case *cur, const sm_case *prev)
+{
+    int nc = cur->n_modes, np = prev ? prev->n_modes : 0;
+    for (int j = 0; j < nc; j++) {
+        cur->mac_to_previous[j] = -1;
+        cur->previous_index[j] = -1;
+    }
+    if (!np || !prev->shape_re)
+        return;
+    double *mac = malloc((size_t)nc * np * sizeof(double));
+    if (!mac)
+        return;
+    for (int j = 0; j < nc; j++)
+        for (int i = 0; i < np; i++)
+            mac[(size_t)j * np + i] = sweep_mac(cur, j, prev, i);
+    for (int t = 0; t < nc && t < np; t++) {
+        int bj = -1, bi = -1;
+        double best = -1;
+        for (int j = 0; j < nc; j++)
+            for (int i = 0; i < np; i++)
+                if (mac[(size_t)j * np + i] > best) {
+                    best = mac[(size_t)j * np + i];
+                    bj = j;
+                    bi = i;
+                }
+        if (bj < 0)
+            break;
+        cur->mac_to_previous[bj] = best;
+        cur->previous_index[bj] = bi;
+        for (int i = 0; i < np; i++)
+            mac[(size_t)bj * np + i] = -2;
+        for (int j = 0; j < nc; j++)
+            mac[(size_t)j * np + bi] = -2;
+    }
+    free(mac);
+}
+
+/* Fill equilibrium outputs of case c at q (kinematics in k). */
+static int sweep_equilibrium_out(const sm_model *m, const double *q, const sm_kin *k, sm_case *c)
+{
+    c->n_nodes = m->n_nodes;
+    c->n_elements = m->n_elems;
+    c->nodes = dm_vec(3 * (size_t)m->n_nodes);
+    c->axial_force = dm_vec((size_t)m->n_elems);
+    if (!c->nodes || !c->axial_force)
+        return SM_NOMEM;
+    memcpy(c->nodes, k->rn, 3 * (size_t)m->n_nodes * sizeof(double));
+    for (int s = 0; s < m->n_subs; s++) {
+        const sm_sub *b = &m->subs[s];
+        for (int j = 0; j < b->nel; j++) {
+            double P = 0;
+            for (int i = 0; i < b->m; i++)
+                P += b->d[(size_t)j * b->m + i] * q[b->q0 + i];
+            c->axial_force[b->elems[j]] = P;
+        }
+    }
+    return SM_OK;
+}
+
+/* Modes of case c at the equilibrium q. */
+static int sweep_modes(const sm_model *m, const double *q, sweep_lin *L, sm_case *c)
+{
+    sm_eig_out e;
+    double t0 = sweep_ms();
+    sweep_linearize(m, q, c->omega, L);
+    double t1 = sweep_ms();
+    int rc = eig_solve(m->n, &L->M, &L->C, &L->K, m->opt.coriolis, m->opt.modes, &e);
+    double t2 = sweep_ms();
+    c->t_linearize = t1 - t0;
+    c->t_eigen = t2 - t1;
+    if (rc < 0)
+        return rc;
+    int k = e.n_modes, nn = m->n_nodes;
+    c->n_modes = k;
+    c->frequency = dm_vec((size_t)k);
+    c->eig_re = dm_vec((size_t)k);
+    c->eig_im = dm_vec((size_t)k);
+    c->mac_to_previous = dm_vec((size_t)k);
+    c->previous_index = calloc((size_t)(k ? k : 1), sizeof(int));
+    c->shape_re = dm_vec((size_t)k * 3 * nn);
+    c->shape_im = dm_vec((size_t)k * 3 * nn);
+    if (!c->frequency || !c->eig_re || !c->eig_im || !c->mac_to_previous || !c->previous_index ||
+        !c->shape_re || !c->shape_im) {
+        eig_out_free(&e);
+        return SM_NOMEM;
+    }
+    for (int j = 0; j < k; j++) {
+        c->eig_re[j] = e.wre[j];
+        c->eig_im[j] = e.wim[j];
+        c->frequency[j] = fabs(e.wim[j]);
+    }
+    sweep_shapes(m, &L->kin, &e, c->shape_re, c->shape_im);
+    c->negative_eigenvalues = e.negative;
+    c->max_real_part = e.max_re;
+    double scale = k ? hypot(e.wre[k - 1], e.wim[k - 1]) : 1;
+    c->stable = e.negative == 0 && !(e.max_re > 1e-8 * fmax(scale, 1e-3));
+    c->status = c->stable ? SM_CASE_SOLVED : SM_CASE_UNSTABLE;
+    eig_out_free(&e);
+    return SM_OK;
+}
+
+
+typedef struct sweep_key {
+    double omega;
+    int index;
+} sweep_key;
+
+static int sweep_key_cmp(const void *a, const void *b)
+{
+    const sweep_key *x = a, *y = b;
+    if (x->omega != y->omega)
+        return x->omega < y->omega ? -1 : 1;
+    return x->index - y->index;
+}
+
+int sm_solve(const sm_model *m, const double *omegas, int n_omegas, sm_progress_fn cb, void *user,
+             sm_result **out, sm_diag *diag)
+{
+    sm_diag scratch;
+    sm_diag *d = diag ? diag : &scratch;
+    memset(d, 0, sizeof *d);
+    d->item_index = -1;
+    *out = NULL;
+    if (n_omegas < 1 || !omegas) {
+        d->status = SM_INVALID_INPUT;
+        d->item = SM_ITEM_OPTIONS;
+        snprintf(d->field, sizeof d->field, "omega");
+        snprintf(d->message, sizeof d->message, "at least one speed is required");
+        return SM_INVALID_INPUT;
+    }
+    for (int i = 0; i < n_omegas; i++)
+        if (!isfinite(omegas[i]) || omegas[i] < 0) {
+            d->status = SM_INVALID_INPUT;
+            d->item = SM_ITEM_OPTIONS;
+            d->item_index = i;
+            snprintf(d->field, sizeof d->field, "omega");
+            snprintf(d->message, sizeof d->message, "speeds must be finite and non-negative (rad/s)");
+            return SM_INVALID_INPUT;
+        }
+    int rc = SM_NOMEM, n = m->n;
+    sm_result *r = calloc(1, sizeof *r);
+    sweep_key *key = malloc((size_t)n_omegas * sizeof *key);
+    double *q = dm_vec((size_t)n);
+    sweep_lin L;
+    int have_lin = 0;
+    if (!r || !key || !q)
+        goto fail;
+    r->cases = calloc((size_t)n_omegas, sizeof(sm_case));
+    if (!r->cases)
+        goto fail;
+    r->n_cases = n_omegas;
+    if ((rc = sweep_lin_alloc(m, &L)) < 0)
+        goto fail;
+    have_lin = 1;
+    for (int i = 0; i < n_omegas; i++) {
+        key[i].omega = omegas[i];
+        key[i].index = i;
+        r->cases[i].omega = omegas[i];
+    }
+    qsort(key, (size_t)n_omegas, sizeof *key, sweep_key_cmp);
+    sm_progress pr = {cb, user, 0, n_omegas};
+    double s_prev = 0;
+    int from_rest = 1;
+    const sm_case *prev = NULL;
+    for (int t = 0; t < n_omegas; t++) {
+        sm_case *c = &r->cases[key[t].index];
+        double s = c->omega * c->omega, t0 = sweep_ms();
+        sm_eq_out eo;
+        if (from_rest) {
+            memset(q, 0, (size_t)n * sizeof(double));
+            s_prev = 0;
+        }
+        rc = eq_solve(m, q, s_prev, s, from_rest, &pr, &eo);
+        if (rc < 0)
+            goto fail;
+        rc = SM_CANCELED;
+        if (eo.canceled)
+            goto fail;
+        c->t_equilibrium = sweep_ms() - t0;
+        c->converged = eo.converged;
+        c->iterations = eo.iterations;
+        c->residual = eo.residual;
+        c->last_omega = sqrt(eo.last_s);
+        frames_eval(m, q, &L.kin);
+        if ((rc = sweep_equilibrium_out(m, q, &L.kin, c)) < 0)
+            goto fail;
+        if (!eo.converged) {
+            c->status = SM_CASE_NO_EQUILIBRIUM;
+            snprintf(c->message, sizeof c->message, "%s", eo.message);
+            from_rest = 1;
+            prev = NULL;
+        } else {
+            if ((rc = sweep_modes(m, q, &L, c)) < 0) {
+                if (rc == SM_NOMEM)
+                    goto fail;
+                /* an eigen failure is reported on the case, not fatal */
+                c->status = SM_CASE_NO_EQUILIBRIUM;
+                snprintf(c->message, sizeof c->message, "eigen-analysis failed: %s", sm_strerror(rc));
+                prev = NULL;
+            } else {
+                sweep_track(c, prev);
+                prev = c;
+            }
+            s_prev = s;
+            from_rest = 0;
+        }
+        pr.done = t + 1;
+        if (cb && cb(user, pr.done, pr.total)) {
+            rc = SM_CANCELED;
+            goto fail;
+        }
+    }
+    if (!m->opt.mode_shapes || !m->opt.coriolis)
+        for (int i = 0; i < n_omegas; i++) {
+            sm_case *c = &r->cases[i];
+            if (!m->opt.mode_shapes) {
+                free(c->shape_re);
+                c->shape_re = NULL;
+            }
+            free(c->shape_im);
+            c->shape_im = NULL;
+        }
+    sweep_lin_free(&L);
+    free(key);
+    free(q);
+    *out = r;
+    return SM_OK;
+fail:
+    if (have_lin)
+        sweep_lin_free(&L);
+    free(key);
+    free(q);
+    sm_result_free(r);
+    d->status = rc;
+    snprintf(d->message, sizeof d->message, "%s", sm_strerror(rc));
+    return rc;
+}
