@@ -21,6 +21,12 @@
 
 #define EQ_MAX_INCREMENTS 400
 #define EQ_MAX_TOTAL_ITER 4000
+/* Validity limit of the model: elastic axial strain.  Inside a frame the
+ * kinematics are linear, so a large rotation shows up as a spurious strain;
+ * beyond 1 % (ten times the yield strain of structural metals) the "steady
+ * state" is an artefact of too few frames (the single frame at beta = 90 deg
+ * runs away), not an equilibrium of the structure. */
+#define EQ_MAX_STRAIN 0.01
 
 typedef struct eq_ws {
     sm_kin kin;
@@ -101,6 +107,37 @@ static int eq_tangent(const sm_model *m, const double *q, double s, eq_ws *w)
     return LAPACKE_dgetrf(LAPACK_COL_MAJOR, n, n, w->Kt.a, n, w->ipiv) == 0 ? SM_OK : SM_SINGULAR;
 }
 
+/* Sign of det(Kt) from its LU factors: a change between two converged
+ * states means a critical point (limit or bifurcation) lies between them. */
+static int eq_det_sign(const eq_ws *w, int n)
+{
+    int sign = 1;
+    for (int i = 0; i < n; i++) {
+        double u = w->Kt.a[(size_t)i * n + i];
+        if (u < 0)
+            sign = -sign;
+        if (w->ipiv[i] != i + 1)
+            sign = -sign;
+    }
+    return sign;
+}
+
+/* Largest elastic axial strain |P_e| / EA over all elements at q. */
+static double eq_max_strain(const sm_model *m, const double *q)
+{
+    double mx = 0;
+    for (int s = 0; s < m->n_subs; s++) {
+        const sm_sub *b = &m->subs[s];
+        for (int j = 0; j < b->nel; j++) {
+            double P = 0;
+            for (int i = 0; i < b->m; i++)
+                P += b->d[(size_t)j * b->m + i] * q[b->q0 + i];
+            mx = fmax(mx, fabs(P) / m->elems[b->elems[j]].EA);
+        }
+    }
+    return mx;
+}
+
 static int eq_progress(sm_progress *pr)
 {
     return pr && pr->cb && pr->cb(pr->user, pr->done, pr->total);
@@ -172,6 +209,7 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
     /* tangent at the start for the first predictor */
     eq_residual(m, q, s, &w);
     int have_lu = eq_tangent(m, q, s, &w) == SM_OK;
+    int sign = have_lu ? eq_det_sign(&w, n) : 1;
     while (s < s_to) {
         if (incr++ >= EQ_MAX_INCREMENTS || w.iterations >= EQ_MAX_TOTAL_ITER) {
             why = "too many continuation steps";
@@ -206,9 +244,16 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
             }
             step = sqrt(step);
             corr = sqrt(corr);
-            if (have_lu && corr > fmax(step, 1e-6 * fmax(1.0, dm_norm(q, n)))) {
+            if (have_lu && corr > fmax(0.5 * step, 1e-6 * fmax(1.0, dm_norm(q, n)))) {
                 ok = 0;
                 why = "the solution jumped to another branch";
+            } else if (eq_max_strain(m, q) > EQ_MAX_STRAIN) {
+                ok = 0;
+                why = "the deformation leaves the small-strain range (axial strain above 1 %): "
+                      "the steady state runs away; use more frames";
+            } else if (eq_det_sign(&w, n) != sign) {
+                ok = 0;
+                why = "the tangent stiffness becomes singular (a limit or bifurcation point)";
             }
         } else {
             why = "Newton-Raphson did not converge";
