@@ -1,0 +1,328 @@
+/*
+ * cli.c — the one-shot `spinmodal` command line tool.
+ *
+ * How it fits: reads one request (DESIGN.md section 3) from a file or stdin,
+ * validates it with the codec, builds the core model, solves every speed and
+ * prints the result document (section 4) or the CSV frequency table on
+ * stdout.  Errors in the request are reported as an RFC 9457 problem
+ * document on stderr, exactly as the daemon would send them.
+ *
+ * Exit codes: 0 every speed has an equilibrium (solved or unstable),
+ * 2 invalid input (problem JSON on stderr, nothing on stdout), 3 some speed
+ * had no equilibrium (the result is still printed), 1 any other error
+ * (I/O, out of memory, LAPACK), 64 usage error.
+ */
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "codec.h"
+#include "spinmodal.h"
+
+enum {
+    CLI_OK = 0,
+    CLI_FAILED = 1,
+    CLI_INVALID = 2,
+    CLI_NO_EQUILIBRIUM = 3,
+    CLI_USAGE = 64
+};
+
+/* Command-line settings of `solve` and `validate`. */
+typedef struct cli_args {
+    const char *command; /* "solve" or "validate" */
+    const char *path;    /* request file, "-" = stdin */
+    int csv;             /* --csv: frequency table instead of JSON */
+    int pretty;          /* --pretty: indented JSON */
+} cli_args;
+
+static const char cli_usage_text[] =
+    "usage: spinmodal solve [--csv] [--pretty] FILE|-\n"
+    "       spinmodal validate [--pretty] FILE|-\n"
+    "       spinmodal --help | --version\n";
+
+static void cli_help(void)
+{
+    printf("spinmodal %s: modal analysis of spinning planar beam structures\n\n%s\n"
+           "commands:\n"
+           "  solve FILE|-     solve the JSON request in FILE (- = stdin) and print the\n"
+           "                   result JSON on stdout\n"
+           "  validate FILE|-  check a request; print its canonical form and SHA-256\n\n"
+           "options:\n"
+           "  --csv            print the frequency table as CSV instead of JSON\n"
+           "  --pretty         indent the JSON output\n"
+           "  -h, --help       show this help\n"
+           "  -V, --version    show the version\n\n"
+           "exit status: 0 solved, 2 invalid request (problem JSON on stderr),\n"
+           "3 some speed had no equilibrium, 1 other error, 64 usage error\n",
+           SM_VERSION, cli_usage_text);
+}
+
+static int cli_usage(const char *why)
+{
+    fprintf(stderr, "spinmodal: %s\n%s", why, cli_usage_text);
+    return CLI_USAGE;
+}
+
+/*
+ * Read all of path ("-" = stdin), at most max + 1 bytes (so the codec can
+ * report "too large").  *buf is malloc'd and NUL-terminated.  Returns 0 or
+ * an errno value.
+ */
+static int cli_read(const char *path, size_t max, char **buf, size_t *len)
+{
+    FILE *f = strcmp(path, "-") ? fopen(path, "rb") : stdin;
+    size_t cap = 65536, n = 0;
+    char *b = NULL;
+    int err = 0;
+
+    *buf = NULL;
+    *len = 0;
+    if (!f)
+        return errno ? errno : EIO;
+    b = malloc(cap + 1);
+    if (!b) {
+        err = ENOMEM;
+        goto done;
+    }
+    for (;;) {
+        size_t want, got;
+        if (n == cap) {
+            size_t ncap = cap * 2 > max + 1 ? max + 1 : cap * 2;
+            char *nb;
+            if (ncap <= cap)
+                break; /* read max + 1 bytes: enough to know it is too large */
+            nb = realloc(b, ncap + 1);
+            if (!nb) {
+                err = ENOMEM;
+                goto done;
+            }
+            b = nb;
+            cap = ncap;
+        }
+        want = cap - n;
+        got = fread(b + n, 1, want, f);
+        n += got;
+        if (got < want) {
+            if (ferror(f))
+                err = EIO;
+            break;
+        }
+    }
+done:
+    if (f != stdin)
+        fclose(f);
+    if (err) {
+        free(b);
+        return err;
+    }
+    b[n] = '\0';
+    *buf = b;
+    *len = n;
+    return 0;
+}
+
+/* Print a JSON document and a newline; 0 or -1 on a write error. */
+static int cli_print_json(FILE *f, const json_t *doc, int pretty)
+{
+    size_t flags = JSON_REAL_PRECISION(17) | (pretty ? JSON_INDENT(2) : JSON_COMPACT);
+
+    if (json_dumpf(doc, f, flags) || fputc('\n', f) == EOF || fflush(f))
+        return -1;
+    return 0;
+}
+
+/* Problem document for errs on stderr; returns CLI_INVALID. */
+static int cli_problem(const codec_errors *errs)
+{
+    json_t *p = codec_problem_from_errors(errs);
+
+    if (!p) {
+        fprintf(stderr, "spinmodal: out of memory\n");
+        return CLI_FAILED;
+    }
+    cli_print_json(stderr, p, 1);
+    json_decref(p);
+    return CLI_INVALID;
+}
+
+static int cli_fail(const char *what, int status)
+{
+    fprintf(stderr, "spinmodal: %s: %s\n", what, sm_strerror(status));
+    return CLI_FAILED;
+}
+
+/* Print the result (JSON or CSV); returns an exit code. */
+static int cli_output(const cli_args *a, const codec_request *req, const sm_model *m,
+                      const sm_result *res)
+{
+    json_t *doc = NULL;
+    char *csv = NULL;
+    size_t len = 0;
+    int i, rc = CLI_OK;
+
+    if (a->csv) {
+        if (codec_result_csv(&csv, &len, res))
+            return cli_fail("CSV encoding", SM_NOMEM);
+        if (fwrite(csv, 1, len, stdout) != len || fflush(stdout))
+            rc = CLI_FAILED;
+        free(csv);
+    } else {
+        if (codec_result_encode(&doc, req, m, res))
+            return cli_fail("result encoding", SM_NOMEM);
+        if (cli_print_json(stdout, doc, a->pretty))
+            rc = CLI_FAILED;
+        json_decref(doc);
+    }
+    if (rc == CLI_FAILED) {
+        fprintf(stderr, "spinmodal: cannot write the result: %s\n", strerror(errno));
+        return rc;
+    }
+    for (i = 0; i < res->n_cases; i++)
+        if (res->cases[i].status == SM_CASE_NO_EQUILIBRIUM)
+            rc = CLI_NO_EQUILIBRIUM;
+    return rc;
+}
+
+/* Solve a validated request and print; returns an exit code. */
+static int cli_solve(const cli_args *a, const codec_request *req, codec_errors *errs)
+{
+    sm_model *m = NULL;
+    sm_result *res = NULL;
+    sm_diag d;
+    const double *speeds;
+    int n, st, rc;
+
+    st = codec_model_new(&m, req, errs, &d);
+    if (st == SM_NOMEM) {
+        rc = cli_fail("model", st);
+        goto done;
+    }
+    if (st != SM_OK) {
+        rc = cli_problem(errs);
+        goto done;
+    }
+    speeds = codec_request_speeds(req, &n);
+    memset(&d, 0, sizeof(d));
+    st = sm_solve(m, speeds, n, NULL, NULL, &res, &d);
+    if (st == SM_INVALID_INPUT) {
+        if (codec_diag_error(req, &d, errs))
+            rc = cli_fail("solve", SM_NOMEM);
+        else
+            rc = cli_problem(errs);
+        goto done;
+    }
+    if (st != SM_OK) {
+        if (d.message[0])
+            fprintf(stderr, "spinmodal: solve: %s\n", d.message);
+        rc = cli_fail("solve", st);
+        goto done;
+    }
+    rc = cli_output(a, req, m, res);
+done:
+    sm_result_free(res);
+    sm_model_free(m);
+    return rc;
+}
+
+/* `validate`: canonical request and its SHA-256. */
+static int cli_validate(const cli_args *a, const codec_request *req)
+{
+    json_t *doc = json_pack("{s:b, s:s, s:O}", "valid", 1, "request_sha256",
+                            codec_request_sha256(req), "canonical",
+                            codec_request_canonical(req));
+    int rc = CLI_OK;
+
+    if (!doc)
+        return cli_fail("validate", SM_NOMEM);
+    if (cli_print_json(stdout, doc, a->pretty)) {
+        fprintf(stderr, "spinmodal: cannot write the result: %s\n", strerror(errno));
+        rc = CLI_FAILED;
+    }
+    json_decref(doc);
+    return rc;
+}
+
+/* Read, validate, then solve or validate; returns an exit code. */
+static int cli_run(const cli_args *a)
+{
+    codec_limits lim;
+    codec_errors *errs = codec_errors_new();
+    codec_request *req = NULL;
+    char *text = NULL;
+    size_t len = 0;
+    int err, st, rc;
+
+    if (!errs)
+        return cli_fail("start", SM_NOMEM);
+    codec_default_limits(&lim);
+    err = cli_read(a->path, lim.max_request_bytes, &text, &len);
+    if (err) {
+        fprintf(stderr, "spinmodal: cannot read %s: %s\n",
+                strcmp(a->path, "-") ? a->path : "standard input", strerror(err));
+        rc = CLI_FAILED;
+        goto done;
+    }
+    st = codec_request_parse(&req, text, len, &lim, errs);
+    if (st == SM_INVALID_INPUT) {
+        rc = cli_problem(errs);
+        goto done;
+    }
+    if (st != SM_OK) {
+        rc = cli_fail("request", st);
+        goto done;
+    }
+    rc = !strcmp(a->command, "validate") ? cli_validate(a, req) : cli_solve(a, req, errs);
+done:
+    codec_request_free(req);
+    free(text);
+    codec_errors_free(errs);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    cli_args a = {NULL, NULL, 0, 0};
+    int i, opts_done = 0;
+
+    if (argc < 2)
+        return cli_usage("a command is required");
+    for (i = 1; i < argc; i++) {
+        const char *s = argv[i];
+        if (!opts_done && (!strcmp(s, "-h") || !strcmp(s, "--help") || !strcmp(s, "help"))) {
+            cli_help();
+            return CLI_OK;
+        }
+        if (!opts_done && (!strcmp(s, "-V") || !strcmp(s, "--version"))) {
+            printf("spinmodal %s\n", SM_VERSION);
+            return CLI_OK;
+        }
+        if (!opts_done && !strcmp(s, "--")) {
+            opts_done = 1;
+        } else if (!opts_done && !strcmp(s, "--csv")) {
+            a.csv = 1;
+        } else if (!opts_done && !strcmp(s, "--pretty")) {
+            a.pretty = 1;
+        } else if (!opts_done && s[0] == '-' && s[1] != '\0') {
+            fprintf(stderr, "spinmodal: unknown option '%s'\n%s", s, cli_usage_text);
+            return CLI_USAGE;
+        } else if (!a.command) {
+            if (strcmp(s, "solve") && strcmp(s, "validate")) {
+                fprintf(stderr, "spinmodal: unknown command '%s'\n%s", s, cli_usage_text);
+                return CLI_USAGE;
+            }
+            a.command = s;
+        } else if (!a.path) {
+            a.path = s;
+        } else {
+            return cli_usage("only one request file may be given");
+        }
+    }
+    if (!a.command)
+        return cli_usage("a command is required");
+    if (!a.path)
+        return cli_usage("a request file (or - for standard input) is required");
+    if (a.csv && strcmp(a.command, "solve"))
+        return cli_usage("--csv applies to solve only");
+    return cli_run(&a);
+}

@@ -1,0 +1,214 @@
+/*
+ * codec.h — JSON <-> core translation for the spinmodal CLI and daemon.
+ *
+ * The codec reads the request of DESIGN.md section 3, validates every field
+ * (collecting all errors, each with the RFC 6901 JSON pointer of the field),
+ * applies the defaults and keeps a canonical copy whose SHA-256 identifies
+ * the question.  It builds the core's sm_structure/sm_options/speeds from
+ * that canonical copy, maps the core's sm_diag back to JSON pointers, encodes
+ * an sm_result as the result document of DESIGN.md section 4 and builds the
+ * RFC 9457 problem documents used for errors.
+ *
+ * Ownership: functions named *_new return objects owned by the caller and
+ * released by the matching *_free (NULL is a no-op).  json_t results are new
+ * references (json_decref).  Status codes are the core's sm_status values.
+ */
+#ifndef SPINMODAL_CODEC_H
+#define SPINMODAL_CODEC_H
+
+#include <stddef.h>
+
+#include <jansson.h>
+
+#include "spinmodal.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---------------------------------------------------------------- limits */
+
+/** Size limits applied while validating a request (the daemon configures them). */
+typedef struct codec_limits {
+    size_t max_request_bytes; /* request text, default 16 MiB */
+    int max_joints;           /* default 1000 */
+    int max_sections;         /* default 1000 */
+    int max_members;          /* default 1000 */
+    int max_point_masses;     /* default 1000 */
+    int max_elements;         /* FE elements summed over all members, default 2000 */
+    int max_speeds;           /* entries of analysis.omega, default 1001 */
+    int max_modes;            /* analysis.modes, default 200 */
+    long max_shape_values;    /* numbers in the mode shapes of a result (speeds x modes x
+                                 nodes x 3, x 2 with Coriolis), default 4e6 (~90 MB JSON) */
+} codec_limits;
+
+/** Fill *lim with the default limits listed in codec_limits. */
+void codec_default_limits(codec_limits *lim);
+
+/* ---------------------------------------------------------------- errors */
+
+/** Most errors kept in one list; later ones are counted, not stored. */
+#define CODEC_MAX_ERRORS 100
+
+/**
+ * A list of validation errors, each a JSON pointer (RFC 6901, "" for the
+ * whole document) and a sentence for a user.  Opaque.
+ */
+typedef struct codec_errors codec_errors;
+
+/** New empty list, or NULL when out of memory.  Free with codec_errors_free. */
+codec_errors *codec_errors_new(void);
+
+/** Free a list; NULL is a no-op. */
+void codec_errors_free(codec_errors *e);
+
+/** Remove every error and reset the malformed flag. */
+void codec_errors_clear(codec_errors *e);
+
+/**
+ * Append an error: pointer is copied, the message is formatted printf-style.
+ * Returns SM_OK or SM_NOMEM (the list then remembers it was truncated).
+ */
+int codec_errors_add(codec_errors *e, const char *pointer, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
+/** Number of stored errors (at most CODEC_MAX_ERRORS + 1 with the "more" note). */
+int codec_errors_count(const codec_errors *e);
+
+/** Pointer of error i (0 <= i < count), borrowed; NULL when out of range. */
+const char *codec_errors_pointer(const codec_errors *e, int i);
+
+/** Message of error i (0 <= i < count), borrowed; NULL when out of range. */
+const char *codec_errors_message(const codec_errors *e, int i);
+
+/** 1 when the list describes a request that is not JSON at all (HTTP 400). */
+int codec_errors_malformed(const codec_errors *e);
+
+/** 1 when the request was larger than max_request_bytes (HTTP 413). */
+int codec_errors_too_large(const codec_errors *e);
+
+/** The list as a JSON array [{"pointer","message"}...]; new reference or NULL (NOMEM). */
+json_t *codec_errors_to_json(const codec_errors *e);
+
+/* --------------------------------------------------------------- request */
+
+/** A validated request with its defaults applied.  Opaque, immutable. */
+typedef struct codec_request codec_request;
+
+/**
+ * Parse and validate request text (need not be NUL-terminated).  On SM_OK,
+ * *out receives a new request (codec_request_free).  On SM_INVALID_INPUT,
+ * *out is NULL and errs lists every problem found (codec_errors_malformed
+ * tells a syntax error from an invalid model).  Returns SM_NOMEM when out of
+ * memory.  lim may be NULL for the defaults; errs must not be NULL.
+ */
+int codec_request_parse(codec_request **out, const char *text, size_t len,
+                        const codec_limits *lim, codec_errors *errs);
+
+/**
+ * Validate an already parsed request (borrowed, not modified).  Same
+ * contract as codec_request_parse.
+ */
+int codec_request_from_json(codec_request **out, const json_t *root,
+                            const codec_limits *lim, codec_errors *errs);
+
+/** Free a request; NULL is a no-op. */
+void codec_request_free(codec_request *r);
+
+/** The structure for sm_model_new; borrowed from r. */
+const sm_structure *codec_request_structure(const codec_request *r);
+
+/** The options for sm_model_new; borrowed from r. */
+const sm_options *codec_request_options(const codec_request *r);
+
+/** The speeds (rad/s) in request order; borrowed from r.  *n receives their count. */
+const double *codec_request_speeds(const codec_request *r, int *n);
+
+/** Name of joint j (the joints are indexed in sorted name order), borrowed; NULL if out of range. */
+const char *codec_request_joint_name(const codec_request *r, int j);
+
+/** The canonical request (defaults applied), borrowed from r. */
+const json_t *codec_request_canonical(const codec_request *r);
+
+/**
+ * The canonical JSON text: keys sorted, compact, reals with 17 significant
+ * digits.  Borrowed from r, NUL-terminated.
+ */
+const char *codec_request_canonical_text(const codec_request *r);
+
+/** SHA-256 of the canonical text as 64 lowercase hex digits, borrowed from r. */
+const char *codec_request_sha256(const codec_request *r);
+
+/**
+ * SHA-256 of len bytes of data as lowercase hex into hex[65] (NUL-terminated).
+ * Returns SM_OK or SM_NOMEM (OpenSSL failure).
+ */
+int codec_sha256_hex(const void *data, size_t len, char hex[65]);
+
+/* ------------------------------------------------------------------ core */
+
+/**
+ * Turn a core diagnostic (sm_model_new, sm_solve) into one error of errs:
+ * the pointer names the member, joint, section, point mass, clamp or option
+ * it refers to.  Returns SM_OK or SM_NOMEM.
+ */
+int codec_diag_error(const codec_request *r, const sm_diag *d, codec_errors *errs);
+
+/**
+ * Build the core model of a request.  On SM_OK *out receives a new model
+ * (sm_model_free).  On any other status *out is NULL and, unless the status
+ * is SM_NOMEM, errs holds one error naming the offending item (topology
+ * errors: cycle, disconnected member, ...).  diag may be NULL.
+ */
+int codec_model_new(sm_model **out, const codec_request *r, codec_errors *errs,
+                    sm_diag *diag);
+
+/* ---------------------------------------------------------------- result */
+
+/** Name of a case status: "solved", "unstable" or "no_equilibrium". */
+const char *codec_case_status_name(sm_case_status s);
+
+/**
+ * Encode a result as the document of DESIGN.md section 4.  r, m and res are
+ * borrowed; *out receives a new reference.  Returns SM_OK or SM_NOMEM.
+ */
+int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
+                        const sm_result *res);
+
+/**
+ * Encode the frequency table as CSV (header omega,mode,frequency_rad_s,
+ * frequency_hz,eig_re,eig_im,mac_to_previous,status; one row per speed and
+ * mode, one row with empty mode fields for a speed without modes).
+ * *out receives a malloc'd NUL-terminated string (free), *len its length
+ * (len may be NULL).  Returns SM_OK or SM_NOMEM.
+ */
+int codec_result_csv(char **out, size_t *len, const sm_result *res);
+
+/* --------------------------------------------------------------- problem */
+
+/**
+ * An RFC 9457 problem document {type, title, status, detail, errors}.
+ * type NULL means "about:blank"; detail may be NULL; errs may be NULL or
+ * empty (no "errors" member then).  Returns a new reference or NULL (NOMEM).
+ */
+json_t *codec_problem_new(int http_status, const char *type, const char *title,
+                          const char *detail, const codec_errors *errs);
+
+/**
+ * The problem document for a failed codec_request_parse/codec_model_new:
+ * 400 (malformed JSON), 413 (too large) or 422 (invalid model), with errs.
+ * Returns a new reference or NULL (NOMEM).
+ */
+json_t *codec_problem_from_errors(const codec_errors *errs);
+
+/** HTTP status the errors of a failed request map to: 400, 413 or 422. */
+int codec_errors_http_status(const codec_errors *e);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SPINMODAL_CODEC_H */

@@ -1,0 +1,256 @@
+#!/usr/bin/env python3
+"""End-to-end tests of the `spinmodal` CLI: exit codes, stdout/stderr, JSON and CSV.
+
+Usage: cli_test.py SPINMODAL SCENARIO   (meson registers one test per scenario)
+       cli_test.py SPINMODAL all
+
+Scenarios build their requests here (no data files) and run the executable as a
+child process.  Each prints one line per check; the exit status is 1 on any failure.
+"""
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+EXE = None
+FAILURES = []
+
+# The paper's aluminium section (DESIGN.md section 3).
+E, AREA, INERTIA, MU = 7e10, 4e-4, 2e-7, 1.2
+SECTION = {"E": E, "A": AREA, "I": INERTIA, "mass_per_length": MU}
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what)
+    if not cond:
+        FAILURES.append(what)
+    return cond
+
+
+def run(args, stdin=None, timeout=300):
+    p = subprocess.run([EXE] + args, input=stdin, capture_output=True, timeout=timeout)
+    return p.returncode, p.stdout.decode("utf-8", "replace"), p.stderr.decode("utf-8", "replace")
+
+
+def write_request(tmp, name, req):
+    path = os.path.join(tmp, name)
+    with open(path, "w") as f:
+        json.dump(req, f)
+    return path
+
+
+def cantilever(omega=0, elements=20, length=10.0):
+    return {
+        "structure": {
+            "joints": {"root": [0, 0], "tip": [length, 0]},
+            "sections": {"al": SECTION},
+            "members": [{"id": "beam", "from": "root", "to": "tip", "section": "al",
+                         "elements": elements}],
+            "clamp": "root",
+        },
+        "analysis": {"omega": omega, "mass": "lumped"},
+    }
+
+
+def angled_beam(omega=20, frames="single"):
+    return {
+        "structure": {
+            "joints": {"O": [0, 0], "C": [5, 0], "P": [5, 5]},
+            "sections": {"al": SECTION},
+            "members": [
+                {"id": "beam1", "from": "O", "to": "C", "section": "al", "elements": 24},
+                {"id": "beam2", "from": "C", "to": "P", "section": "al", "elements": 24},
+            ],
+            "clamp": "O",
+        },
+        "frames": frames,
+        "analysis": {"omega": omega, "geometric_stiffening": True},
+    }
+
+
+def parse_json(text, what):
+    try:
+        return json.loads(text)
+    except ValueError as e:
+        check(False, "%s is JSON (%s): %.200s" % (what, e, text))
+        return None
+
+
+# ------------------------------------------------------------------ scenarios
+
+def t_cantilever(tmp):
+    """(a) straight 10 m cantilever at rest: first frequency vs Euler-Bernoulli."""
+    length = 10.0
+    path = write_request(tmp, "cantilever.json", cantilever(length=length))
+    rc, out, err = run(["solve", path])
+    check(rc == 0, "cantilever: exit 0 (got %d; stderr %.300s)" % (rc, err))
+    doc = parse_json(out, "cantilever stdout")
+    if not doc:
+        return
+    exact = 1.875104069 ** 2 * math.sqrt(E * INERTIA / (MU * length ** 4))
+    case = doc["cases"][0]
+    w1 = case["modes"][0]["frequency_rad_s"]
+    check(abs(w1 - exact) <= 0.005 * exact,
+          "cantilever: omega_1 = %.6f rad/s within 0.5%% of %.6f" % (w1, exact))
+    check(abs(case["modes"][0]["frequency_hz"] - w1 / (2 * math.pi)) < 1e-9 * w1,
+          "cantilever: frequency_hz = frequency_rad_s / 2 pi")
+    check(case["status"] == "solved", "cantilever: status solved")
+    check(case["stability"]["stable"] is True, "cantilever: stable")
+    check(len(case["modes"]) == 3, "cantilever: 3 modes by default")
+    check(case["modes"][0]["mac_to_previous"] is None, "cantilever: mac_to_previous null at the first speed")
+    check(doc["model"]["elements"] == 20 and doc["model"]["nodes"] == 21,
+          "cantilever: model has 20 elements and 21 nodes (%s)" % doc["model"])
+    check(doc["solver"]["name"] == "spinmodal", "cantilever: solver name")
+    check(re.fullmatch(r"[0-9a-f]{64}", doc["solver"]["request_sha256"]) is not None,
+          "cantilever: request_sha256 is 64 hex digits")
+    eq = case["equilibrium"]
+    check(eq["converged"] is True and len(eq["nodes"]) == 21 and len(eq["axial_force"]) == 20,
+          "cantilever: equilibrium nodes and axial forces")
+    check(abs(eq["joints"]["tip"][0] - length) < 1e-9 and abs(eq["joints"]["root"][0]) < 1e-12,
+          "cantilever: joints map to the right nodes at rest (tip %s)" % eq["joints"].get("tip"))
+    shape = case["modes"][0].get("shape", {})
+    check(len(shape.get("re", [])) == 21 and len(shape.get("im", [])) == 21,
+          "cantilever: mode shapes re and im (Coriolis on) per node")
+    check(all(k in doc["timing_ms"] for k in ("equilibrium", "linearize", "eigen")), "cantilever: timing_ms")
+    # the sha printed by `validate` is the one in the result
+    rc2, out2, _ = run(["validate", path])
+    val = parse_json(out2, "validate stdout") if rc2 == 0 else None
+    check(val is not None and val["request_sha256"] == doc["solver"]["request_sha256"],
+          "validate: same request_sha256 as solve")
+    check(val is not None and val["canonical"]["analysis"]["coriolis"] is True,
+          "validate: canonical request has the defaults")
+    # stdin
+    with open(path, "rb") as f:
+        rc3, out3, _ = run(["solve", "-"], stdin=f.read())
+    check(rc3 == 0 and parse_json(out3, "stdin result")["cases"][0]["modes"][0]["frequency_rad_s"] == w1,
+          "cantilever: '-' reads standard input")
+
+
+def t_invalid(tmp):
+    """(b) invalid requests: exit 2, problem JSON on stderr, nothing on stdout."""
+    req = cantilever()
+    req["structure"]["members"][0]["to"] = "Q"
+    req["analysis"]["modes"] = 0
+    rc, out, err = run(["solve", write_request(tmp, "bad.json", req)])
+    check(rc == 2, "invalid: exit 2 (got %d)" % rc)
+    check(out == "", "invalid: nothing on stdout")
+    prob = parse_json(err, "invalid stderr")
+    if prob:
+        check(prob.get("status") == 422, "invalid: problem status 422")
+        ptrs = [e["pointer"] for e in prob.get("errors", [])]
+        check(ptrs[:1] == ["/structure/members/0/to"], "invalid: errors[0].pointer (%s)" % ptrs)
+        check("/analysis/modes" in ptrs, "invalid: every error is listed (%s)" % ptrs)
+        check("title" in prob and "type" in prob, "invalid: RFC 9457 type and title")
+    # malformed JSON -> 400
+    rc, out, err = run(["solve", "-"], stdin=b'{"structure": ')
+    prob = parse_json(err, "malformed stderr")
+    check(rc == 2 and out == "" and prob and prob.get("status") == 400, "malformed JSON: exit 2, status 400")
+    # topology error from the core (a cycle) -> 422 with a member pointer
+    tri = angled_beam(omega=0, frames="per_element")
+    tri["structure"]["members"].append({"id": "beam3", "from": "P", "to": "O", "section": "al", "elements": 4})
+    rc, out, err = run(["solve", write_request(tmp, "cycle.json", tri)])
+    prob = parse_json(err, "cycle stderr")
+    check(rc == 2 and prob and prob.get("status") == 422 and
+          prob["errors"][0]["pointer"].startswith("/structure/members/"),
+          "cycle: exit 2, status 422, member pointer (%s)" % (prob or {}).get("errors"))
+    # too large (16 MiB limit) -> 413
+    big = b'{"pad": "' + b"x" * (17 * 1024 * 1024) + b'"}'
+    rc, out, err = run(["solve", "-"], stdin=big)
+    prob = parse_json(err, "too-large stderr")
+    check(rc == 2 and prob and prob.get("status") == 413, "too large: exit 2, status 413")
+    # unreadable file -> 1
+    rc, out, err = run(["solve", os.path.join(tmp, "missing.json")])
+    check(rc == 1 and out == "" and "missing.json" in err, "missing file: exit 1 with a message")
+
+
+def t_no_equilibrium(tmp):
+    """(c) single frame at beta = 90 deg, Omega = 20: no equilibrium, exit 3, result printed."""
+    rc, out, err = run(["solve", write_request(tmp, "angled.json", angled_beam(20, "single"))])
+    check(rc == 3, "no equilibrium: exit 3 (got %d; stderr %.300s)" % (rc, err))
+    doc = parse_json(out, "no-equilibrium stdout")
+    if not doc:
+        return
+    case = doc["cases"][0]
+    check(case["status"] == "no_equilibrium", "no equilibrium: status (%s)" % case["status"])
+    check(case["equilibrium"]["converged"] is False, "no equilibrium: converged false")
+    d = case.get("diagnostics", {})
+    check(all(k in d for k in ("iterations", "residual", "last_omega", "message")),
+          "no equilibrium: diagnostics %s" % d)
+    check(d.get("last_omega") is not None and d["last_omega"] < 20, "no equilibrium: last_omega < 20")
+    check(case["modes"] == [], "no equilibrium: no modes")
+
+
+def t_csv(tmp):
+    """(d) --csv: header and one row per (speed, mode); a case without modes gets one row."""
+    req = cantilever(omega=[0, 1, 2])
+    req["analysis"]["modes"] = 4
+    rc, out, err = run(["solve", "--csv", write_request(tmp, "sweep.json", req)])
+    lines = out.splitlines()
+    check(rc == 0, "csv: exit 0 (got %d; %.200s)" % (rc, err))
+    check(lines[:1] == ["omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status"],
+          "csv: header")
+    check(len(lines) == 1 + 3 * 4, "csv: 12 rows for 3 speeds x 4 modes (got %d)" % (len(lines) - 1))
+    rows = [l.split(",") for l in lines[1:]]
+    check(all(len(r) == 8 for r in rows), "csv: 8 fields per row")
+    check(rows and rows[0][1] == "1" and rows[0][6] == "" and rows[-1][6] != "",
+          "csv: modes numbered from 1, MAC empty at the first speed only")
+    rc, out, err = run(["solve", "--csv", write_request(tmp, "angled.json", angled_beam(20, "single"))])
+    lines = out.splitlines()
+    check(rc == 3 and len(lines) == 2 and lines[1].split(",")[1:] == ["", "", "", "", "", "", "no_equilibrium"],
+          "csv: a case without equilibrium is one row with its status (%s)" % lines[1:])
+
+
+def t_help_version(tmp):
+    """(e) --help and --version."""
+    rc, out, _ = run(["--help"])
+    check(rc == 0 and "usage: spinmodal solve" in out, "--help: exit 0 and usage on stdout")
+    rc, out, _ = run(["--version"])
+    check(rc == 0 and re.fullmatch(r"spinmodal \d+\.\d+\.\d+\S*\n", out) is not None,
+          "--version: 'spinmodal X.Y.Z' (%r)" % out)
+    path = write_request(tmp, "c.json", cantilever())
+    rc2, out2, _ = run(["solve", path])
+    doc = parse_json(out2, "solve stdout") if rc2 == 0 else None
+    check(doc is not None and out.split()[1] == doc["solver"]["version"], "--version matches solver.version")
+
+
+def t_usage(tmp):
+    """(f) usage errors: exit 64, message on stderr."""
+    path = write_request(tmp, "c.json", cantilever())
+    for args in ([], ["frobnicate", path], ["solve"], ["solve", "--bogus", path],
+                 ["solve", path, path], ["validate", "--csv", path]):
+        rc, out, err = run(args)
+        check(rc == 64 and out == "" and "usage" in err, "usage error %s: exit 64 (got %d)" % (args, rc))
+
+
+SCENARIOS = {
+    "cantilever": t_cantilever,
+    "invalid": t_invalid,
+    "no_equilibrium": t_no_equilibrium,
+    "csv": t_csv,
+    "help_version": t_help_version,
+    "usage": t_usage,
+}
+
+
+def main():
+    global EXE
+    if len(sys.argv) != 3 or (sys.argv[2] not in SCENARIOS and sys.argv[2] != "all"):
+        print("usage: cli_test.py SPINMODAL {%s|all}" % "|".join(SCENARIOS), file=sys.stderr)
+        return 2
+    EXE = os.path.abspath(sys.argv[1])
+    names = list(SCENARIOS) if sys.argv[2] == "all" else [sys.argv[2]]
+    with tempfile.TemporaryDirectory(prefix="spinmodal-cli-") as tmp:
+        for name in names:
+            try:
+                SCENARIOS[name](tmp)
+            except Exception as e:  # a crash of the script is a failure, with its cause
+                check(False, "%s: %s: %s" % (name, type(e).__name__, e))
+    print("%d failed" % len(FAILURES))
+    return 1 if FAILURES else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

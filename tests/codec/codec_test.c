@@ -1,0 +1,599 @@
+/*
+ * codec_test.c — data-driven tests of the JSON codec (server/codec.c).
+ *
+ * Usage: codec_test CASES_DIR
+ *
+ * Every folder of CASES_DIR is one case:
+ *   request.json + expected-error.json  an invalid request.  The request goes
+ *       through codec_request_parse and, when the codec accepts it,
+ *       codec_model_new (topology errors come from the core).  Every entry
+ *       of "errors" ({"pointer" or "pointer_prefix", "contains"}) must match
+ *       one reported error; optional "status" is the HTTP status (400, 413,
+ *       422) and "limits" overrides codec_limits fields.
+ *   request.json + checks.json  a valid request; checks: canonical_contains,
+ *       same_sha_as / different_sha_from (other files of the folder),
+ *       joint_names, speeds, options, structure, model (sizes from
+ *       sm_model_get_info).
+ * Before the folders a few unit checks run (SHA-256 vector, error list cap,
+ * problem document, CSV encoder).  One line per case; exit status 1 when
+ * anything failed.
+ */
+#include <dirent.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "codec.h"
+
+#define TEST_PATH_MAX 4096
+
+/* Failure messages of the current case. */
+typedef struct test_case {
+    const char *name; /* folder name */
+    int failures;     /* checks that failed */
+} test_case;
+
+#if defined(__GNUC__)
+__attribute__((format(printf, 2, 3)))
+#endif
+static void fail(test_case *tc, const char *fmt, ...)
+{
+    va_list ap;
+
+    if (tc->failures++ == 0)
+        printf("FAIL %s\n", tc->name);
+    printf("     ");
+    va_start(ap, fmt);
+    vprintf(fmt, ap);
+    va_end(ap);
+    printf("\n");
+}
+
+/* Whole file as a malloc'd NUL-terminated string, or NULL. */
+static char *read_text(const char *path, size_t *len)
+{
+    FILE *f = fopen(path, "rb");
+    char *buf = NULL;
+    long n;
+
+    if (!f)
+        return NULL;
+    if (fseek(f, 0, SEEK_END) || (n = ftell(f)) < 0 || fseek(f, 0, SEEK_SET))
+        goto done;
+    buf = malloc((size_t)n + 1);
+    if (!buf)
+        goto done;
+    if (fread(buf, 1, (size_t)n, f) != (size_t)n) {
+        free(buf);
+        buf = NULL;
+        goto done;
+    }
+    buf[n] = '\0';
+    if (len)
+        *len = (size_t)n;
+done:
+    fclose(f);
+    return buf;
+}
+
+/* path = dir/file; 0, or -1 when it does not fit. */
+static int path_join(char path[TEST_PATH_MAX], const char *dir, const char *file)
+{
+    int n = snprintf(path, TEST_PATH_MAX, "%s/%s", dir, file);
+
+    return n < 0 || n >= TEST_PATH_MAX ? -1 : 0;
+}
+
+static int file_exists(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+
+    if (!f)
+        return 0;
+    fclose(f);
+    return 1;
+}
+
+/* Limits with the overrides of spec (an object or NULL). */
+static void apply_limits(codec_limits *lim, const json_t *spec)
+{
+    const json_t *x;
+
+    codec_default_limits(lim);
+    if ((x = json_object_get(spec, "max_request_bytes")))
+        lim->max_request_bytes = (size_t)json_integer_value(x);
+    if ((x = json_object_get(spec, "max_shape_values")))
+        lim->max_shape_values = (long)json_integer_value(x);
+#define LIMIT(f) if ((x = json_object_get(spec, #f))) lim->f = (int)json_integer_value(x);
+    LIMIT(max_joints) LIMIT(max_sections) LIMIT(max_members) LIMIT(max_point_masses)
+    LIMIT(max_elements) LIMIT(max_speeds) LIMIT(max_modes)
+#undef LIMIT
+}
+
+/* Parse dir/file into a request; NULL (and a failure) when it does not validate. */
+static codec_request *load_request(test_case *tc, const char *dir, const char *file,
+                                   const codec_limits *lim)
+{
+    char path[TEST_PATH_MAX];
+    codec_errors *errs = codec_errors_new();
+    codec_request *req = NULL;
+    size_t len = 0;
+    char *text;
+    int st, i;
+
+    text = path_join(path, dir, file) ? NULL : read_text(path, &len);
+    if (!text || !errs) {
+        fail(tc, "cannot read %s", path);
+        goto done;
+    }
+    st = codec_request_parse(&req, text, len, lim, errs);
+    if (st != SM_OK) {
+        fail(tc, "%s rejected (%s):", file, sm_strerror(st));
+        for (i = 0; i < codec_errors_count(errs); i++)
+            fail(tc, "  '%s': %s", codec_errors_pointer(errs, i), codec_errors_message(errs, i));
+    }
+done:
+    free(text);
+    codec_errors_free(errs);
+    return req;
+}
+
+/* An RFC 6901 pointer: "" or "/..." with ~ only as ~0 or ~1. */
+static int pointer_ok(const char *p)
+{
+    if (p[0] != '\0' && p[0] != '/')
+        return 0;
+    for (; *p; p++)
+        if (*p == '~' && p[1] != '0' && p[1] != '1')
+            return 0;
+    return 1;
+}
+
+/* Does some error match the expectation e? */
+static int error_matches(const codec_errors *errs, const json_t *e)
+{
+    const char *ptr = json_string_value(json_object_get(e, "pointer"));
+    const char *prefix = json_string_value(json_object_get(e, "pointer_prefix"));
+    const char *contains = json_string_value(json_object_get(e, "contains"));
+    int i;
+
+    for (i = 0; i < codec_errors_count(errs); i++) {
+        const char *p = codec_errors_pointer(errs, i);
+        const char *m = codec_errors_message(errs, i);
+        if (ptr && strcmp(p, ptr))
+            continue;
+        if (prefix && strncmp(p, prefix, strlen(prefix)))
+            continue;
+        if (contains && !strstr(m, contains))
+            continue;
+        return 1;
+    }
+    return 0;
+}
+
+/* An invalid request: every expected error must be reported. */
+static void run_invalid(test_case *tc, const char *dir, const json_t *exp)
+{
+    char path[TEST_PATH_MAX];
+    codec_limits lim;
+    codec_errors *errs = codec_errors_new();
+    codec_request *req = NULL;
+    sm_model *m = NULL;
+    const json_t *e, *status = json_object_get(exp, "status");
+    json_t *problem = NULL;
+    size_t len = 0, k;
+    char *text;
+    int st, i;
+
+    apply_limits(&lim, json_object_get(exp, "limits"));
+    text = path_join(path, dir, "request.json") ? NULL : read_text(path, &len);
+    if (!text || !errs) {
+        fail(tc, "cannot read %s", path);
+        goto done;
+    }
+    st = codec_request_parse(&req, text, len, &lim, errs);
+    if (st == SM_OK)
+        st = codec_model_new(&m, req, errs, NULL);
+    if (st == SM_OK) {
+        fail(tc, "the request was accepted");
+        goto done;
+    }
+    if (st == SM_NOMEM)
+        fail(tc, "out of memory");
+    json_array_foreach(json_object_get(exp, "errors"), k, e) {
+        if (!error_matches(errs, e)) {
+            char *want = json_dumps(e, JSON_COMPACT);
+            fail(tc, "expected error %s not reported", want ? want : "?");
+            free(want);
+        }
+    }
+    for (i = 0; i < codec_errors_count(errs); i++)
+        if (!pointer_ok(codec_errors_pointer(errs, i)))
+            fail(tc, "malformed pointer '%s'", codec_errors_pointer(errs, i));
+    if (status && codec_errors_http_status(errs) != (int)json_integer_value(status))
+        fail(tc, "HTTP status %d, expected %d", codec_errors_http_status(errs),
+             (int)json_integer_value(status));
+    problem = codec_problem_from_errors(errs);
+    if (!problem || !json_is_array(json_object_get(problem, "errors")))
+        fail(tc, "no problem document with errors");
+    if (tc->failures) {
+        fail(tc, "reported errors:");
+        for (i = 0; i < codec_errors_count(errs); i++)
+            fail(tc, "  '%s': %s", codec_errors_pointer(errs, i), codec_errors_message(errs, i));
+    }
+done:
+    json_decref(problem);
+    sm_model_free(m);
+    codec_request_free(req);
+    codec_errors_free(errs);
+    free(text);
+}
+
+/* checks.options: selected sm_options fields. */
+static void check_options(test_case *tc, const sm_options *o, const json_t *want)
+{
+    const char *key;
+    const json_t *v;
+
+    json_object_foreach((json_t *)want, key, v) {
+        long got, w = (long)json_integer_value(v);
+        if (!strcmp(key, "frames")) got = (long)o->frames;
+        else if (!strcmp(key, "frames_param")) got = o->frames_param;
+        else if (!strcmp(key, "mass")) got = (long)o->mass;
+        else if (!strcmp(key, "basis")) got = (long)o->basis;
+        else if (!strcmp(key, "modes")) got = o->modes;
+        else if (!strcmp(key, "modes_per_frame")) got = o->modes_per_frame;
+        else if (!strcmp(key, "geometric_stiffening")) got = o->geometric_stiffening;
+        else if (!strcmp(key, "coriolis")) got = o->coriolis;
+        else if (!strcmp(key, "mode_shapes")) got = o->mode_shapes;
+        else {
+            fail(tc, "unknown option check '%s'", key);
+            continue;
+        }
+        if (got != w)
+            fail(tc, "option %s is %ld, expected %ld", key, got, w);
+    }
+}
+
+/* checks.structure: counts, clamp, members [from, to, section, elements], point masses. */
+static void check_structure(test_case *tc, const sm_structure *st, const json_t *want)
+{
+    const json_t *x, *row;
+    size_t i;
+
+#define COUNT(f) if ((x = json_object_get(want, #f)) && st->f != (int)json_integer_value(x)) \
+        fail(tc, #f " is %d, expected %d", st->f, (int)json_integer_value(x));
+    COUNT(n_joints) COUNT(n_sections) COUNT(n_members) COUNT(n_point_masses) COUNT(clamp)
+#undef COUNT
+    json_array_foreach(json_object_get(want, "members"), i, row) {
+        const sm_member *m = (int)i < st->n_members ? &st->members[i] : NULL;
+        if (!m || m->from != json_integer_value(json_array_get(row, 0)) ||
+            m->to != json_integer_value(json_array_get(row, 1)) ||
+            m->section != json_integer_value(json_array_get(row, 2)) ||
+            m->elements != json_integer_value(json_array_get(row, 3)))
+            fail(tc, "member %zu differs", i);
+    }
+    json_array_foreach(json_object_get(want, "point_masses"), i, row) {
+        const sm_point_mass *p = (int)i < st->n_point_masses ? &st->point_masses[i] : NULL;
+        if (!p || p->joint != json_integer_value(json_array_get(row, 0)) ||
+            p->mass != json_number_value(json_array_get(row, 1)))
+            fail(tc, "point mass %zu differs", i);
+    }
+}
+
+/* Same canonical text after a second pass (the canonical form is a fixpoint). */
+static void check_idempotent(test_case *tc, const codec_request *req)
+{
+    const char *text = codec_request_canonical_text(req);
+    codec_errors *errs = codec_errors_new();
+    codec_request *again = NULL;
+
+    if (!errs || codec_request_parse(&again, text, strlen(text), NULL, errs) != SM_OK)
+        fail(tc, "the canonical request does not validate");
+    else if (strcmp(text, codec_request_canonical_text(again)))
+        fail(tc, "canonicalizing twice changes the text");
+    codec_request_free(again);
+    codec_errors_free(errs);
+}
+
+/* Compare the SHA-256 of req with the requests in files. */
+static void check_shas(test_case *tc, const char *dir, const codec_request *req,
+                       const json_t *files, int same)
+{
+    const json_t *f;
+    size_t i;
+
+    json_array_foreach(files, i, f) {
+        codec_request *other = load_request(tc, dir, json_string_value(f), NULL);
+        if (!other)
+            continue;
+        if (same != !strcmp(codec_request_sha256(req), codec_request_sha256(other)))
+            fail(tc, "SHA-256 of %s should %s:\n       %s\n       %s", json_string_value(f),
+                 same ? "be the same" : "differ", codec_request_canonical_text(req),
+                 codec_request_canonical_text(other));
+        codec_request_free(other);
+    }
+}
+
+/* checks.model: the core model builds, with these sizes. */
+static void check_model(test_case *tc, const codec_request *req, const json_t *want)
+{
+    codec_errors *errs = codec_errors_new();
+    sm_model *m = NULL;
+    sm_model_info info;
+    const json_t *x;
+    int st;
+
+    if (!errs) {
+        fail(tc, "out of memory");
+        return;
+    }
+    st = codec_model_new(&m, req, errs, NULL);
+    if (st != SM_OK) {
+        fail(tc, "sm_model_new: %s: '%s' %s", sm_strerror(st), codec_errors_pointer(errs, 0),
+             codec_errors_message(errs, 0));
+        goto done;
+    }
+    sm_model_get_info(m, &info);
+#define INFO(f) if ((x = json_object_get(want, #f)) && info.f != (int)json_integer_value(x)) \
+        fail(tc, "model " #f " is %d, expected %d", info.f, (int)json_integer_value(x));
+    INFO(nodes) INFO(elements) INFO(frames) INFO(coordinates)
+#undef INFO
+done:
+    sm_model_free(m);
+    codec_errors_free(errs);
+}
+
+/* A valid request and its checks. */
+static void run_valid(test_case *tc, const char *dir, const json_t *chk)
+{
+    codec_request *req = load_request(tc, dir, "request.json", NULL);
+    const json_t *x;
+    const double *sp;
+    size_t i;
+    int n, k;
+
+    if (!req)
+        return;
+    json_array_foreach(json_object_get(chk, "canonical_contains"), i, x)
+        if (!strstr(codec_request_canonical_text(req), json_string_value(x)))
+            fail(tc, "canonical text lacks %s:\n       %s", json_string_value(x),
+                 codec_request_canonical_text(req));
+    check_shas(tc, dir, req, json_object_get(chk, "same_sha_as"), 1);
+    check_shas(tc, dir, req, json_object_get(chk, "different_sha_from"), 0);
+    json_array_foreach(json_object_get(chk, "joint_names"), i, x) {
+        const char *got = codec_request_joint_name(req, (int)i);
+        if (!got || strcmp(got, json_string_value(x)))
+            fail(tc, "joint %zu is '%s', expected '%s'", i, got ? got : "(none)",
+                 json_string_value(x));
+    }
+    if ((x = json_object_get(chk, "speeds"))) {
+        sp = codec_request_speeds(req, &n);
+        if (n != (int)json_array_size(x))
+            fail(tc, "%d speeds, expected %zu", n, json_array_size(x));
+        for (k = 0; k < n && k < (int)json_array_size(x); k++)
+            if (sp[k] != json_number_value(json_array_get(x, (size_t)k)))
+                fail(tc, "speed %d is %g", k, sp[k]);
+    }
+    if ((x = json_object_get(chk, "options")))
+        check_options(tc, codec_request_options(req), x);
+    if ((x = json_object_get(chk, "structure")))
+        check_structure(tc, codec_request_structure(req), x);
+    if ((x = json_object_get(chk, "model")))
+        check_model(tc, req, x);
+    if (strlen(codec_request_sha256(req)) != 64)
+        fail(tc, "SHA-256 is not 64 hex digits");
+    check_idempotent(tc, req);
+    codec_request_free(req);
+}
+
+static int run_case(const char *root, const char *name)
+{
+    char dir[TEST_PATH_MAX], path[TEST_PATH_MAX];
+    test_case tc = {name, 0};
+    json_error_t jerr;
+    json_t *spec;
+
+    if (path_join(dir, root, name) || path_join(path, dir, "expected-error.json")) {
+        fail(&tc, "path too long");
+        return 1;
+    }
+    if (file_exists(path)) {
+        spec = json_load_file(path, 0, &jerr);
+        if (!spec)
+            fail(&tc, "%s: %s", path, jerr.text);
+        else
+            run_invalid(&tc, dir, spec);
+    } else {
+        spec = path_join(path, dir, "checks.json") ? NULL : json_load_file(path, 0, &jerr);
+        if (!spec)
+            fail(&tc, "no expected-error.json or readable checks.json: %s", jerr.text);
+        else
+            run_valid(&tc, dir, spec);
+    }
+    json_decref(spec);
+    if (!tc.failures)
+        printf("ok   %s\n", name);
+    return tc.failures != 0;
+}
+
+/* ------------------------------------------------------------ unit checks */
+
+static void unit_sha(test_case *tc)
+{
+    char hex[65];
+
+    codec_sha256_hex("abc", 3, hex);
+    if (strcmp(hex, "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"))
+        fail(tc, "SHA-256(\"abc\") = %s", hex);
+}
+
+static void unit_errors(test_case *tc)
+{
+    codec_errors *e = codec_errors_new();
+    json_t *p = NULL;
+    int i;
+
+    for (i = 0; i < CODEC_MAX_ERRORS + 50; i++)
+        codec_errors_add(e, "/x", "error %d", i);
+    if (codec_errors_count(e) != CODEC_MAX_ERRORS + 1)
+        fail(tc, "error list holds %d entries", codec_errors_count(e));
+    if (!strstr(codec_errors_message(e, CODEC_MAX_ERRORS), "more errors"))
+        fail(tc, "no 'more errors' note at the end");
+    p = codec_problem_from_errors(e);
+    if (!p || json_integer_value(json_object_get(p, "status")) != 422 ||
+        json_array_size(json_object_get(p, "errors")) != CODEC_MAX_ERRORS + 1 ||
+        strcmp(json_string_value(json_object_get(p, "type")), "about:blank"))
+        fail(tc, "problem document");
+    json_decref(p);
+    p = codec_problem_new(503, "urn:spinmodal:shutting-down", "Service Unavailable", NULL, NULL);
+    if (!p || json_object_get(p, "errors") || json_object_get(p, "detail"))
+        fail(tc, "problem without errors");
+    json_decref(p);
+    codec_errors_free(e);
+}
+
+static void unit_csv(test_case *tc)
+{
+    double freq[2] = {3.5, 20}, re[2] = {0, 0}, im[2] = {3.5, 20}, mac[2] = {-1, -1};
+    int prev[2] = {-1, -1};
+    sm_case cases[2];
+    sm_result res = {2, cases};
+    char *csv = NULL;
+    size_t len = 0;
+    const char *want =
+        "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status\n"
+        "0,1,3.5,0.55704230082163375,0,3.5,,solved\n"
+        "0,2,20,3.183098861837907,0,20,,solved\n"
+        "20,,,,,,,no_equilibrium\n";
+
+    memset(cases, 0, sizeof(cases));
+    cases[0].status = SM_CASE_SOLVED;
+    cases[0].n_modes = 2;
+    cases[0].frequency = freq;
+    cases[0].eig_re = re;
+    cases[0].eig_im = im;
+    cases[0].mac_to_previous = mac;
+    cases[0].previous_index = prev;
+    cases[1].omega = 20;
+    cases[1].status = SM_CASE_NO_EQUILIBRIUM;
+    if (codec_result_csv(&csv, &len, &res) != SM_OK || strcmp(csv, want) || len != strlen(want))
+        fail(tc, "CSV:\n%s", csv ? csv : "(none)");
+    free(csv);
+}
+
+/* codec_diag_error: every kind of sm_diag item maps to the right pointer. */
+static void unit_diag(test_case *tc)
+{
+    static const char *text =
+        "{\"structure\": {\"joints\": {\"O\": [0, 0], \"a/b\": [1, 0], \"P\": [1, 1]},"
+        " \"sections\": {\"al\": {\"E\": 1, \"A\": 1, \"I\": 1, \"mass_per_length\": 1}},"
+        " \"members\": [{\"from\": \"O\", \"to\": \"a/b\", \"section\": \"al\", \"elements\": 1},"
+        " {\"from\": \"a/b\", \"to\": \"P\", \"section\": \"al\", \"elements\": 1}],"
+        " \"point_masses\": [{\"joint\": \"P\", \"mass\": 1}], \"clamp\": \"O\"},"
+        " \"frames\": {\"per_member\": 1}, \"analysis\": {\"omega\": [0, 1]}}";
+    static const struct {
+        sm_item item;
+        int index;
+        const char *field;
+        const char *pointer;
+    } map[] = {
+        {SM_ITEM_MEMBER, 1, "to", "/structure/members/1/to"},
+        {SM_ITEM_MEMBER, 1, "length", "/structure/members/1"},
+        {SM_ITEM_MEMBER, 0, "E", "/structure/sections/al/E"},
+        {SM_ITEM_MEMBER, 7, "", "/structure/members"},
+        {SM_ITEM_SECTION, 0, "mu", "/structure/sections/al/mass_per_length"},
+        {SM_ITEM_JOINT, 2, "", "/structure/joints/a~1b"},
+        {SM_ITEM_JOINT, 0, "y", "/structure/joints/O/1"},
+        {SM_ITEM_POINT_MASS, 0, "mass", "/structure/point_masses/0/mass"},
+        {SM_ITEM_CLAMP, -1, "", "/structure/clamp"},
+        {SM_ITEM_OPTIONS, -1, "frames", "/frames"},
+        {SM_ITEM_OPTIONS, -1, "frames_param", "/frames/per_member"},
+        {SM_ITEM_OPTIONS, -1, "modes", "/analysis/modes"},
+        {SM_ITEM_OPTIONS, -1, "basis", "/analysis/substructure_modes"},
+        {SM_ITEM_OPTIONS, 1, "omega", "/analysis/omega/1"},
+        {SM_ITEM_NONE, -1, "", "/structure"},
+    };
+    codec_errors *errs = codec_errors_new();
+    codec_request *req = NULL;
+    size_t k;
+
+    if (codec_request_parse(&req, text, strlen(text), NULL, errs) != SM_OK) {
+        fail(tc, "diag request rejected: '%s' %s", codec_errors_pointer(errs, 0),
+             codec_errors_message(errs, 0));
+        goto done;
+    }
+    for (k = 0; k < sizeof(map) / sizeof(map[0]); k++) {
+        sm_diag d;
+        memset(&d, 0, sizeof(d));
+        d.status = SM_INVALID_INPUT;
+        d.item = map[k].item;
+        d.item_index = map[k].index;
+        snprintf(d.field, sizeof(d.field), "%s", map[k].field);
+        snprintf(d.message, sizeof(d.message), "diag %zu", k);
+        codec_errors_clear(errs);
+        if (codec_diag_error(req, &d, errs) != SM_OK || codec_errors_count(errs) != 1 ||
+            strcmp(codec_errors_pointer(errs, 0), map[k].pointer) ||
+            strcmp(codec_errors_message(errs, 0), d.message))
+            fail(tc, "diag %zu -> '%s', expected '%s'", k, codec_errors_pointer(errs, 0),
+                 map[k].pointer);
+    }
+done:
+    codec_request_free(req);
+    codec_errors_free(errs);
+}
+
+static int cmp_name(const void *a, const void *b)
+{
+    return strcmp(*(char *const *)a, *(char *const *)b);
+}
+
+int main(int argc, char **argv)
+{
+    test_case tc = {"unit: sha256, error list, problem, csv, diag pointers", 0};
+    char **names = NULL;
+    size_t n = 0, cap = 0, i;
+    struct dirent *de;
+    DIR *d;
+    int failed = 0;
+
+    if (argc != 2) {
+        fprintf(stderr, "usage: codec_test CASES_DIR\n");
+        return 2;
+    }
+    unit_sha(&tc);
+    unit_errors(&tc);
+    unit_csv(&tc);
+    unit_diag(&tc);
+    if (tc.failures)
+        failed++;
+    else
+        printf("ok   %s\n", tc.name);
+    d = opendir(argv[1]);
+    if (!d) {
+        perror(argv[1]);
+        return 1;
+    }
+    while ((de = readdir(d))) {
+        if (de->d_name[0] == '.')
+            continue;
+        if (n == cap) {
+            char **nn = realloc(names, (cap = cap ? 2 * cap : 64) * sizeof(*names));
+            if (!nn)
+                return 1;
+            names = nn;
+        }
+        names[n++] = strdup(de->d_name);
+    }
+    closedir(d);
+    qsort(names, n, sizeof(*names), cmp_name);
+    for (i = 0; i < n; i++) {
+        failed += run_case(argv[1], names[i]);
+        free(names[i]);
+    }
+    free(names);
+    printf("%zu cases, %d failed\n", n, failed);
+    return failed ? 1 : 0;
+}
