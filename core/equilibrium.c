@@ -31,6 +31,7 @@
 typedef struct eq_ws {
     sm_kin kin;
     double *F, *g, *dq, *qt, *q0, *qp, *work;
+    double *P;               /* n_elems axial forces */
     dmat Kt, M, H, W;
     int *ipiv;
     int iterations;          /* total Newton iterations */
@@ -47,6 +48,7 @@ static void eq_ws_free(eq_ws *w)
     free(w->q0);
     free(w->qp);
     free(w->work);
+    free(w->P);
     free(w->ipiv);
     dm_free(&w->Kt);
     dm_free(&w->M);
@@ -68,7 +70,8 @@ static int eq_ws_alloc(const sm_model *m, eq_ws *w)
     w->qp = dm_vec((size_t)n);
     w->work = dm_vec((size_t)(4 * mx + n));
     w->ipiv = malloc((size_t)n * sizeof(int));
-    if (!w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp || !w->work || !w->ipiv ||
+    w->P = dm_vec((size_t)m->n_elems);
+    if (!w->P || !w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp || !w->work || !w->ipiv ||
         frames_kin_alloc(m, &w->kin) || dm_alloc(&w->Kt, n, n) || dm_alloc(&w->M, n, n) ||
         dm_alloc(&w->H, n, n) || dm_alloc(&w->W, n, 2 * m->n_mp)) {
         eq_ws_free(w);
@@ -122,19 +125,13 @@ static int eq_det_sign(const eq_ws *w, int n)
     return sign;
 }
 
-/* Largest elastic axial strain |P_e| / EA over all elements at q. */
-static double eq_max_strain(const sm_model *m, const double *q)
+/* Largest elastic axial strain |P_e| / EA over all elements at q; P: n_elems scratch. */
+static double eq_max_strain(const sm_model *m, const double *q, double *P)
 {
     double mx = 0;
-    for (int s = 0; s < m->n_subs; s++) {
-        const sm_sub *b = &m->subs[s];
-        for (int j = 0; j < b->nel; j++) {
-            double P = 0;
-            for (int i = 0; i < b->m; i++)
-                P += b->d[(size_t)j * b->m + i] * q[b->q0 + i];
-            mx = fmax(mx, fabs(P) / m->elems[b->elems[j]].EA);
-        }
-    }
+    lin_axial_forces(m, q, P);
+    for (int e = 0; e < m->n_elems; e++)
+        mx = fmax(mx, fabs(P[e]) / m->elems[e].EA);
     return mx;
 }
 
@@ -247,7 +244,7 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
             if (have_lu && corr > fmax(0.5 * step, 1e-6 * fmax(1.0, dm_norm(q, n)))) {
                 ok = 0;
                 why = "the solution jumped to another branch";
-            } else if (eq_max_strain(m, q) > EQ_MAX_STRAIN) {
+            } else if (eq_max_strain(m, q, w.P) > EQ_MAX_STRAIN) {
                 ok = 0;
                 why = "the deformation leaves the small-strain range (axial strain above 1 %): "
                       "the steady state runs away; use more frames";

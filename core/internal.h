@@ -124,6 +124,7 @@ void frames_hessian(const sm_model *m, const double *q, const sm_kin *k, dmat *H
 /* --------------------------------------------------------- linearize.c */
 void lin_geometric_force(const sm_model *m, const double *q, double *fg);
 void lin_geometric_tangent(const sm_model *m, const double *q, int frozen, dmat *Kt, double *work);
+void lin_axial_forces(const sm_model *m, const double *q, double *P);
 void lin_elastic_force(const sm_model *m, const double *q, double *f);
 void lin_elastic_add(const sm_model *m, dmat *Kt);
 void lin_mass(const sm_model *m, const sm_kin *k, dmat *M, dmat *W);

@@ -16,6 +16,20 @@
 #include <math.h>
 #include <string.h>
 
+/** P[e] = d_e . q_s, the axial force of every FE element e (eq. 24), N. */
+void lin_axial_forces(const sm_model *m, const double *q, double *P)
+{
+    for (int s = 0; s < m->n_subs; s++) {
+        const sm_sub *b = &m->subs[s];
+        for (int j = 0; j < b->nel; j++) {
+            double t = 0;
+            for (int i = 0; i < b->m; i++)
+                t += b->d[(size_t)j * b->m + i] * q[b->q0 + i];
+            P[b->elems[j]] = t;
+        }
+    }
+}
+
 /** f += blockdiag(K_s) q. */
 void lin_elastic_force(const sm_model *m, const double *q, double *f)
 {

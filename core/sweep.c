@@ -195,15 +195,7 @@ static int sweep_equilibrium_out(const sm_model *m, const double *q, const sm_ki
     if (!c->nodes || !c->axial_force)
         return SM_NOMEM;
     memcpy(c->nodes, k->rn, 3 * (size_t)m->n_nodes * sizeof(double));
-    for (int s = 0; s < m->n_subs; s++) {
-        const sm_sub *b = &m->subs[s];
-        for (int j = 0; j < b->nel; j++) {
-            double P = 0;
-            for (int i = 0; i < b->m; i++)
-                P += b->d[(size_t)j * b->m + i] * q[b->q0 + i];
-            c->axial_force[b->elems[j]] = P;
-        }
-    }
+    lin_axial_forces(m, q, c->axial_force);
     return SM_OK;
 }
 
