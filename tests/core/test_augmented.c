@@ -19,13 +19,10 @@ static sm_case *solve(sm_options *o, double beta, double om, sm_model **m, sm_re
 
 int main(int argc, char **argv)
 {
-    char path[1024];
     tu_csv ex, ck;
-    snprintf(path, sizeof path, "%s/angled_beam_exact.csv", argc > 1 ? argv[1] : ".");
-    if (tu_csv_read(path, &ex) < 0)
+    if (tu_ref_read(argc, argv, "angled_beam_exact.csv", &ex) < 0)
         return 1;
-    snprintf(path, sizeof path, "%s/multiframe_checkpoints.csv", argc > 1 ? argv[1] : ".");
-    if (tu_csv_read(path, &ck) < 0)
+    if (tu_ref_read(argc, argv, "multiframe_checkpoints.csv", &ck) < 0)
         return 1;
     sm_model *m;
     sm_result *r;

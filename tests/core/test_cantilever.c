@@ -33,10 +33,8 @@ static void check(sm_options *o, int ne, double tol, const double *bl)
 
 int main(int argc, char **argv)
 {
-    char path[1024];
     tu_csv c;
-    snprintf(path, sizeof path, "%s/cantilever.csv", argc > 1 ? argv[1] : ".");
-    if (tu_csv_read(path, &c) < 0)
+    if (tu_ref_read(argc, argv, "cantilever.csv", &c) < 0)
         return 1;
     double bl[3] = {tu_csv_num(&c, 0, "w1"), tu_csv_num(&c, 0, "w2"), tu_csv_num(&c, 0, "w3")};
     tu_csv_free(&c);

@@ -10,10 +10,8 @@
 
 int main(int argc, char **argv)
 {
-    char path[1024];
     tu_csv ex;
-    snprintf(path, sizeof path, "%s/angled_beam_exact.csv", argc > 1 ? argv[1] : ".");
-    if (tu_csv_read(path, &ex) < 0)
+    if (tu_ref_read(argc, argv, "angled_beam_exact.csv", &ex) < 0)
         return 1;
     sm_frame_scheme fs[4] = {SM_FRAMES_SINGLE, SM_FRAMES_PER_MEMBER, SM_FRAMES_ELEMENTS_PER_FRAME,
                              SM_FRAMES_PER_ELEMENT};

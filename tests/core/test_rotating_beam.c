@@ -9,10 +9,8 @@
 
 int main(int argc, char **argv)
 {
-    char path[1024];
     tu_csv c;
-    snprintf(path, sizeof path, "%s/cantilever.csv", argc > 1 ? argv[1] : ".");
-    if (tu_csv_read(path, &c) < 0)
+    if (tu_ref_read(argc, argv, "cantilever.csv", &c) < 0)
         return 1;
     double L = 10, EI = 7e10 * 2e-7, mu = 1.2, t = sqrt(mu * L * L * L * L / EI);
     double xy[4] = {0, 0, L, 0};

@@ -8,10 +8,8 @@
 
 int main(int argc, char **argv)
 {
-    char path[1024];
     tu_csv ex;
-    snprintf(path, sizeof path, "%s/angled_beam_exact.csv", argc > 1 ? argv[1] : ".");
-    if (tu_csv_read(path, &ex) < 0)
+    if (tu_ref_read(argc, argv, "angled_beam_exact.csv", &ex) < 0)
         return 1;
     tu_angled a;
     tu_angled_beam(&a, 90, 24, 24);

@@ -9,13 +9,10 @@
 
 int main(int argc, char **argv)
 {
-    char path[1024];
     tu_csv t2, ck;
-    snprintf(path, sizeof path, "%s/paper_table2.csv", argc > 1 ? argv[1] : ".");
-    if (tu_csv_read(path, &t2) < 0)
+    if (tu_ref_read(argc, argv, "paper_table2.csv", &t2) < 0)
         return 1;
-    snprintf(path, sizeof path, "%s/multiframe_checkpoints.csv", argc > 1 ? argv[1] : ".");
-    if (tu_csv_read(path, &ck) < 0)
+    if (tu_ref_read(argc, argv, "multiframe_checkpoints.csv", &ck) < 0)
         return 1;
     tu_angled a;
     tu_angled_beam(&a, 90, 24, 24);

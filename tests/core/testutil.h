@@ -156,6 +156,15 @@ static inline int tu_csv_read(const char *path, tu_csv *c)
     return 0;
 }
 
+/* Read reference file `name` from the directory given as argv[1] (meson
+ * passes tests/reference), or from "." when absent. */
+static inline int tu_ref_read(int argc, char **argv, const char *name, tu_csv *c)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", argc > 1 ? argv[1] : ".", name);
+    return tu_csv_read(path, c);
+}
+
 static inline const char *tu_csv_get(const tu_csv *c, int row, const char *col)
 {
     for (int j = 0; j < c->cols; j++)
