@@ -1,0 +1,749 @@
+/*
+ * jobs.c — submission, bounded queue and worker pool of spinmodald.
+ *
+ * The store is the durable queue: a submission is committed there before
+ * the caller answers, and workers claim the oldest queued job from it
+ * (store_claim_next), so a restart or a second process sees the same
+ * queue.  This module keeps the in-memory half:
+ *   - `queued`, the number of queued jobs, for the 429 bound (initialised
+ *     from the store, +1 per accepted submission, -1 per claim or cancel);
+ *   - one slot per worker with the running job's id, live progress and its
+ *     cancel flag, read by the core's progress callback after every Newton
+ *     iteration and every speed (cancel, time limit, shutdown);
+ *   - a generation counter bumped whenever a job leaves queued/running, on
+ *     which jobs_wait sleeps (?wait=S).
+ * Locks: `lock` guards everything in struct jobs; `claim_lock` makes
+ * "claim a job in the store + publish it in a slot" atomic with respect to
+ * jobs_cancel, so a DELETE arriving between the two is never lost.  No store
+ * call is made while holding `lock`.
+ */
+#include "jobs.h"
+
+#include <errno.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "log.h"
+
+/* OpenBLAS: pin BLAS to one thread per worker (parallelism is across jobs).
+ * Weak, so a reference BLAS without the symbol links too. */
+extern void openblas_set_num_threads(int n) __attribute__((weak));
+
+#define JOBS_MAX_ATTEMPTS 3   /* claims before a job that keeps dying is failed */
+#define JOBS_IDLE_POLL 5.0    /* s between store polls of an idle worker */
+
+typedef struct jobs_slot {
+    char id[65];          /* running job, "" when idle */
+    int done, total;      /* speeds finished / requested */
+    int cancel;           /* 1: DELETE asked to stop */
+    int timed_out;        /* 1: the callback stopped it for the time limit */
+    double started;       /* log_now() at claim */
+} jobs_slot;
+
+typedef struct jobs_worker {
+    jobs *pool;
+    int index;
+    pthread_t thread;
+    int started;          /* 1 when pthread_create succeeded */
+} jobs_worker;
+
+struct jobs {
+    store *st;                 /* borrowed */
+    metrics *mx;               /* borrowed */
+    jobs_config cfg;
+    pthread_mutex_t lock;
+    pthread_mutex_t claim_lock;
+    pthread_cond_t work_cv;    /* workers: a job was queued, or stopping */
+    pthread_cond_t done_cv;    /* waiters: a job finished (gen changed), or stopping */
+    int queued;
+    int stopping;              /* no new submissions, workers leave their loop */
+    int stop_now;              /* running jobs stop and go back to the queue */
+    int alive, busy;
+    unsigned long long gen;
+    jobs_slot *slots;          /* cfg.workers */
+    jobs_worker *workers;      /* cfg.workers */
+};
+
+/* ---------------------------------------------------------------- helpers */
+
+/* Absolute CLOCK_REALTIME deadline seconds from now, for timed waits. */
+static struct timespec jobs_deadline(double seconds)
+{
+    struct timespec ts;
+    double frac;
+
+    clock_gettime(CLOCK_REALTIME, &ts);
+    if (seconds < 0)
+        seconds = 0;
+    if (seconds > 1e6)
+        seconds = 1e6;
+    frac = seconds - floor(seconds);
+    ts.tv_sec += (time_t)floor(seconds);
+    ts.tv_nsec += (long)(frac * 1e9);
+    if (ts.tv_nsec >= 1000000000L) {
+        ts.tv_sec++;
+        ts.tv_nsec -= 1000000000L;
+    }
+    return ts;
+}
+
+/* Monotonic seconds, for elapsed times. */
+static double jobs_clock(void)
+{
+    struct timespec ts;
+
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static jobs_slot *jobs_find_slot(jobs *j, const char *id)
+{
+    int i;
+
+    for (i = 0; i < j->cfg.workers; i++)
+        if (strcmp(j->slots[i].id, id) == 0)
+            return &j->slots[i];
+    return NULL;
+}
+
+/* Signal waiters that some job left queued/running. */
+static void jobs_bump(jobs *j)
+{
+    pthread_mutex_lock(&j->lock);
+    j->gen++;
+    pthread_cond_broadcast(&j->done_cv);
+    pthread_mutex_unlock(&j->lock);
+}
+
+static int jobs_map_store(int rc)
+{
+    switch (rc) {
+    case STORE_OK: return JOBS_OK;
+    case STORE_NOT_FOUND: return JOBS_NOT_FOUND;
+    case STORE_CONFLICT: return JOBS_CONFLICT;
+    case STORE_NOMEM: return JOBS_NOMEM;
+    default: return JOBS_STORE_ERROR;
+    }
+}
+
+int jobs_id(const codec_request *req, char id[65])
+{
+    char buf[64 + 1 + 64];
+    int n = snprintf(buf, sizeof(buf), "%s:%s", codec_request_sha256(req), sm_version());
+
+    if (n < 0 || (size_t)n >= sizeof(buf))
+        return JOBS_NOMEM;
+    return codec_sha256_hex(buf, (size_t)n, id) == SM_OK ? JOBS_OK : JOBS_NOMEM;
+}
+
+/* ------------------------------------------------------------ the error */
+
+/*
+ * The error object of a failed job as JSON text (malloc'd, or NULL when out
+ * of memory): {"type","title","detail"[,"errors"][,"diagnostics"]}.
+ * errors and diagnostics are stolen (may be NULL).
+ */
+static char *jobs_error_text(const char *type, const char *title, const char *detail,
+                             json_t *errors, json_t *diagnostics)
+{
+    json_t *e = json_object();
+    char *text = NULL;
+
+    if (!e)
+        goto done;
+    if (json_object_set_new(e, "type", json_string(type)) ||
+        json_object_set_new(e, "title", json_string(title)) ||
+        json_object_set_new(e, "detail", json_string(detail ? detail : "")))
+        goto done;
+    if (errors && json_object_set_new(e, "errors", json_incref(errors)))
+        goto done;
+    if (diagnostics && json_object_set_new(e, "diagnostics", json_incref(diagnostics)))
+        goto done;
+    text = json_dumps(e, JSON_COMPACT | JSON_REAL_PRECISION(17));
+done:
+    json_decref(errors);
+    json_decref(diagnostics);
+    json_decref(e);
+    return text;
+}
+
+/* Diagnostics of case c (no equilibrium). */
+static json_t *jobs_case_diag(const sm_case *c)
+{
+    return json_pack("{s:f, s:f, s:i, s:f, s:s}", "omega", c->omega, "last_omega",
+                     c->last_omega, "iterations", c->iterations, "residual",
+                     isfinite(c->residual) ? c->residual : -1.0, "message", c->message);
+}
+
+/* ---------------------------------------------------------------- a job */
+
+/* What a worker produced for one job, handed to store_finish. */
+typedef struct jobs_outcome_rec {
+    store_state state;       /* DONE, FAILED, CANCELED; QUEUED = requeue */
+    char *error;             /* JSON text or NULL */
+    char *result;            /* JSON text or NULL */
+    char *csv;               /* CSV text or NULL */
+    size_t csv_len;
+    int speeds_done;
+    double solve_seconds;    /* < 0 when no solve ran */
+} jobs_outcome_rec;
+
+/* Progress/cancel callback of sm_solve: user is the worker's slot index. */
+typedef struct jobs_cb_ctx {
+    jobs *pool;
+    jobs_slot *slot;
+    double t0;               /* jobs_clock() at the start of the job */
+} jobs_cb_ctx;
+
+static int jobs_progress_cb(void *user, int done, int total)
+{
+    jobs_cb_ctx *c = user;
+    int stop;
+
+    pthread_mutex_lock(&c->pool->lock);
+    c->slot->done = done;
+    c->slot->total = total;
+    if (jobs_clock() - c->t0 > c->pool->cfg.job_timeout)
+        c->slot->timed_out = 1;
+    stop = c->slot->cancel || c->slot->timed_out || c->pool->stop_now;
+    pthread_mutex_unlock(&c->pool->lock);
+    return stop;
+}
+
+/* Result (and CSV) of a solved request; fills rec (state DONE or FAILED). */
+static int jobs_encode(const codec_request *req, const sm_model *m, const sm_result *res,
+                       jobs_outcome_rec *rec)
+{
+    json_t *doc = NULL;
+    const sm_case *bad = NULL;
+    int i, n_bad = 0;
+    char detail[512];
+
+    if (codec_result_encode(&doc, req, m, res) != SM_OK)
+        return SM_NOMEM;
+    rec->result = json_dumps(doc, JSON_COMPACT | JSON_REAL_PRECISION(17));
+    json_decref(doc);
+    if (!rec->result || codec_result_csv(&rec->csv, &rec->csv_len, res) != SM_OK)
+        return SM_NOMEM;
+    for (i = 0; i < res->n_cases; i++)
+        if (res->cases[i].status == SM_CASE_NO_EQUILIBRIUM) {
+            if (!bad)
+                bad = &res->cases[i];
+            n_bad++;
+        }
+    rec->speeds_done = res->n_cases;
+    rec->state = STORE_DONE;
+    if (bad) {
+        snprintf(detail, sizeof(detail),
+                 "no dynamic equilibrium at %d of %d speeds, first at omega = %.6g rad/s "
+                 "(last speed reached %.6g rad/s): %s; the other speeds are in the result",
+                 n_bad, res->n_cases, bad->omega, bad->last_omega, bad->message);
+        rec->error = jobs_error_text("no_equilibrium", "No dynamic equilibrium", detail, NULL,
+                                     jobs_case_diag(bad));
+        if (!rec->error)
+            return SM_NOMEM;
+        rec->state = STORE_FAILED;
+    }
+    return SM_OK;
+}
+
+/* A failure before or inside the core: fills rec->state/error. */
+static void jobs_fail(jobs_outcome_rec *rec, const char *type, const char *title,
+                      const char *detail, json_t *errors)
+{
+    rec->state = STORE_FAILED;
+    rec->error = jobs_error_text(type, title, detail, errors, NULL);
+}
+
+/* Run the claimed job through codec and core; fills rec. */
+static void jobs_run(jobs *j, jobs_slot *slot, const store_job *job, jobs_outcome_rec *rec)
+{
+    codec_errors *errs = codec_errors_new();
+    codec_request *req = NULL;
+    sm_model *m = NULL;
+    sm_result *res = NULL;
+    sm_diag d;
+    jobs_cb_ctx ctx = {j, slot, jobs_clock()};
+    const double *speeds;
+    char detail[512];
+    int n, st;
+
+    rec->solve_seconds = -1;
+    if (!errs)
+        goto nomem;
+    st = codec_request_parse(&req, job->request ? job->request : "", job->request_len,
+                             &j->cfg.limits, errs);
+    if (st == SM_NOMEM)
+        goto nomem;
+    if (st != SM_OK) {
+        jobs_fail(rec, "invalid", "Stored request is no longer valid",
+                  "the request was accepted earlier but this spinmodald rejects it",
+                  codec_errors_to_json(errs));
+        goto done;
+    }
+    memset(&d, 0, sizeof(d));
+    st = codec_model_new(&m, req, errs, &d);
+    if (st == SM_NOMEM)
+        goto nomem;
+    if (st != SM_OK) {
+        snprintf(detail, sizeof(detail), "the model could not be built: %s", sm_strerror(st));
+        jobs_fail(rec, st == SM_INVALID_INPUT ? "invalid" : "solver_error",
+                  "Model construction failed", detail, codec_errors_to_json(errs));
+        goto done;
+    }
+    speeds = codec_request_speeds(req, &n);
+    memset(&d, 0, sizeof(d));
+    st = sm_solve(m, speeds, n, jobs_progress_cb, &ctx, &res, &d);
+    rec->solve_seconds = jobs_clock() - ctx.t0;
+    pthread_mutex_lock(&j->lock);
+    rec->speeds_done = slot->done;
+    pthread_mutex_unlock(&j->lock);
+    if (st == SM_CANCELED) {
+        pthread_mutex_lock(&j->lock);
+        if (slot->timed_out) {
+            pthread_mutex_unlock(&j->lock);
+            snprintf(detail, sizeof(detail),
+                     "the job ran longer than the limit of %g s (--job-timeout) and was "
+                     "stopped after %d of %d speeds",
+                     j->cfg.job_timeout, rec->speeds_done, n);
+            jobs_fail(rec, "timeout", "Job time limit exceeded", detail, NULL);
+        } else {
+            rec->state = slot->cancel ? STORE_CANCELED : STORE_QUEUED;
+            pthread_mutex_unlock(&j->lock);
+        }
+        goto done;
+    }
+    if (st == SM_NOMEM)
+        goto nomem;
+    if (st != SM_OK) {
+        snprintf(detail, sizeof(detail), "%s%s%s", sm_strerror(st), d.message[0] ? ": " : "",
+                 d.message);
+        if (st == SM_INVALID_INPUT)
+            codec_diag_error(req, &d, errs);
+        jobs_fail(rec, st == SM_INVALID_INPUT ? "invalid" : "solver_error", "Solver error",
+                  detail, codec_errors_count(errs) ? codec_errors_to_json(errs) : NULL);
+        goto done;
+    }
+    if (jobs_encode(req, m, res, rec) != SM_OK)
+        goto nomem;
+    goto done;
+nomem:
+    free(rec->result);
+    free(rec->csv);
+    free(rec->error);
+    rec->result = rec->csv = NULL;
+    rec->csv_len = 0;
+    jobs_fail(rec, "solver_error", "Out of memory", "the daemon ran out of memory running this job",
+              NULL);
+done:
+    sm_result_free(res);
+    sm_model_free(m);
+    codec_request_free(req);
+    codec_errors_free(errs);
+}
+
+/* Record rec in the store, count and log it. */
+static void jobs_record(jobs *j, const store_job *job, const jobs_outcome_rec *rec)
+{
+    char secs[32], speeds[32];
+    int rc;
+
+    snprintf(secs, sizeof(secs), "%.3f", rec->solve_seconds < 0 ? 0.0 : rec->solve_seconds);
+    snprintf(speeds, sizeof(speeds), "%d/%d", rec->speeds_done, job->speeds_total);
+    if (rec->state == STORE_QUEUED) {
+        rc = store_requeue(j->st, job->id);
+        if (rc == STORE_OK) {
+            pthread_mutex_lock(&j->lock);
+            j->queued++;
+            pthread_mutex_unlock(&j->lock);
+        }
+        log_event(rc == STORE_OK ? "info" : "error", "job_requeued", "job", job->id, "speeds",
+                  speeds, "reason", "shutdown", "store", rc == STORE_OK ? NULL : "failed",
+                  (char *)NULL);
+        return;
+    }
+    rc = store_finish(j->st, job->id, rec->state, log_now(), rec->speeds_done, rec->error,
+                      rec->result, rec->result ? strlen(rec->result) : 0, rec->csv, rec->csv_len);
+    if (rec->solve_seconds >= 0 && rec->state != STORE_CANCELED)
+        metrics_solve_seconds(j->mx, rec->solve_seconds);
+    metrics_job_finished(j->mx, rec->state);
+    log_event(rc == STORE_OK ? "info" : "error",
+              rec->state == STORE_DONE     ? "job_done"
+              : rec->state == STORE_FAILED ? "job_failed"
+                                           : "job_canceled",
+              "job", job->id, "state", store_state_name(rec->state), "speeds", speeds, "seconds",
+              secs, "attempts", NULL, "store", rc == STORE_OK ? NULL : "finish failed",
+              (char *)NULL);
+}
+
+/* --------------------------------------------------------------- workers */
+
+/* Claim the next job into slot; 1 when one was claimed. */
+static int jobs_claim(jobs *j, jobs_slot *slot, store_job *job)
+{
+    int rc;
+
+    pthread_mutex_lock(&j->claim_lock);
+    rc = store_claim_next(j->st, log_now(), job);
+    if (rc == STORE_OK) {
+        pthread_mutex_lock(&j->lock);
+        memcpy(slot->id, job->id, sizeof(slot->id));
+        slot->done = 0;
+        slot->total = job->speeds_total;
+        slot->cancel = job->cancel_requested;
+        slot->timed_out = 0;
+        slot->started = log_now();
+        if (j->queued > 0)
+            j->queued--;
+        j->busy++;
+        pthread_mutex_unlock(&j->lock);
+    }
+    pthread_mutex_unlock(&j->claim_lock);
+    if (rc != STORE_OK && rc != STORE_NOT_FOUND) {
+        log_event("error", "store_error", "op", "claim", (char *)NULL);
+        return -1;
+    }
+    return rc == STORE_OK;
+}
+
+/* Run (or refuse, after too many attempts) one claimed job. */
+static void jobs_handle(jobs *j, jobs_slot *slot, store_job *job)
+{
+    jobs_outcome_rec rec;
+    char attempts[16];
+
+    memset(&rec, 0, sizeof(rec));
+    snprintf(attempts, sizeof(attempts), "%d", job->attempts);
+    log_event("info", "job_started", "job", job->id, "attempts", attempts, (char *)NULL);
+    if (job->attempts > JOBS_MAX_ATTEMPTS) {
+        rec.solve_seconds = -1;
+        jobs_fail(&rec, "interrupted", "Job interrupted repeatedly",
+                  "the job was interrupted (crash or kill) every time it ran; it is not retried "
+                  "again — resubmit it to try once more",
+                  NULL);
+    } else {
+        jobs_run(j, slot, job, &rec);
+    }
+    jobs_record(j, job, &rec);
+    free(rec.error);
+    free(rec.result);
+    free(rec.csv);
+}
+
+static void *jobs_worker_main(void *arg)
+{
+    jobs_worker *w = arg;
+    jobs *j = w->pool;
+    jobs_slot *slot = &j->slots[w->index];
+    store_job job;
+    struct timespec until;
+    int got;
+
+    memset(&job, 0, sizeof(job));
+    for (;;) {
+        pthread_mutex_lock(&j->lock);
+        if (j->stopping) {
+            pthread_mutex_unlock(&j->lock);
+            break;
+        }
+        if (j->queued == 0) {
+            until = jobs_deadline(JOBS_IDLE_POLL);
+            pthread_cond_timedwait(&j->work_cv, &j->lock, &until);
+        }
+        if (j->stopping) {
+            pthread_mutex_unlock(&j->lock);
+            break;
+        }
+        pthread_mutex_unlock(&j->lock);
+        got = jobs_claim(j, slot, &job);
+        if (got < 0) {
+            until = jobs_deadline(1.0);
+            pthread_mutex_lock(&j->lock);
+            if (!j->stopping)
+                pthread_cond_timedwait(&j->work_cv, &j->lock, &until);
+            pthread_mutex_unlock(&j->lock);
+            continue;
+        }
+        if (got == 0) {
+            /* nothing to claim: resynchronise the count with the store so
+             * a stale count never makes the worker spin */
+            long long counts[STORE_N_STATES];
+            int ok = store_count(j->st, counts) == STORE_OK;
+            pthread_mutex_lock(&j->lock);
+            j->queued = ok ? (int)(counts[STORE_QUEUED] > 1000000000LL ? 1000000000LL
+                                                                      : counts[STORE_QUEUED])
+                           : 0;
+            pthread_mutex_unlock(&j->lock);
+            continue;
+        }
+        jobs_handle(j, slot, &job);
+        store_job_clear(&job);
+        pthread_mutex_lock(&j->lock);
+        slot->id[0] = '\0';
+        j->busy--;
+        j->gen++;
+        pthread_cond_broadcast(&j->done_cv);
+        pthread_mutex_unlock(&j->lock);
+    }
+    pthread_mutex_lock(&j->lock);
+    j->alive--;
+    pthread_cond_broadcast(&j->done_cv);
+    pthread_mutex_unlock(&j->lock);
+    return NULL;
+}
+
+/* ------------------------------------------------------------ lifecycle */
+
+static void jobs_free(jobs *j)
+{
+    if (!j)
+        return;
+    pthread_cond_destroy(&j->work_cv);
+    pthread_cond_destroy(&j->done_cv);
+    pthread_mutex_destroy(&j->claim_lock);
+    pthread_mutex_destroy(&j->lock);
+    free(j->slots);
+    free(j->workers);
+    free(j);
+}
+
+int jobs_start(jobs **out, store *st, metrics *mx, const jobs_config *cfg)
+{
+    long long counts[STORE_N_STATES];
+    jobs *j;
+    int i;
+
+    *out = NULL;
+    if (store_count(st, counts) != STORE_OK)
+        return JOBS_STORE_ERROR;
+    j = calloc(1, sizeof(*j));
+    if (!j)
+        return JOBS_NOMEM;
+    j->st = st;
+    j->mx = mx;
+    j->cfg = *cfg;
+    if (j->cfg.workers < 1)
+        j->cfg.workers = 1;
+    if (j->cfg.queue_max < 1)
+        j->cfg.queue_max = 1;
+    if (!(j->cfg.job_timeout > 0))
+        j->cfg.job_timeout = 300;
+    j->queued = (int)(counts[STORE_QUEUED] > 1000000000LL ? 1000000000LL : counts[STORE_QUEUED]);
+    j->slots = calloc((size_t)j->cfg.workers, sizeof(*j->slots));
+    j->workers = calloc((size_t)j->cfg.workers, sizeof(*j->workers));
+    if (!j->slots || !j->workers || pthread_mutex_init(&j->lock, NULL) ||
+        pthread_mutex_init(&j->claim_lock, NULL) || pthread_cond_init(&j->work_cv, NULL) ||
+        pthread_cond_init(&j->done_cv, NULL)) {
+        free(j->slots);
+        free(j->workers);
+        free(j);
+        return JOBS_NOMEM;
+    }
+    if (openblas_set_num_threads)
+        openblas_set_num_threads(1);
+    for (i = 0; i < j->cfg.workers; i++) {
+        j->workers[i].pool = j;
+        j->workers[i].index = i;
+        pthread_mutex_lock(&j->lock);
+        j->alive++;
+        pthread_mutex_unlock(&j->lock);
+        if (pthread_create(&j->workers[i].thread, NULL, jobs_worker_main, &j->workers[i])) {
+            pthread_mutex_lock(&j->lock);
+            j->alive--;
+            pthread_mutex_unlock(&j->lock);
+            jobs_stop(j, 0);
+            return JOBS_NOMEM;
+        }
+        j->workers[i].started = 1;
+    }
+    *out = j;
+    return JOBS_OK;
+}
+
+void jobs_stop(jobs *j, double grace)
+{
+    struct timespec until = jobs_deadline(grace);
+    int i;
+
+    if (!j)
+        return;
+    pthread_mutex_lock(&j->lock);
+    j->stopping = 1;
+    pthread_cond_broadcast(&j->work_cv);
+    pthread_cond_broadcast(&j->done_cv);
+    while (j->busy > 0) {
+        if (pthread_cond_timedwait(&j->done_cv, &j->lock, &until) == ETIMEDOUT)
+            break;
+    }
+    j->stop_now = 1;   /* jobs still running go back to the queue */
+    pthread_mutex_unlock(&j->lock);
+    for (i = 0; i < j->cfg.workers; i++)
+        if (j->workers[i].started)
+            pthread_join(j->workers[i].thread, NULL);
+    jobs_free(j);
+}
+
+int jobs_stopping(jobs *j)
+{
+    int s;
+
+    pthread_mutex_lock(&j->lock);
+    s = j->stopping;
+    pthread_mutex_unlock(&j->lock);
+    return s;
+}
+
+/* ------------------------------------------------------------ requests */
+
+int jobs_submit(jobs *j, const codec_request *req, jobs_outcome *outcome, store_job *job)
+{
+    char id[65];
+    int speeds, created = 0, rc;
+    store_job tmp;
+    store_job *jb = job ? job : &tmp;
+
+    memset(&tmp, 0, sizeof(tmp));
+    *outcome = JOBS_EXISTING;
+    if (jobs_stopping(j))
+        return JOBS_STOPPING;
+    if (jobs_id(req, id) != JOBS_OK)
+        return JOBS_NOMEM;
+    /* cache hit: a read, no write transaction */
+    rc = store_get(j->st, id, 0, jb);
+    if (rc == STORE_OK && jb->state != STORE_FAILED && jb->state != STORE_CANCELED) {
+        metrics_cache(j->mx, 1);
+        store_job_clear(&tmp);
+        return JOBS_OK;
+    }
+    store_job_clear(jb);
+    if (rc != STORE_OK && rc != STORE_NOT_FOUND)
+        return jobs_map_store(rc);
+    pthread_mutex_lock(&j->lock);
+    if (j->queued >= j->cfg.queue_max) {
+        pthread_mutex_unlock(&j->lock);
+        return JOBS_FULL;
+    }
+    j->queued++;   /* reserve the place before the write */
+    pthread_mutex_unlock(&j->lock);
+    codec_request_speeds(req, &speeds);
+    rc = store_submit(j->st, id, codec_request_canonical_text(req),
+                      strlen(codec_request_canonical_text(req)), speeds, log_now(), &created, jb);
+    pthread_mutex_lock(&j->lock);
+    if (rc != STORE_OK || created == 0)
+        j->queued--;   /* nothing new queued: give the place back */
+    else
+        pthread_cond_signal(&j->work_cv);
+    pthread_mutex_unlock(&j->lock);
+    store_job_clear(&tmp);
+    if (rc != STORE_OK)
+        return jobs_map_store(rc);
+    *outcome = created == 1 ? JOBS_CREATED : created == 2 ? JOBS_RESUBMITTED : JOBS_EXISTING;
+    metrics_cache(j->mx, created == 0);
+    if (created)
+        log_event("info", "job_queued", "job", id, "resubmitted", created == 2 ? "true" : NULL,
+                  (char *)NULL);
+    return JOBS_OK;
+}
+
+int jobs_cancel(jobs *j, const char *id, store_job *job)
+{
+    store_state state = STORE_QUEUED;
+    jobs_slot *slot;
+    int rc;
+
+    pthread_mutex_lock(&j->claim_lock);
+    rc = store_cancel(j->st, id, log_now(), &state);
+    if (rc == STORE_OK) {
+        pthread_mutex_lock(&j->lock);
+        if (state == STORE_CANCELED) {          /* was queued */
+            if (j->queued > 0)
+                j->queued--;
+        } else if ((slot = jobs_find_slot(j, id)) != NULL) {
+            slot->cancel = 1;                    /* the callback stops it */
+        }
+        pthread_mutex_unlock(&j->lock);
+    }
+    pthread_mutex_unlock(&j->claim_lock);
+    if (rc == STORE_OK && state == STORE_CANCELED) {
+        metrics_job_finished(j->mx, STORE_CANCELED);
+        log_event("info", "job_canceled", "job", id, "state", "queued", (char *)NULL);
+        jobs_bump(j);
+    }
+    if (job && (rc == STORE_OK || rc == STORE_CONFLICT)) {
+        int rc2 = jobs_get(j, id, 0, job);
+        if (rc2 != JOBS_OK)
+            return rc2;
+    }
+    return jobs_map_store(rc);
+}
+
+int jobs_get(jobs *j, const char *id, unsigned flags, store_job *out)
+{
+    jobs_slot *slot;
+    int rc = store_get(j->st, id, flags, out);
+
+    if (rc != STORE_OK)
+        return jobs_map_store(rc);
+    if (out->state == STORE_RUNNING) {
+        pthread_mutex_lock(&j->lock);
+        slot = jobs_find_slot(j, id);
+        if (slot) {
+            out->speeds_done = slot->done;
+            if (slot->cancel)
+                out->cancel_requested = 1;
+        }
+        pthread_mutex_unlock(&j->lock);
+    }
+    return JOBS_OK;
+}
+
+int jobs_wait(jobs *j, const char *id, double timeout)
+{
+    double end = jobs_clock() + (timeout > 0 ? timeout : 0);
+    unsigned long long gen;
+    struct timespec until;
+    store_job job;
+    store_state state;
+    int rc, stopping;
+
+    memset(&job, 0, sizeof(job));
+    for (;;) {
+        pthread_mutex_lock(&j->lock);
+        gen = j->gen;
+        stopping = j->stopping;
+        pthread_mutex_unlock(&j->lock);
+        if (stopping)
+            return JOBS_STOPPING;
+        rc = store_get(j->st, id, 0, &job);
+        state = job.state;
+        store_job_clear(&job);
+        if (rc != STORE_OK)
+            return jobs_map_store(rc);
+        if (state != STORE_QUEUED && state != STORE_RUNNING)
+            return JOBS_OK;
+        if (jobs_clock() >= end)
+            return JOBS_OK;
+        /* sleep until some job finishes, at most 1 s (another process may finish it) */
+        until = jobs_deadline(fmin(1.0, end - jobs_clock()));
+        pthread_mutex_lock(&j->lock);
+        while (j->gen == gen && !j->stopping) {
+            if (pthread_cond_timedwait(&j->done_cv, &j->lock, &until) == ETIMEDOUT)
+                break;
+        }
+        pthread_mutex_unlock(&j->lock);
+    }
+}
+
+void jobs_get_stats(jobs *j, jobs_stats *s)
+{
+    pthread_mutex_lock(&j->lock);
+    s->queued = j->queued;
+    s->workers = j->cfg.workers;
+    s->workers_alive = j->alive;
+    s->workers_busy = j->busy;
+    pthread_mutex_unlock(&j->lock);
+}
