@@ -532,6 +532,9 @@ int jobs_start(jobs **out, store *st, metrics *mx, const jobs_config *cfg)
         j->cfg.queue_max = 1;
     if (!(j->cfg.job_timeout > 0))
         j->cfg.job_timeout = 300;
+    /* A stored request was accepted once: its body limit does not apply to
+     * the canonical text (longer: defaults added, reals at 17 digits). */
+    j->cfg.limits.max_request_bytes = (size_t)-1;
     j->queued = (int)(counts[STORE_QUEUED] > 1000000000LL ? 1000000000LL : counts[STORE_QUEUED]);
     j->slots = calloc((size_t)j->cfg.workers, sizeof(*j->slots));
     j->workers = calloc((size_t)j->cfg.workers, sizeof(*j->workers));
