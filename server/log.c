@@ -34,14 +34,17 @@ void log_time(double t, char buf[32])
     time_t s = (time_t)t;
     int ms = (int)((t - (double)s) * 1000.0);
     struct tm tm;
+    char ymdhms[24];
+    size_t n;
 
     if (ms < 0)
         ms = 0;
     if (ms > 999)
         ms = 999;
     gmtime_r(&s, &tm);
-    snprintf(buf, 32, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900, tm.tm_mon + 1,
-             tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, ms);
+    n = strftime(ymdhms, sizeof(ymdhms), "%Y-%m-%dT%H:%M:%S", &tm);
+    ymdhms[n] = '\0';
+    snprintf(buf, 32, "%.20s.%03dZ", ymdhms, ms % 1000);
 }
 
 /* Append text to line (cap bytes), truncating. */
