@@ -19,9 +19,11 @@ required=(
   libmicrohttpd-dev libsqlite3-dev         # daemon (spinmodald)
   python3 python3-jsonschema               # schema validation tests
   curl ca-certificates                     # clients, end-to-end tests
+  nodejs npm chromium                      # web front end (clients/web) and its browser test (tests/web)
+  clang libclang-rt-14-dev                 # CI fuzz step: libFuzzer (only Recommended by clang)
 )
 # Optional: nice to have, a failure to install them is only a warning.
-optional=(valgrind)
+optional=(valgrind wrk)                    # wrk: tests/bench/bench_http.sh
 
 say() { printf 'install-deps: %s\n' "$*"; }
 
@@ -51,6 +53,8 @@ fi
 missing() {
   local p
   for p in "$@"; do
+    # npm also comes inside other nodejs builds (NodeSource's provides and conflicts with it)
+    if [ "$p" = npm ] && command -v npm >/dev/null 2>&1; then continue; fi
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed'; then
       printf '%s\n' "$p"
     fi

@@ -1,0 +1,549 @@
+/*
+ * main.c — spinmodald, the analysis daemon (server/DAEMON.md).
+ *
+ * How it fits: reads the flags (each with a SPINMODAL_* environment
+ * variable; the flag wins), reads the token file once, blocks SIGTERM and
+ * SIGINT in every thread (they are taken with sigwait here, after the
+ * start) and ignores SIGPIPE, then starts the modules in order
+ * store_open -> jobs_start -> http_start and logs `listening` with the
+ * bound address.  On SIGTERM/SIGINT: `stopping`, http_begin_stop (POST
+ * answers 503), jobs_stop (grace period), http_stop, store_close,
+ * `stopped`, exit 0.
+ *
+ * Exit status: 0 after a clean stop, 64 on a bad flag, 1 when it cannot
+ * start (token file, database, port).
+ */
+#include <errno.h>
+#include <getopt.h>
+#include <limits.h>
+#include <math.h>
+#include <pthread.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <microhttpd.h>
+#include <sqlite3.h>
+
+#include "codec.h"
+#include "http.h"
+#include "jobs.h"
+#include "log.h"
+#include "metrics.h"
+#include "spinmodal.h"
+#include "store.h"
+
+enum { EXIT_START = 1, EXIT_USAGE = 64 };
+
+#define MAIN_TOKEN_MAX 4096   /* bytes of a token file */
+
+/* The flags, in --help order. */
+enum {
+    F_LISTEN,
+    F_DB,
+    F_WORKERS,
+    F_QUEUE_MAX,
+    F_MAX_BODY,
+    F_MAX_ELEMENTS,
+    F_MAX_SPEEDS,
+    F_JOB_TIMEOUT,
+    F_TOKEN_FILE,
+    F_CORS_ORIGIN,
+    F_SHUTDOWN_GRACE,
+    F_LOG_FORMAT,
+    F_N
+};
+
+typedef struct main_flag {
+    const char *name;   /* without the leading -- */
+    const char *env;    /* environment variable */
+    const char *arg;    /* argument name in --help */
+    const char *def;    /* default in --help */
+    const char *help;   /* one line */
+} main_flag;
+
+static const main_flag main_flags[F_N] = {
+    {"listen", "SPINMODAL_LISTEN", "HOST:PORT", "127.0.0.1:8080",
+     "address to listen on; [IPv6]:PORT; port 0 = any free port"},
+    {"db", "SPINMODAL_DB", "PATH", "./spinmodal.db", "SQLite database of the jobs"},
+    {"workers", "SPINMODAL_WORKERS", "N", "online cores", "solver threads (1-1024)"},
+    {"queue-max", "SPINMODAL_QUEUE_MAX", "N", "1000", "queued jobs before POST answers 429"},
+    {"max-body", "SPINMODAL_MAX_BODY", "BYTES", "1048576", "largest request body (413 above)"},
+    {"max-elements", "SPINMODAL_MAX_ELEMENTS", "N", "2000", "most finite elements of a request"},
+    {"max-speeds", "SPINMODAL_MAX_SPEEDS", "N", "1001", "most speeds of a request"},
+    {"job-timeout", "SPINMODAL_JOB_TIMEOUT", "S", "300", "seconds of solving before a job fails"},
+    {"token-file", "SPINMODAL_TOKEN_FILE", "PATH", "none (no auth)",
+     "file holding the bearer token POST and DELETE need"},
+    {"cors-origin", "SPINMODAL_CORS_ORIGIN", "ORIGIN", "none",
+     "Access-Control-Allow-Origin for browsers"},
+    {"shutdown-grace", "SPINMODAL_SHUTDOWN_GRACE", "S", "10",
+     "seconds running jobs get to finish on SIGTERM"},
+    {"log-format", "SPINMODAL_LOG_FORMAT", "text|json", "text", "log lines on stderr"},
+};
+
+/* The effective settings. */
+typedef struct main_opts {
+    char host[256];          /* listen address, without brackets */
+    int port;                /* 0..65535 */
+    int ipv6;                /* host was given in [brackets] */
+    const char *db;
+    long workers, queue_max, max_body, max_elements, max_speeds;
+    double job_timeout;      /* s, > 0 */
+    double shutdown_grace;   /* s, >= 0 */
+    const char *token_file;  /* NULL = no auth */
+    const char *cors_origin; /* NULL = no CORS */
+    log_format format;
+} main_opts;
+
+/* The running daemon, for the stop. */
+typedef struct main_daemon {
+    store *st;
+    metrics *mx;
+    jobs *j;
+    http *h;
+} main_daemon;
+
+static void main_help(void)
+{
+    int i;
+
+    printf("spinmodald %s: HTTP daemon computing natural frequencies of spinning beam "
+           "structures\n\nusage: spinmodald [OPTION]...\n\noptions (each also read from the "
+           "environment variable shown; the option wins):\n",
+           SM_VERSION);
+    for (i = 0; i < F_N; i++)
+        printf("  --%s %s\n      %s\n      env %s, default %s\n", main_flags[i].name,
+               main_flags[i].arg, main_flags[i].help, main_flags[i].env, main_flags[i].def);
+    printf("  -h, --help       show this help\n"
+           "  -V, --version    show the versions\n\n"
+           "exit status: 0 after a clean stop (SIGTERM, SIGINT), 64 bad option,\n"
+           "1 cannot start (token file, database, port)\n");
+}
+
+static void main_version(void)
+{
+    printf("spinmodald %s (libspinmodal %s, libmicrohttpd %s, SQLite %s)\n", SM_VERSION,
+           sm_version(), MHD_get_version(), sqlite3_libversion());
+}
+
+/* ------------------------------------------------------------ values */
+
+/* Integer in [lo, hi]; 0 or -1. */
+static int main_long(const char *s, long lo, long hi, long *out)
+{
+    char *end;
+    long v;
+
+    errno = 0;
+    v = strtol(s, &end, 10);
+    if (errno || end == s || *end || v < lo || v > hi || s[0] == '+' || s[0] == ' ')
+        return -1;
+    *out = v;
+    return 0;
+}
+
+/* Number of seconds in [lo, hi]; 0 or -1. */
+static int main_seconds(const char *s, double lo, double hi, double *out)
+{
+    char *end;
+    double v;
+
+    errno = 0;
+    v = strtod(s, &end);
+    if (errno || end == s || *end || !isfinite(v) || v < lo || v > hi ||
+        strpbrk(s, "xXnNiI") != NULL)
+        return -1;
+    *out = v;
+    return 0;
+}
+
+/* HOST:PORT or [IPV6]:PORT into o; 0 or -1. */
+static int main_listen(const char *s, main_opts *o)
+{
+    const char *colon, *host = s;
+    size_t n;
+    long port;
+
+    o->ipv6 = 0;
+    if (s[0] == '[') {
+        const char *close = strchr(s, ']');
+        if (!close || close[1] != ':')
+            return -1;
+        host = s + 1;
+        n = (size_t)(close - host);
+        colon = close + 1;
+        o->ipv6 = 1;
+    } else {
+        colon = strrchr(s, ':');
+        if (!colon)
+            return -1;
+        n = (size_t)(colon - s);
+        if (memchr(s, ':', n)) /* a bare IPv6 address needs brackets */
+            return -1;
+    }
+    if (n == 0 || n >= sizeof(o->host) || main_long(colon + 1, 0, 65535, &port))
+        return -1;
+    memcpy(o->host, host, n);
+    o->host[n] = '\0';
+    o->port = (int)port;
+    return 0;
+}
+
+/* 1 when s is non-empty printable ASCII (safe in a header). */
+static int main_printable(const char *s)
+{
+    if (!*s)
+        return 0;
+    for (; *s; s++)
+        if (*s < 0x20 || *s > 0x7e)
+            return 0;
+    return 1;
+}
+
+/* Set flag f from value v; 0, or -1 with what a valid value is in *want. */
+static int main_set(main_opts *o, int f, const char *v, const char **want)
+{
+    switch (f) {
+    case F_LISTEN:
+        *want = "HOST:PORT (IPv4 or a name, or [IPv6]) with a port from 0 to 65535";
+        return main_listen(v, o);
+    case F_DB:
+        *want = "a file path";
+        o->db = v;
+        return *v ? 0 : -1;
+    case F_WORKERS:
+        *want = "an integer from 1 to 1024";
+        return main_long(v, 1, 1024, &o->workers);
+    case F_QUEUE_MAX:
+        *want = "an integer from 1 to 10000000";
+        return main_long(v, 1, 10000000, &o->queue_max);
+    case F_MAX_BODY:
+        *want = "a number of bytes from 1 to 1073741824";
+        return main_long(v, 1, 1073741824L, &o->max_body);
+    case F_MAX_ELEMENTS:
+        *want = "an integer from 1 to 1000000";
+        return main_long(v, 1, 1000000, &o->max_elements);
+    case F_MAX_SPEEDS:
+        *want = "an integer from 1 to 100000";
+        return main_long(v, 1, 100000, &o->max_speeds);
+    case F_JOB_TIMEOUT:
+        *want = "a number of seconds greater than 0 (at most 1000000)";
+        return main_seconds(v, 1e-3, 1e6, &o->job_timeout);
+    case F_TOKEN_FILE:
+        *want = "a file path";
+        o->token_file = v;
+        return *v ? 0 : -1;
+    case F_CORS_ORIGIN:
+        *want = "an origin such as https://example.org (printable ASCII)";
+        o->cors_origin = v;
+        return main_printable(v) ? 0 : -1;
+    case F_SHUTDOWN_GRACE:
+        *want = "a number of seconds from 0 to 3600";
+        return main_seconds(v, 0.0, 3600.0, &o->shutdown_grace);
+    default:
+        *want = "text or json";
+        if (strcmp(v, "text") && strcmp(v, "json"))
+            return -1;
+        o->format = strcmp(v, "json") == 0 ? LOG_JSON : LOG_TEXT;
+        return 0;
+    }
+}
+
+static void main_defaults(main_opts *o)
+{
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+
+    memset(o, 0, sizeof(*o));
+    strcpy(o->host, "127.0.0.1");
+    o->port = 8080;
+    o->db = "./spinmodal.db";
+    o->workers = cores < 1 ? 1 : cores > 1024 ? 1024 : cores;
+    o->queue_max = 1000;
+    o->max_body = 1048576;
+    o->max_elements = 2000;
+    o->max_speeds = 1001;
+    o->job_timeout = 300.0;
+    o->shutdown_grace = 10.0;
+    o->format = LOG_TEXT;
+}
+
+/* ------------------------------------------------------------ parsing */
+
+static int main_usage(const char *fmt, const char *a, const char *b)
+{
+    fprintf(stderr, "spinmodald: ");
+    fprintf(stderr, fmt, a, b);
+    fprintf(stderr, "\nTry 'spinmodald --help'.\n");
+    return EXIT_USAGE;
+}
+
+/*
+ * Collect the flags of argv into given[] (the last one wins); *action is
+ * 'h' or 'V' for --help/--version.  Returns 0 or EXIT_USAGE.
+ */
+static int main_scan(int argc, char **argv, const char *given[F_N], int *action)
+{
+    struct option longopts[F_N + 3];
+    int i, c;
+
+    for (i = 0; i < F_N; i++) {
+        longopts[i].name = main_flags[i].name;
+        longopts[i].has_arg = required_argument;
+        longopts[i].flag = NULL;
+        longopts[i].val = 256 + i;
+    }
+    longopts[F_N] = (struct option){"help", no_argument, NULL, 'h'};
+    longopts[F_N + 1] = (struct option){"version", no_argument, NULL, 'V'};
+    longopts[F_N + 2] = (struct option){NULL, 0, NULL, 0};
+    opterr = 0;
+    while ((c = getopt_long(argc, argv, ":hV", longopts, NULL)) != -1) {
+        if (c == 'h' || c == 'V') {
+            *action = c;
+            return 0;
+        }
+        if (c == ':')
+            return main_usage("option '%s' needs a value%s.", argv[optind - 1], "");
+        if (c == '?')
+            return main_usage("unknown option '%s'%s.", argv[optind - 1], "");
+        given[c - 256] = optarg;
+    }
+    if (optind < argc)
+        return main_usage("unexpected argument '%s'%s.", argv[optind], "");
+    return 0;
+}
+
+/* Parse argv and the environment into o.  Returns 0, EXIT_USAGE, or -1 after --help/--version. */
+static int main_parse(int argc, char **argv, main_opts *o)
+{
+    const char *given[F_N] = {NULL}, *v, *want;
+    char source[64];
+    int i, action = 0, rc;
+
+    main_defaults(o);
+    rc = main_scan(argc, argv, given, &action);
+    if (rc)
+        return rc;
+    if (action) {
+        if (action == 'h')
+            main_help();
+        else
+            main_version();
+        return -1;
+    }
+    for (i = 0; i < F_N; i++) {
+        v = given[i];
+        snprintf(source, sizeof(source), "--%s", main_flags[i].name);
+        if (!v) {
+            v = getenv(main_flags[i].env);
+            snprintf(source, sizeof(source), "%s", main_flags[i].env);
+        }
+        if (!v || (!given[i] && !*v)) /* an empty variable counts as unset */
+            continue;
+        if (main_set(o, i, v, &want)) {
+            fprintf(stderr, "spinmodald: %s needs %s, not '%s'.\nTry 'spinmodald --help'.\n",
+                    source, want, v);
+            return EXIT_USAGE;
+        }
+    }
+    return 0;
+}
+
+/*
+ * Read the token file once, trimmed, into *token (malloc'd).  Returns 0,
+ * or EXIT_START after printing why.
+ */
+static int main_token(const char *path, char **token)
+{
+    const char *why = NULL;
+    char *buf = NULL, *s;
+    size_t n, len;
+    FILE *f;
+
+    *token = NULL;
+    f = fopen(path, "rb");
+    if (!f) {
+        why = strerror(errno);
+        goto fail;
+    }
+    buf = malloc(MAIN_TOKEN_MAX + 1);
+    if (!buf) {
+        why = strerror(ENOMEM);
+        goto fail;
+    }
+    n = fread(buf, 1, MAIN_TOKEN_MAX + 1, f);
+    if (ferror(f))
+        why = strerror(errno ? errno : EIO);
+    else if (n > MAIN_TOKEN_MAX)
+        why = "it is larger than 4096 bytes";
+    else if (memchr(buf, '\0', n))
+        why = "it holds a NUL byte";
+    if (why)
+        goto fail;
+    fclose(f);
+    f = NULL;
+    buf[n] = '\0';
+    for (s = buf; *s && strchr(" \t\r\n", *s); s++)
+        ;
+    len = strlen(s);
+    while (len > 0 && strchr(" \t\r\n", s[len - 1]))
+        s[--len] = '\0';
+    if (len == 0) {
+        why = "it is empty";
+        goto fail;
+    }
+    memmove(buf, s, len + 1);
+    *token = buf;
+    return 0;
+fail:
+    if (f)
+        fclose(f);
+    free(buf);
+    fprintf(stderr, "spinmodald: cannot use the token file '%s': %s.\n", path, why);
+    return EXIT_START;
+}
+
+/* ------------------------------------------------------------ running */
+
+/* "HOST:PORT" or "[HOST]:PORT" of the bound address into buf. */
+static void main_addr(const main_opts *o, int port, char *buf, size_t cap)
+{
+    if (o->ipv6 || strchr(o->host, ':'))
+        snprintf(buf, cap, "[%s]:%d", o->host, port);
+    else
+        snprintf(buf, cap, "%s:%d", o->host, port);
+}
+
+static void main_fail(const char *what, const char *detail)
+{
+    log_event("error", "start_failed", "error", what, "detail", detail, (const char *)NULL);
+}
+
+/* Open the store and the metrics; 0 or EXIT_START. */
+static int main_open(const main_opts *o, main_daemon *d)
+{
+    char err[512], n[32];
+    int requeued = 0;
+
+    err[0] = '\0';
+    if (store_open(&d->st, o->db, &requeued, err, sizeof(err)) != STORE_OK) {
+        main_fail("cannot open the database", err[0] ? err : o->db);
+        return EXIT_START;
+    }
+    snprintf(n, sizeof(n), "%d", requeued);
+    log_event("info", "recovered", "jobs", n, "db", o->db, (const char *)NULL);
+    d->mx = metrics_new();
+    if (!d->mx) {
+        main_fail("out of memory", NULL);
+        return EXIT_START;
+    }
+    return 0;
+}
+
+/* Start the pool and the HTTP server; 0 or EXIT_START. */
+static int main_serve(const main_opts *o, const char *token, main_daemon *d)
+{
+    jobs_config jc;
+    http_config hc;
+    char addr[300], workers[16];
+    int rc;
+
+    http_default_config(&hc);
+    hc.host = o->host;
+    hc.port = o->port;
+    hc.max_body = (size_t)o->max_body;
+    hc.limits.max_request_bytes = (size_t)o->max_body;
+    hc.limits.max_elements = (int)o->max_elements;
+    hc.limits.max_speeds = (int)o->max_speeds;
+    hc.token = token;
+    hc.cors_origin = o->cors_origin;
+    jc.workers = (int)o->workers;
+    jc.queue_max = (int)o->queue_max;
+    jc.job_timeout = o->job_timeout;
+    jc.limits = hc.limits;
+    rc = jobs_start(&d->j, d->st, d->mx, &jc);
+    if (rc != JOBS_OK) {
+        main_fail("cannot start the workers",
+                  rc == JOBS_NOMEM ? "out of memory" : "the database failed");
+        return EXIT_START;
+    }
+    main_addr(o, o->port, addr, sizeof(addr));
+    rc = http_start(&d->h, &hc, d->j, d->st, d->mx);
+    if (rc != HTTP_OK) {
+        main_fail(rc == HTTP_ADDRESS ? "cannot resolve the listen address"
+                  : rc == HTTP_NOMEM ? "out of memory"
+                                     : "cannot listen (address in use or not permitted)",
+                  addr);
+        return EXIT_START;
+    }
+    main_addr(o, http_port(d->h), addr, sizeof(addr));
+    snprintf(workers, sizeof(workers), "%ld", o->workers);
+    log_event("info", "listening", "addr", addr, "workers", workers, "version", SM_VERSION,
+              (const char *)NULL);
+    return 0;
+}
+
+/* Stop in DAEMON.md order; safe on a partly started daemon. */
+static void main_stop(main_daemon *d, double grace)
+{
+    http_begin_stop(d->h);
+    jobs_stop(d->j, grace);
+    d->j = NULL;
+    http_stop(d->h);
+    d->h = NULL;
+    store_close(d->st);
+    d->st = NULL;
+    metrics_free(d->mx);
+    d->mx = NULL;
+}
+
+/* Block SIGTERM/SIGINT in this and every later thread, ignore SIGPIPE; 0 or -1. */
+static int main_signals(sigset_t *set)
+{
+    struct sigaction sa;
+
+    memset(&sa, 0, sizeof(sa));
+    sa.sa_handler = SIG_IGN;
+    sigemptyset(&sa.sa_mask);
+    if (sigemptyset(set) || sigaddset(set, SIGTERM) || sigaddset(set, SIGINT) ||
+        pthread_sigmask(SIG_BLOCK, set, NULL) || sigaction(SIGPIPE, &sa, NULL))
+        return -1;
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    main_daemon d = {NULL, NULL, NULL, NULL};
+    main_opts o;
+    char *token = NULL;
+    sigset_t set;
+    int rc, sig = 0;
+
+    rc = main_parse(argc, argv, &o);
+    if (rc)
+        return rc < 0 ? 0 : rc;
+    log_init(o.format, 1);
+    if (o.token_file && main_token(o.token_file, &token))
+        return EXIT_START;
+    if (main_signals(&set)) {
+        fprintf(stderr, "spinmodald: cannot set up the signals: %s.\n", strerror(errno));
+        free(token);
+        return EXIT_START;
+    }
+    rc = main_open(&o, &d);
+    if (!rc)
+        rc = main_serve(&o, token, &d);
+    free(token);
+    if (rc) {
+        main_stop(&d, 0.0);
+        return rc;
+    }
+    while (sigwait(&set, &sig) != 0)
+        ;
+    log_event("info", "stopping", "signal", sig == SIGINT ? "SIGINT" : "SIGTERM",
+              (const char *)NULL);
+    main_stop(&d, o.shutdown_grace);
+    log_event("info", "stopped", (const char *)NULL);
+    return 0;
+}
