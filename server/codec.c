@@ -452,7 +452,8 @@ static int int_value(const json_t *x, long lo, long hi, long *out)
     if (!json_is_real(x))
         return 0;
     d = json_real_value(x);
-    if (!isfinite(d) || d != floor(d) || d < (double)lo || d > (double)hi)
+    if (!isfinite(d) || d != floor(d) || d < (double)lo || d > (double)hi ||
+        d >= -(double)LONG_MIN) /* (long)d overflows from 2^63 on */
         return 0;
     *out = (long)d;
     return 1;
@@ -1419,6 +1420,9 @@ int codec_request_parse(codec_request **out, const char *text, size_t len,
     root = json_loadb(text, len, JSON_REJECT_DUPLICATES, &jerr);
     if (!root) {
         errs->malformed = 1;
+        for (size_t k = 0; jerr.text[k]; k++) /* jansson's "near '...'" may cut a UTF-8 char */
+            if ((unsigned char)jerr.text[k] >= 0x80)
+                jerr.text[k] = '?';
         if (json_error_code(&jerr) == json_error_out_of_memory)
             return SM_NOMEM;
         if (codec_errors_add(errs, "", "not valid JSON: %s (line %d, column %d)", jerr.text,
