@@ -3,12 +3,18 @@
  *
  * How it fits: libmicrohttpd runs one thread per connection and calls
  * http_handler in three phases (libmicrohttpd's simplepost.c shape):
- *   1. headers received: *req_cls is NULL; allocate the request context,
- *      route it and answer at once every request except a POST that passed
- *      its header checks (auth, ?wait, Content-Type, Content-Length);
- *   2. body data: append to the context's buffer, capped at --max-body;
- *   3. body complete (*upload_data_size == 0): validate with the codec,
- *      submit to the job pool, optionally wait, answer.
+ *   1. headers received: *req_cls is NULL; allocate the request context
+ *      and route it.  Only refusals of a body are answered here (401, 400
+ *      ?wait, 415, 413 by Content-Length, or any answer to a non-POST that
+ *      carries a body): libmicrohttpd then closes the connection without
+ *      reading the body.  Everything else waits for phase 3 so the
+ *      connection stays alive;
+ *   2. body data of POST /v1/analyses and /v1/validate: appended to the
+ *      context's buffer, capped at --max-body (over it: 413 at once, see
+ *      http_early_too_large);
+ *   3. request complete (*upload_data_size == 0): answer GET/HEAD/DELETE/
+ *      OPTIONS, or validate the POST body with the codec, submit it to the
+ *      job pool, optionally wait, answer.
  * http_completed (MHD_OPTION_NOTIFY_COMPLETED) counts the response in the
  * metrics, logs the `request` line and frees the context.
  *
@@ -16,8 +22,8 @@
  * word, a hex id or a timestamp) and the stored error and result texts are
  * spliced in verbatim, so a GET of a finished job costs one store read and
  * one copy.  Bodies are handed to libmicrohttpd with a free callback (no
- * second copy).  Any allocation failure answers 503 + Retry-After; if even
- * that cannot be built, a static 503 is sent.
+ * second copy).  Any allocation or store failure answers 503 +
+ * Retry-After; if even that cannot be built, a static 503 is sent.
  *
  * Stop: http_begin_stop sets `stopping` and waits until no thread is
  * inside a jobs_* call (calls are bracketed by http_enter/http_leave and
@@ -26,8 +32,10 @@
  */
 #include "http.h"
 
+#include <errno.h>
 #include <limits.h>
 #include <netdb.h>
+#include <poll.h>
 #include <pthread.h>
 #include <stdarg.h>
 #include <stdint.h>
@@ -48,8 +56,6 @@
 #define HTTP_LIST_DEFAULT 20       /* ?limit= default */
 #define HTTP_LIST_MAX 100          /* ?limit= maximum */
 #define HTTP_BODY_CHUNK 65536      /* first body allocation when Content-Length is unknown */
-#define HTTP_DRAIN_MAX ((size_t)64 << 20) /* bytes of an oversized chunked body dropped
-                                             before the connection is closed */
 #define HTTP_RETRY_BUSY "5"        /* Retry-After of 429 and of 503 while stopping */
 #define HTTP_RETRY_FAULT "1"       /* Retry-After of 503 for store/memory failures */
 #define HTTP_PROBLEMS "https://spinmodal.dev/problems/"
@@ -113,9 +119,10 @@ typedef struct http_req {
     double wait;             /* ?wait= of a POST, s */
     char *body;              /* POST body received so far (malloc'd) */
     size_t len, cap;         /* bytes in body, bytes allocated */
-    size_t received;         /* body bytes received, dropped ones included */
+    size_t announced;        /* Content-Length of a POST, 0 = none */
     int body_state;          /* BODY_* */
     int collect;             /* a POST whose body is read (phase 2) */
+    int raw_answer;          /* answered on the socket by http_early_too_large */
 } http_req;
 
 /* A response header. */
@@ -245,6 +252,22 @@ static void http_buf_put(http_buf *b, const char *s, size_t n)
     memcpy(b->p + b->len, s, n);
     b->len += n;
     b->p[b->len] = '\0';
+}
+
+/* Make room for n more bytes at once (large spliced results); nomem is sticky. */
+static void http_buf_reserve(http_buf *b, size_t n)
+{
+    char *np;
+
+    if (b->nomem || b->len + n + 1 <= b->cap)
+        return;
+    np = realloc(b->p, b->len + n + 1);
+    if (!np) {
+        b->nomem = 1;
+        return;
+    }
+    b->p = np;
+    b->cap = b->len + n + 1;
 }
 
 static void http_buf_puts(http_buf *b, const char *s)
@@ -482,6 +505,8 @@ static enum MHD_Result http_not_found(struct MHD_Connection *c, http_req *r, int
 /* The value of Allow for a route's methods. */
 static const char *http_allow(const http *h, unsigned methods)
 {
+    if ((methods & M_POST) && (methods & M_DELETE))
+        return "GET, HEAD, POST, DELETE";
     if (methods == M_POST)
         return h->cors_origin ? "POST, OPTIONS" : "POST";
     if (methods & M_POST)
@@ -567,21 +592,21 @@ static int http_unfinished(const store_job *jb)
 static int http_job_wait(http *h, const char *id, double wait, unsigned flags, store_job *out)
 {
     double end = http_mono() + wait, left;
-    int rc = http_job_read(h, id, wait > 0.0 ? 0u : flags, out);
+    int rc = http_job_read(h, id, wait > 0.0 ? 0u : flags, out), wrc;
 
     if (rc != JOBS_OK || wait <= 0.0)
         return rc;
     while (http_unfinished(out) && (left = end - http_mono()) > 0.0) {
         if (http_enter(h))
             break;
-        rc = jobs_wait(h->j, id, left < HTTP_WAIT_SLICE ? left : HTTP_WAIT_SLICE);
+        wrc = jobs_wait(h->j, id, left < HTTP_WAIT_SLICE ? left : HTTP_WAIT_SLICE);
         http_leave(h);
-        if (rc == JOBS_STOPPING)
-            break;
         store_job_clear(out);
         rc = http_job_read(h, id, 0, out);
         if (rc != JOBS_OK)
             return rc;
+        if (wrc != JOBS_OK) /* stopping, or the store failed: answer what we have */
+            break;
     }
     if (flags && out->has_result) {
         store_job_clear(out);
@@ -609,6 +634,8 @@ static enum MHD_Result http_send_status(struct MHD_Connection *c, http_req *r, i
     http_hdr loc = {MHD_HTTP_HEADER_LOCATION, location};
 
     snprintf(location, sizeof(location), "/v1/analyses/%s", jb->id);
+    http_buf_reserve(&b, 1024 + (jb->result ? jb->result_len : 0) +
+                             (jb->error ? strlen(jb->error) : 0));
     http_buf_status(&b, jb, 1);
     return http_respond_buf(c, r, status, "application/json", &b, &loc,
                             status == MHD_HTTP_ACCEPTED ? 1 : 0);
@@ -894,15 +921,116 @@ static int http_is_json(const char *ct)
     return *p == '\0';
 }
 
-/* 413 for a body over --max-body. */
-static enum MHD_Result http_too_large(struct MHD_Connection *c, http_req *r)
+/* The problem document of a body over --max-body; NULL when out of memory. */
+static json_t *http_too_large_doc(const http *h)
 {
     char detail[96];
 
     snprintf(detail, sizeof(detail), "The request body is larger than the limit of %zu bytes.",
-             r->h->max_body);
-    return http_problem(c, r, MHD_HTTP_CONTENT_TOO_LARGE, NULL, "Content Too Large", detail,
-                        NULL, 0);
+             h->max_body);
+    return codec_problem_new(MHD_HTTP_CONTENT_TOO_LARGE, NULL, "Content Too Large", detail,
+                             NULL);
+}
+
+/* 413 for a body over --max-body. */
+static enum MHD_Result http_too_large(struct MHD_Connection *c, http_req *r)
+{
+    return http_respond_problem(c, r, MHD_HTTP_CONTENT_TOO_LARGE, http_too_large_doc(r->h),
+                                NULL, 0);
+}
+
+/* Send n bytes at p on fd (non-blocking), waiting up to 1 s at a time; 0 or -1. */
+static int http_raw_send(int fd, const char *p, size_t n)
+{
+    struct pollfd pfd = {fd, POLLOUT, 0};
+    ssize_t k;
+
+    while (n > 0) {
+        k = send(fd, p, n, MSG_NOSIGNAL);
+        if (k > 0) {
+            p += k;
+            n -= (size_t)k;
+        } else if (k < 0 && (errno == EAGAIN || errno == EWOULDBLOCK || errno == EINTR)) {
+            if (poll(&pfd, 1, 1000) <= 0)
+                return -1;
+        } else {
+            return -1;
+        }
+    }
+    return 0;
+}
+
+/* Read and drop what the client still sends, until it closes, 2 s or 16 MiB. */
+static void http_raw_drain(int fd)
+{
+    struct pollfd pfd = {fd, POLLIN, 0};
+    double end = http_mono() + 2.0;
+    size_t total = 0;
+    char sink[16384];
+    ssize_t k;
+
+    while (total < ((size_t)16 << 20) && http_mono() < end) {
+        if (poll(&pfd, 1, 100) < 0 && errno != EINTR)
+            return;
+        if (!(pfd.revents & (POLLIN | POLLHUP | POLLERR)))
+            continue;
+        k = recv(fd, sink, sizeof(sink), 0);
+        if (k == 0 || (k < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR))
+            return;
+        if (k > 0)
+            total += (size_t)k;
+    }
+}
+
+/*
+ * 413 for a body without Content-Length that went over --max-body while it
+ * arrives.  libmicrohttpd 0.9.75 refuses MHD_queue_response while it hands
+ * over body data (later versions accept it: tried first), so the answer is
+ * written on the socket here, from this connection's own thread with
+ * nothing else of it in flight; the sending side is then shut, the
+ * client's remaining bytes drained briefly (so the close does not reset
+ * the answer away), and MHD_NO has libmicrohttpd close the connection.
+ */
+static enum MHD_Result http_early_too_large(struct MHD_Connection *c, http_req *r)
+{
+    const union MHD_ConnectionInfo *ci;
+    http_buf b = {0};
+    char *body = NULL;
+    json_t *doc;
+    size_t len;
+
+    if (http_too_large(c, r) == MHD_YES && r->status)
+        return MHD_YES;
+    ci = MHD_get_connection_info(c, MHD_CONNECTION_INFO_CONNECTION_FD);
+    doc = http_too_large_doc(r->h);
+    if (doc)
+        body = json_dumps(doc, JSON_COMPACT);
+    json_decref(doc);
+    if (!ci || !body) {
+        free(body);
+        return MHD_NO;
+    }
+    len = strlen(body);
+    http_buf_printf(&b, "HTTP/1.1 413 %s\r\nConnection: close\r\nContent-Type: "
+                        "application/problem+json\r\nContent-Length: %zu\r\n",
+                    MHD_get_reason_phrase_for(MHD_HTTP_CONTENT_TOO_LARGE), len);
+    if (r->h->cors_origin) {
+        http_buf_puts(&b, "Access-Control-Allow-Origin: ");
+        http_buf_puts(&b, r->h->cors_origin);
+        http_buf_puts(&b, "\r\n");
+    }
+    http_buf_puts(&b, "\r\n");
+    http_buf_put(&b, body, len);
+    if (!b.nomem && http_raw_send(ci->connect_fd, b.p, b.len) == 0) {
+        r->status = MHD_HTTP_CONTENT_TOO_LARGE;
+        r->bytes = len;
+        r->raw_answer = 1;
+        shutdown(ci->connect_fd, SHUT_WR);
+        http_raw_drain(ci->connect_fd);
+    }
+    free(b.p);
+    free(body);
+    return MHD_NO;
 }
 
 /*
@@ -939,10 +1067,7 @@ static int http_post_begin(struct MHD_Connection *c, http_req *r, enum MHD_Resul
         *q = http_unavailable(c, r, "stopping");
         return 0;
     }
-    if (cl && n > 0) { /* one allocation for the announced body */
-        r->body = malloc((size_t)n);
-        r->cap = r->body ? (size_t)n : 0;
-    }
+    r->announced = cl ? (size_t)n : 0;
     return 1;
 }
 
@@ -952,7 +1077,6 @@ static void http_take_body(http_req *r, const char *data, size_t n)
     size_t need;
     char *nb;
 
-    r->received = r->received + n < r->received ? SIZE_MAX : r->received + n;
     if (r->body_state != BODY_OK)
         return;
     need = r->len + n;
@@ -966,6 +1090,8 @@ static void http_take_body(http_req *r, const char *data, size_t n)
             ncap = need;
         if (ncap > r->h->max_body)
             ncap = r->h->max_body;
+        if (r->announced >= need && ncap > r->announced)
+            ncap = r->announced; /* memory follows the bytes received, up to Content-Length */
         nb = realloc(r->body, ncap);
         if (!nb) {
             r->body_state = BODY_NOMEM;
@@ -998,6 +1124,8 @@ static enum MHD_Result http_submit(struct MHD_Connection *c, http_req *r,
     memset(&jb, 0, sizeof(jb));
     rc = jobs_submit(r->h->j, req, &outcome, &jb);
     http_leave(r->h);
+    if (rc != JOBS_OK)
+        store_job_clear(&jb);
     if (rc == JOBS_FULL)
         return http_problem(c, r, MHD_HTTP_TOO_MANY_REQUESTS, "queue-full", "Too Many Requests",
                             "The queue of analyses is full; retry later.", &retry, 1);
@@ -1036,6 +1164,31 @@ static enum MHD_Result http_validated(struct MHD_Connection *c, http_req *r,
     return http_respond_buf(c, r, MHD_HTTP_OK, "application/json", &b, NULL, 0);
 }
 
+/*
+ * Topology checks of the core (cycles, disconnected members …) that the
+ * codec alone does not see: build the model and drop it.  Skipped for a
+ * POST of a job the store already holds (it passed them when submitted).
+ * Returns an sm_status; errs is filled on failure.
+ */
+static int http_check_model(http_req *r, const codec_request *req, codec_errors *errs)
+{
+    sm_model *m = NULL;
+    store_job jb;
+    char id[65];
+    int st, known = 0;
+
+    memset(&jb, 0, sizeof(jb));
+    if (r->route == R_ANALYSES && jobs_id(req, id) == JOBS_OK &&
+        http_job_read(r->h, id, 0, &jb) == JOBS_OK)
+        known = jb.state != STORE_FAILED && jb.state != STORE_CANCELED;
+    store_job_clear(&jb);
+    if (known)
+        return SM_OK;
+    st = codec_model_new(&m, req, errs, NULL);
+    sm_model_free(m);
+    return st;
+}
+
 /* The whole body of a POST is in: validate, then submit or describe, answer. */
 static enum MHD_Result http_post_end(struct MHD_Connection *c, http_req *r)
 {
@@ -1054,11 +1207,13 @@ static enum MHD_Result http_post_end(struct MHD_Connection *c, http_req *r)
     rc = codec_request_parse(&req, r->body ? r->body : "", r->len, &r->h->limits, errs);
     free(r->body);
     r->body = NULL;
+    if (rc == SM_OK)
+        rc = http_check_model(r, req, errs);
     if (rc == SM_OK && r->route == R_VALIDATE)
         q = http_validated(c, r, req);
     else if (rc == SM_OK)
         q = http_submit(c, r, req);
-    else if (rc == SM_INVALID_INPUT)
+    else if (rc != SM_NOMEM && codec_errors_count(errs) > 0)
         q = http_respond_problem(c, r, codec_errors_http_status(errs),
                                  codec_problem_from_errors(errs), NULL, 0);
     else
@@ -1246,6 +1401,8 @@ static enum MHD_Result http_answer(struct MHD_Connection *c, http_req *r)
 
     if (r->method == M_OPTIONS && r->h->cors_origin)
         return http_preflight(c, r);
+    if (r->method == M_OPTIONS && strcmp(r->path, "*") == 0)
+        return http_not_allowed(c, r, M_GET | M_HEAD | M_POST | M_DELETE);
     if (r->route == R_OTHER)
         return http_not_found(c, r, 0);
     if (!(allowed & r->method))
@@ -1324,8 +1481,9 @@ static enum MHD_Result http_handler(void *cls, struct MHD_Connection *c, const c
         if (r->collect)
             http_take_body(r, upload, *upload_size);
         *upload_size = 0;
-        /* an endless oversized chunked body: give up on the connection */
-        return r->received > h->max_body + HTTP_DRAIN_MAX ? MHD_NO : MHD_YES;
+        if (r->body_state == BODY_TOO_LARGE)
+            return http_early_too_large(c, r);
+        return MHD_YES;
     }
     return r->collect ? http_post_end(c, r) : http_answer(c, r);
 }
@@ -1366,6 +1524,8 @@ static void http_completed(void *cls, struct MHD_Connection *c, void **req_cls,
     snprintf(status, sizeof(status), "%d", r->status);
     snprintf(ms, sizeof(ms), "%.1f", (http_mono() - r->t0) * 1000.0);
     snprintf(bytes, sizeof(bytes), "%zu", r->bytes);
+    if (r->raw_answer)
+        toe = MHD_REQUEST_TERMINATED_COMPLETED_OK; /* our own close after the answer */
     log_event("info", "request", "method", r->method_name, "path", r->path, "status", status,
               "ms", ms, "bytes", bytes, "job", r->id[0] ? r->id : NULL, "error",
               (unsigned)toe < sizeof(toe_names) / sizeof(toe_names[0]) ? toe_names[toe]

@@ -2,11 +2,11 @@
  * main.c — spinmodald, the analysis daemon (server/DAEMON.md).
  *
  * How it fits: reads the flags (each with a SPINMODAL_* environment
- * variable; the flag wins), reads the token file once, blocks SIGTERM and
- * SIGINT in every thread (they are taken with sigwait here, after the
- * start) and ignores SIGPIPE, then starts the modules in order
- * store_open -> jobs_start -> http_start and logs `listening` with the
- * bound address.  On SIGTERM/SIGINT: `stopping`, http_begin_stop (POST
+ * variable; the flag wins), reads the token file once, turns SIGTERM and
+ * SIGINT into a byte on a self-pipe (blocked in the threads it starts,
+ * main reads the pipe after the start) and ignores SIGPIPE, then starts
+ * the modules in order store_open -> jobs_start -> http_start and logs
+ * `listening` with the bound address.  On SIGTERM/SIGINT: `stopping`, http_begin_stop (POST
  * answers 503), jobs_stop (grace period), http_stop, store_close,
  * `stopped`, exit 0.
  *
@@ -14,6 +14,7 @@
  * start (token file, database, port).
  */
 #include <errno.h>
+#include <fcntl.h>
 #include <getopt.h>
 #include <limits.h>
 #include <math.h>
@@ -271,11 +272,10 @@ static void main_defaults(main_opts *o)
 
 /* ------------------------------------------------------------ parsing */
 
-static int main_usage(const char *fmt, const char *a, const char *b)
+/* "spinmodald: <before>'<arg>'<after>." and a hint; returns EXIT_USAGE. */
+static int main_usage(const char *before, const char *arg, const char *after)
 {
-    fprintf(stderr, "spinmodald: ");
-    fprintf(stderr, fmt, a, b);
-    fprintf(stderr, "\nTry 'spinmodald --help'.\n");
+    fprintf(stderr, "spinmodald: %s'%s'%s.\nTry 'spinmodald --help'.\n", before, arg, after);
     return EXIT_USAGE;
 }
 
@@ -304,13 +304,13 @@ static int main_scan(int argc, char **argv, const char *given[F_N], int *action)
             return 0;
         }
         if (c == ':')
-            return main_usage("option '%s' needs a value%s.", argv[optind - 1], "");
+            return main_usage("option ", argv[optind - 1], " needs a value");
         if (c == '?')
-            return main_usage("unknown option '%s'%s.", argv[optind - 1], "");
+            return main_usage("unknown option ", argv[optind - 1], "");
         given[c - 256] = optarg;
     }
     if (optind < argc)
-        return main_usage("unexpected argument '%s'%s.", argv[optind], "");
+        return main_usage("unexpected argument ", argv[optind], "");
     return 0;
 }
 
@@ -498,27 +498,87 @@ static void main_stop(main_daemon *d, double grace)
     d->mx = NULL;
 }
 
-/* Block SIGTERM/SIGINT in this and every later thread, ignore SIGPIPE; 0 or -1. */
-static int main_signals(sigset_t *set)
+/*
+ * Write end of the self-pipe.  The one global of the daemon: a signal
+ * handler gets no argument.  Set before the handlers are installed.
+ */
+static volatile sig_atomic_t main_signal_fd = -1;
+
+/* SIGTERM/SIGINT: one byte (the signal number) into the self-pipe. */
+static void main_on_signal(int sig)
+{
+    int saved = errno;
+    unsigned char b = (unsigned char)sig;
+    ssize_t n;
+
+    if (main_signal_fd >= 0) {
+        n = write(main_signal_fd, &b, 1);
+        (void)n; /* a full pipe already holds a stop request */
+    }
+    errno = saved;
+}
+
+/*
+ * Signals: SIGTERM/SIGINT write to the self-pipe fds (the handler works in
+ * whichever thread takes them, the BLAS library's own threads started
+ * before main included), and are blocked in this thread so the threads
+ * started next inherit the block (main unblocks them once it waits on the
+ * pipe); SIGPIPE is ignored.  0 or -1.
+ */
+static int main_signals(int fds[2], sigset_t *set)
 {
     struct sigaction sa;
 
+    if (pipe(fds))
+        return -1;
+    if (fcntl(fds[0], F_SETFD, FD_CLOEXEC) || fcntl(fds[1], F_SETFD, FD_CLOEXEC) ||
+        fcntl(fds[1], F_SETFL, O_NONBLOCK))
+        return -1;
+    main_signal_fd = fds[1];
     memset(&sa, 0, sizeof(sa));
     sa.sa_handler = SIG_IGN;
     sigemptyset(&sa.sa_mask);
+    if (sigaction(SIGPIPE, &sa, NULL))
+        return -1;
+    sa.sa_handler = main_on_signal;
+    sa.sa_flags = SA_RESTART;
     if (sigemptyset(set) || sigaddset(set, SIGTERM) || sigaddset(set, SIGINT) ||
-        pthread_sigmask(SIG_BLOCK, set, NULL) || sigaction(SIGPIPE, &sa, NULL))
+        sigaddset(&sa.sa_mask, SIGTERM) || sigaddset(&sa.sa_mask, SIGINT) ||
+        sigaction(SIGTERM, &sa, NULL) || sigaction(SIGINT, &sa, NULL) ||
+        pthread_sigmask(SIG_BLOCK, set, NULL))
         return -1;
     return 0;
+}
+
+/* Wait for SIGTERM/SIGINT (a byte on the self-pipe); returns the signal. */
+static int main_wait_signal(int fd, const sigset_t *set)
+{
+    unsigned char b = 0;
+    ssize_t n;
+
+    pthread_sigmask(SIG_UNBLOCK, set, NULL);
+    do
+        n = read(fd, &b, 1);
+    while (n < 0 && errno == EINTR);
+    return n == 1 ? (int)b : SIGTERM;
+}
+
+static void main_close_pipe(int fds[2])
+{
+    main_signal_fd = -1;
+    if (fds[0] >= 0)
+        close(fds[0]);
+    if (fds[1] >= 0)
+        close(fds[1]);
 }
 
 int main(int argc, char **argv)
 {
     main_daemon d = {NULL, NULL, NULL, NULL};
-    main_opts o;
+    int rc, sig, fds[2] = {-1, -1};
     char *token = NULL;
+    main_opts o;
     sigset_t set;
-    int rc, sig = 0;
 
     rc = main_parse(argc, argv, &o);
     if (rc)
@@ -526,8 +586,9 @@ int main(int argc, char **argv)
     log_init(o.format, 1);
     if (o.token_file && main_token(o.token_file, &token))
         return EXIT_START;
-    if (main_signals(&set)) {
+    if (main_signals(fds, &set)) {
         fprintf(stderr, "spinmodald: cannot set up the signals: %s.\n", strerror(errno));
+        main_close_pipe(fds);
         free(token);
         return EXIT_START;
     }
@@ -537,13 +598,14 @@ int main(int argc, char **argv)
     free(token);
     if (rc) {
         main_stop(&d, 0.0);
+        main_close_pipe(fds);
         return rc;
     }
-    while (sigwait(&set, &sig) != 0)
-        ;
+    sig = main_wait_signal(fds[0], &set);
     log_event("info", "stopping", "signal", sig == SIGINT ? "SIGINT" : "SIGTERM",
               (const char *)NULL);
     main_stop(&d, o.shutdown_grace);
     log_event("info", "stopped", (const char *)NULL);
+    main_close_pipe(fds);
     return 0;
 }
