@@ -144,7 +144,8 @@ async function run() {
   const browser = await chromium.launch({
     executablePath: CHROMIUM,
     headless: true,
-    args: ['--headless', '--no-sandbox', '--disable-background-networking'],
+    args: ['--headless', '--no-sandbox', '--disable-background-networking',
+           '--disable-dev-shm-usage', '--disable-gpu'],  // small /dev/shm in containers
   });
   const context = await browser.newContext({viewport: {width: 1440, height: 900}, acceptDownloads: true});
   const page = await context.newPage();
