@@ -64,7 +64,7 @@ static int eig_inertia(int n, double *A)
 static int eig_definite(int n, const double *A, double *L, int *chol)
 {
     memcpy(L, A, (size_t)n * n * sizeof(double));
-    *chol = n == 0 || LAPACKE_dpotrf(LAPACK_COL_MAJOR, 'L', n, L, n) == 0;
+    *chol = n == 0 || LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', n, L, n) == 0;
     if (*chol)
         return 0;
     memcpy(L, A, (size_t)n * n * sizeof(double));
@@ -165,10 +165,10 @@ static int eig_condense(int n, const dmat *M, const dmat *K, eig_split *sp)
         sp->neg_zz = eig_definite(z, Kzz, Lzz, &chol);
         rc = SM_SINGULAR;
         if (chol) {
-            LAPACKE_dpotrs(LAPACK_COL_MAJOR, 'L', z, r, Lzz, z, sp->S, z);
+            LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'L', z, r, Lzz, z, sp->S, z);
         } else {
             int *ip = malloc((size_t)z * sizeof(int));
-            int bad = !ip || LAPACKE_dgesv(LAPACK_COL_MAJOR, z, r, Kzz, z, ip, sp->S, z) != 0;
+            int bad = !ip || LAPACKE_dgesv_work(LAPACK_COL_MAJOR, z, r, Kzz, z, ip, sp->S, z) != 0;
             free(ip);
             if (bad)
                 goto done;
@@ -347,7 +347,7 @@ static int eig_gyro_general(int n, const eig_split *sp, const double *Cy, int k,
             T[(size_t)j * r + i] = sp->Kr[(size_t)j * r + i];
             T[(size_t)(r + j) * r + i] = Cy[(size_t)j * r + i];
         }
-    LAPACKE_dpotrs(LAPACK_COL_MAJOR, 'U', r, N2, sp->U, r, T, r);
+    LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'U', r, N2, sp->U, r, T, r);
     for (int i = 0; i < r; i++) {
         A[(size_t)(r + i) * N2 + i] = 1.0;
         for (int j = 0; j < N2; j++)

@@ -107,7 +107,7 @@ static int eq_tangent(const sm_model *m, const double *q, double s, eq_ws *w)
     lin_elastic_add(m, &w->Kt);
     if (m->opt.geometric_stiffening)
         lin_geometric_tangent(m, q, 0, &w->Kt, w->work);
-    return LAPACKE_dgetrf(LAPACK_COL_MAJOR, n, n, w->Kt.a, n, w->ipiv) == 0 ? SM_OK : SM_SINGULAR;
+    return LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, n, n, w->Kt.a, n, w->ipiv) == 0 ? SM_OK : SM_SINGULAR;
 }
 
 /* Sign of det(Kt) from its LU factors: a change between two converged
@@ -155,7 +155,7 @@ static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progre
             return 0;
         for (int i = 0; i < n; i++)
             w->dq[i] = -w->F[i];
-        LAPACKE_dgetrs(LAPACK_COL_MAJOR, 'N', n, 1, w->Kt.a, n, w->ipiv, w->dq, n);
+        LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', n, 1, w->Kt.a, n, w->ipiv, w->dq, n);
         double step = dm_norm(w->dq, n), alpha = 1.0, rt = 0;
         /* damped step: halve while the residual grows */
         for (int tries = 0; tries < 8; tries++) {
@@ -220,7 +220,7 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
         memcpy(w.qp, q, (size_t)n * sizeof(double));
         if (have_lu) {
             memcpy(w.dq, w.g, (size_t)n * sizeof(double));
-            LAPACKE_dgetrs(LAPACK_COL_MAJOR, 'N', n, 1, w.Kt.a, n, w.ipiv, w.dq, n);
+            LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', n, 1, w.Kt.a, n, w.ipiv, w.dq, n);
             for (int i = 0; i < n; i++)
                 w.qp[i] += (sn - s) * w.dq[i];
         }

@@ -18,6 +18,7 @@
  */
 #include "internal.h"
 
+#include <cblas.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -34,7 +35,8 @@ int frames_kin_alloc(const sm_model *m, sm_kin *k)
     k->wp = dm_vec(2 * (size_t)m->n_mp);
     k->fext = dm_vec(2 * (size_t)m->n_nodes);
     if (!k->theta || !k->R || !k->rn || !k->wn || !k->rp || !k->wp || !k->fext ||
-        dm_alloc(&k->Jth, m->n, m->n_subs) || dm_alloc(&k->JR, m->n, 2 * m->n_subs) ||
+        dm_alloc(&k->Jth, m->n, m->n_subs) || dm_alloc(&k->Jtha, m->n, m->n_subs) ||
+        dm_alloc(&k->JR, m->n, 2 * m->n_subs) ||
         dm_alloc(&k->Jn, m->n, 3 * m->n_nodes) || dm_alloc(&k->Jp, m->n, 2 * m->n_mp)) {
         frames_kin_free(k);
         return SM_NOMEM;
@@ -52,6 +54,7 @@ void frames_kin_free(sm_kin *k)
     free(k->wp);
     free(k->fext);
     dm_free(&k->Jth);
+    dm_free(&k->Jtha);
     dm_free(&k->JR);
     dm_free(&k->Jn);
     dm_free(&k->Jp);
@@ -228,16 +231,22 @@ void frames_hessian(const sm_model *m, const double *q, const sm_kin *k, dmat *H
             F[2 * b->root + 1] += Ft[1];
         }
         const double *jt = &DM(&k->Jth, 0, s);
+        double *jta = &DM(&k->Jtha, 0, s);
+        /* column s of Jth is zero from row q0 on: theta_s depends on its ancestors only */
+        for (int j = 0; j < q0; j++)
+            jta[j] = a * jt[j];
+        memset(jta + q0, 0, (size_t)(m->n - q0) * sizeof(double));
         for (int j = 0; j < q0; j++) {
             if (jt[j] == 0.0)
                 continue;
-            double aj = a * jt[j];
-            for (int i = 0; i < q0; i++)
-                DM(H, i, j) += aj * jt[i];
             for (int i = 0; i < mm; i++) {
                 DM(H, q0 + i, j) += gs[i] * jt[j];
                 DM(H, j, q0 + i) += gs[i] * jt[j];
             }
         }
     }
+    /* H += sum_s a_s Jth_s Jth_s' = Jtha Jth' (one BLAS-3 call instead of n_subs rank-1 updates) */
+    if (m->n > 0 && m->n_subs > 0)
+        cblas_dgemm(CblasColMajor, CblasNoTrans, CblasTrans, m->n, m->n, m->n_subs, 1.0, k->Jtha.a,
+                    m->n, k->Jth.a, m->n, 1.0, H->a, m->n);
 }

@@ -112,6 +112,7 @@ typedef struct sm_kin {
     double *rp;         /* 2*n_mp: mass point positions */
     double *wp;         /* 2*n_mp: local deformed positions of mass points */
     double *fext;       /* 2*n_nodes: scratch for the Hessian recursion */
+    dmat Jtha;          /* n x n_subs: scratch, column s = a_s (d theta_s/dq)' (Hessian) */
     dmat Jp;            /* n x (2*n_mp): columns = (d r_p/dq)' */
 } sm_kin;
 
