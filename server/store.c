@@ -922,13 +922,27 @@ static int no_change_status(store_conn *c, const char *id)
     return status == STORE_OK ? STORE_CONFLICT : status;
 }
 
+/* Run the bound update st of the writer's open transaction on job id and end
+ * the transaction: committed when a row changed; else rolled back with
+ * STORE_NOT_FOUND or STORE_CONFLICT (no_change_status). */
+static int writer_update_one(store *s, store_conn *c, sqlite3_stmt *st, const char *id)
+{
+    int changes = 0, status = conn_update(c, st, &changes);
+
+    if (status != STORE_OK)
+        return writer_end(s, status, 0);
+    if (changes == 0)
+        return writer_end(s, no_change_status(c, id), 0);
+    return writer_end(s, STORE_OK, 1);
+}
+
 int store_finish(store *s, const char *id, store_state state, double now, int speeds_done,
                  const char *error, const char *result, size_t result_len,
                  const char *csv, size_t csv_len)
 {
     store_conn *c = NULL;
     sqlite3_stmt *st;
-    int rc, status, changes = 0;
+    int rc, status;
 
     if (id == NULL)
         return STORE_NOT_FOUND;
@@ -951,19 +965,14 @@ int store_finish(store *s, const char *id, store_state state, double now, int sp
         stmt_done(st);
         return writer_end(s, store_rc_of(rc), 0);
     }
-    status = conn_update(c, st, &changes);
-    if (status != STORE_OK)
-        return writer_end(s, status, 0);
-    if (changes == 0)
-        return writer_end(s, no_change_status(c, id), 0);
-    return writer_end(s, STORE_OK, 1);
+    return writer_update_one(s, c, st, id);
 }
 
 int store_requeue(store *s, const char *id)
 {
     store_conn *c = NULL;
     sqlite3_stmt *st;
-    int rc, status, changes = 0;
+    int rc, status;
 
     if (id == NULL)
         return STORE_NOT_FOUND;
@@ -977,12 +986,7 @@ int store_requeue(store *s, const char *id)
         stmt_done(st);
         return writer_end(s, store_rc_of(rc), 0);
     }
-    status = conn_update(c, st, &changes);
-    if (status != STORE_OK)
-        return writer_end(s, status, 0);
-    if (changes == 0)
-        return writer_end(s, no_change_status(c, id), 0);
-    return writer_end(s, STORE_OK, 1);
+    return writer_update_one(s, c, st, id);
 }
 
 int store_cancel(store *s, const char *id, double now, store_state *state)
