@@ -207,6 +207,12 @@ typedef enum sm_case_status {
     SM_CASE_NO_EQUILIBRIUM    /* continuation/Newton failed: see diagnostics */
 } sm_case_status;
 
+/* Inside a frame the kinematics are linear (small rotations).  An
+ * equilibrium whose nodes turn more than this relative to their own frame is
+ * reported with a warning: its numbers describe the model, not the structure
+ * (use more frames). */
+#define SM_FRAME_ROTATION_LIMIT 1.0
+
 /** Result of one speed.  Arrays are owned by the sm_result. */
 typedef struct sm_case {
     double omega;             /* rad/s */
@@ -221,6 +227,8 @@ typedef struct sm_case {
     double *nodes;            /* 3*n_nodes: deformed x, y and rotation phi (rad) */
     int n_elements;
     double *axial_force;      /* n_elements: P_e, N (eq. 24) */
+    double max_frame_rotation; /* rad: largest rotation of a node relative to its own frame */
+    char warning[256];        /* "" or why the state is outside the model's validity (still reported) */
     /* stability */
     int stable;
     int negative_eigenvalues; /* of K* */

@@ -196,6 +196,29 @@ static int sweep_equilibrium_out(const sm_model *m, const double *q, const sm_ki
         return SM_NOMEM;
     memcpy(c->nodes, k->rn, 3 * (size_t)m->n_nodes * sizeof(double));
     lin_axial_forces(m, q, c->axial_force);
+    /* rotation of each node relative to its frame: the phi rows of N q_s */
+    double rot = 0;
+    int at = -1;
+    for (int s = 0; s < m->n_subs; s++) {
+        const sm_sub *b = &m->subs[s];
+        for (int i = 0; i < b->nfree; i++) {
+            double p = 0;
+            for (int j = 0; j < b->m; j++)
+                p += DM(&b->N, 3 * i + 2, j) * q[b->q0 + j];
+            if (fabs(p) > rot) {
+                rot = fabs(p);
+                at = b->free_nodes[i];
+            }
+        }
+    }
+    c->max_frame_rotation = rot;
+    c->warning[0] = '\0';
+    if (c->converged && rot > SM_FRAME_ROTATION_LIMIT)
+        snprintf(c->warning, sizeof c->warning,
+                 "FE node %d turns %.2f rad relative to its frame (limit %.1f rad for the linear kinematics "
+                 "inside a frame): the steady state and frequencies are those of the model, not of the "
+                 "structure; use more frames",
+                 at, rot, SM_FRAME_ROTATION_LIMIT);
     return SM_OK;
 }
 

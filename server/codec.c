@@ -1743,6 +1743,9 @@ static json_t *enc_equilibrium(const codec_request *r, const sm_model *m, const 
     if (c->axial_force && c->n_elements > 0 &&
         json_object_set_new(e, "axial_force", jreals(c->axial_force, c->n_elements)))
         goto fail;
+    if (c->nodes && c->n_nodes > 0 &&
+        json_object_set_new(e, "max_frame_rotation", jreal(c->max_frame_rotation)))
+        goto fail;
     return e;
 fail:
     json_decref(joints);
@@ -1807,6 +1810,9 @@ static json_t *enc_case(const codec_request *r, const sm_model *m, const sm_case
     for (k = 0; k < c->n_modes; k++)
         if (json_array_append_new(modes, enc_mode(c, k, r->opt.mode_shapes)))
             goto fail;
+    if (c->warning[0] &&
+        json_object_set_new(o, "warnings", json_pack("[s]", c->warning)))
+        goto fail;
     if (c->status != SM_CASE_SOLVED &&
         json_object_set_new(o, "diagnostics",
                             json_pack("{s:i, s:o, s:o, s:s}", "iterations", c->iterations,

@@ -39,8 +39,22 @@ int main(int argc, char **argv)
             int tip = sm_model_joint_node(m, 2);
             double dx = r->cases[0].nodes[3 * tip] - tu_csv_num(&ex, i, "tip_X1");
             TU_CHECK(dx > 1.0, "single frame drifts outward at 10 rad/s: tip error %.3f m", dx);
+            /* and says so: its nodes turn far beyond the small-rotation range of a frame */
+            TU_CHECK(r->cases[0].status == SM_CASE_SOLVED && r->cases[0].max_frame_rotation > 2.0 &&
+                         strstr(r->cases[0].warning, "relative to its frame"),
+                     "single frame at 10 rad/s: warning (max frame rotation %.3f rad) '%s'",
+                     r->cases[0].max_frame_rotation, r->cases[0].warning);
             printf("single frame at 10 rad/s: free end %.3f m outside the exact one\n", dx);
         }
+    sm_result_free(r);
+    sm_model_free(m);
+    /* per-element frames at 20 rad/s stay well inside it: no warning */
+    o.frames = SM_FRAMES_PER_ELEMENT;
+    r = tu_solve1(&a.st, &o, 20.0, &m);
+    TU_CHECK(r && r->cases[0].status == SM_CASE_SOLVED && !r->cases[0].warning[0] &&
+                 r->cases[0].max_frame_rotation > 0 && r->cases[0].max_frame_rotation < 0.2,
+             "per-element frames at 20 rad/s: no warning (max frame rotation %.3f rad)",
+             r ? r->cases[0].max_frame_rotation : -1.0);
     sm_result_free(r);
     sm_model_free(m);
     tu_csv_free(&ex);

@@ -343,6 +343,8 @@ async function run() {
     ok(st3[0] === 'failed' && st3[1] === 'no_equilibrium', 'single frame: job failed with no_equilibrium', JSON.stringify(st3));
     const notes = await page.textContent('#case-notes');
     ok(/20 rad\/s: no_equilibrium/.test(notes), 'speeds without equilibrium are reported', notes.slice(0, 200));
+    ok(/Warning at \d+ speeds \(Ω = 8…18 rad\/s\): FE node \d+ turns [\d.]+ rad relative to its frame/.test(notes),
+      'speeds outside the small-rotation range of a frame carry the warning', notes.slice(0, 400));
     const solvedRows = await page.locator('#freq-table tbody td:text-is("solved")').count();
     ok(solvedRows >= 5 && solvedRows < 11, 'the other speeds are still shown', String(solvedRows));
     await shot(page, '04-no-equilibrium.png');

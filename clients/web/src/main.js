@@ -560,6 +560,16 @@ function showResult(id, request, result) {
       (typeof d.last_omega === 'number' ? ` (last speed reached ${sig(d.last_omega)} rad/s)` : '');
     notes.append(p);
   }
+  // warnings (outside the model's validity): one note for all the speeds that carry one
+  const warned = cases.filter((c) => Array.isArray(c.warnings) && c.warnings.length > 0);
+  if (warned.length) {
+    const om = warned.map((c) => c.omega);
+    const p = document.createElement('p');
+    p.className = 'note warning';
+    p.textContent = `Warning at ${warned.length === 1 ? `Ω = ${sig(om[0])} rad/s` :
+      `${warned.length} speeds (Ω = ${sig(Math.min(...om))}…${sig(Math.max(...om))} rad/s)`}: ${warned[0].warnings[0]}`;
+    notes.append(p);
+  }
 
   // speed selector: request order, default the highest speed that has modes
   const sel = $('mode-speed');
