@@ -185,5 +185,24 @@ int main(void)
     dm_free(&C);
     dm_free(&K);
     blocks();
+    /* a nearly free coordinate (w1^2 / w2^2 ~ 1e-16, below the 1e-14 the S'S
+     * route accepts): the zheevr fallback answers */
+    dm_alloc(&M, 2, 2);
+    dm_alloc(&C, 2, 2);
+    dm_alloc(&K, 2, 2);
+    DM(&M, 0, 0) = DM(&M, 1, 1) = 1;
+    DM(&K, 0, 0) = 1e-16;
+    DM(&K, 1, 1) = 1.0;
+    DM(&C, 0, 1) = -0.5;
+    DM(&C, 1, 0) = 0.5;
+    roots(1e-16, 1.0, 0.5, &w1, &w2);
+    w1 = 1e-8 / w2; /* the small root without cancellation: w1 w2 = sqrt(k1 k2) */
+    TU_CHECK(eig_solve(2, &M, &C, &K, 1, 2, &e) == SM_OK && e.n_modes == 2, "eig_solve, nearly free coordinate");
+    TU_NEAR(e.wim[0], w1, 1e-6 * w1, "nearly free coordinate: w1");
+    TU_NEAR(e.wim[1], w2, 1e-12, "nearly free coordinate: w2");
+    eig_out_free(&e);
+    dm_free(&M);
+    dm_free(&C);
+    dm_free(&K);
     return tu_finish("eigen");
 }
