@@ -196,15 +196,13 @@ static int sweep_equilibrium_out(const sm_model *m, const double *q, const sm_ki
         return SM_NOMEM;
     memcpy(c->nodes, k->rn, 3 * (size_t)m->n_nodes * sizeof(double));
     lin_axial_forces(m, q, c->axial_force);
-    /* rotation of each node relative to its frame: the phi rows of N q_s */
+    /* rotation of each node relative to its frame: phi_k - (theta_s - theta0_s) */
     double rot = 0;
     int at = -1;
     for (int s = 0; s < m->n_subs; s++) {
         const sm_sub *b = &m->subs[s];
         for (int i = 0; i < b->nfree; i++) {
-            double p = 0;
-            for (int j = 0; j < b->m; j++)
-                p += DM(&b->N, 3 * i + 2, j) * q[b->q0 + j];
+            double p = k->rn[3 * b->free_nodes[i] + 2] - (k->theta[s] - b->theta0);
             if (fabs(p) > rot) {
                 rot = fabs(p);
                 at = b->free_nodes[i];
