@@ -1,5 +1,5 @@
 /*
- * codec_test.c — data-driven tests of the JSON codec (server/codec.c).
+ * codec_test.c — data-driven tests of the JSON codec (server/codec/).
  *
  * Usage: codec_test CASES_DIR
  *

@@ -206,7 +206,7 @@ def t_schemas():
         missing = [m for m in missing if "/then/" not in m and "/if/" not in m]
         check(not missing, "%s schema: title and description on every property %s" % (name, missing[:10] or ""))
 
-    # defaults in the request schema are the codec's (server/codec.c)
+    # defaults in the request schema are the codec's (server/codec/)
     an = C.request["$defs"]["analysis"]["properties"]
     want = {"modes": 3, "geometric_stiffening": True, "coriolis": True, "mass": "lumped",
             "substructure_modes": "augmented", "modes_per_frame": "all", "mode_shapes": True}

@@ -1,5 +1,5 @@
 /*
- * fuzz_codec.c — fuzz target for the request codec (server/codec.c).
+ * fuzz_codec.c — fuzz target for the request codec (server/codec/).
  *
  * How it fits: libFuzzer (clang -fsanitize=fuzzer, target fuzz_codec) or
  * main.c (the replay driver, any compiler, target fuzz_codec_replay) hands

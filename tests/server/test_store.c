@@ -1,5 +1,5 @@
 /*
- * test_store.c — behaviour of the SQLite job store (server/store.h) on a
+ * test_store.c — behaviour of the SQLite job store (server/daemon/store.h) on a
  * real database file in a mkdtemp directory: schema version and WAL on a
  * fresh open, submission outcomes, claim order, finish with large texts
  * read back byte-exactly, cancel and requeue in every state, newest-first

@@ -1,7 +1,7 @@
 /*
  * embedded.h — files served verbatim by spinmodald, embedded at build time.
  *
- * server/embed.py turns files of the source tree (the JSON files of schemas/, the `/`
+ * server/daemon/embed.py turns files of the source tree (the JSON files of schemas/, the `/`
  * page, later the web front end) into a generated embedded.c with one
  * table entry per URL path.  Only these paths are ever served from "files":
  * nothing is read from disk at run time, so no request path can reach
