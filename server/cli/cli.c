@@ -2,8 +2,9 @@
  * cli.c — the one-shot `spinmodal` command line tool.
  *
  * How it fits: reads one request (DESIGN.md section 3) from a file or stdin,
- * validates it with the codec, builds the core model, solves every speed and
- * prints the result document (section 4) or the CSV frequency table on
+ * validates it with the codec, runs it through the codec's pipeline
+ * (codec_run: model, solve, documents; the daemon's workers call the same)
+ * and prints the result document (section 4) or the CSV frequency table on
  * stdout.  Errors in the request are reported as an RFC 9457 problem
  * document on stderr, exactly as the daemon would send them.
  *
@@ -152,76 +153,47 @@ static int cli_fail(const char *what, int status)
     return CLI_FAILED;
 }
 
-/* Print the result (JSON or CSV); returns an exit code. */
-static int cli_output(const cli_args *a, const codec_request *req, const sm_model *m,
-                      const sm_result *res)
+/* Print the documents of a run (JSON or CSV); returns an exit code. */
+static int cli_output(const cli_args *a, const codec_run_out *out)
 {
-    json_t *doc = NULL;
-    char *csv = NULL;
-    size_t len = 0;
-    int i, rc = CLI_OK;
+    int rc = CLI_OK;
 
     if (a->csv) {
-        if (codec_result_csv(&csv, &len, res))
-            return cli_fail("CSV encoding", SM_NOMEM);
-        if (fwrite(csv, 1, len, stdout) != len || fflush(stdout))
+        if (fwrite(out->csv, 1, out->csv_len, stdout) != out->csv_len || fflush(stdout))
             rc = CLI_FAILED;
-        free(csv);
-    } else {
-        if (codec_result_encode(&doc, req, m, res))
-            return cli_fail("result encoding", SM_NOMEM);
-        if (cli_print_json(stdout, doc, a->pretty))
-            rc = CLI_FAILED;
-        json_decref(doc);
+    } else if (cli_print_json(stdout, out->result, a->pretty)) {
+        rc = CLI_FAILED;
     }
     if (rc == CLI_FAILED) {
         fprintf(stderr, "spinmodal: cannot write the result: %s\n", strerror(errno));
         return rc;
     }
-    for (i = 0; i < res->n_cases; i++)
-        if (res->cases[i].status == SM_CASE_NO_EQUILIBRIUM)
-            rc = CLI_NO_EQUILIBRIUM;
-    return rc;
+    return out->outcome == CODEC_RUN_PARTIAL ? CLI_NO_EQUILIBRIUM : CLI_OK;
 }
 
-/* Solve a validated request and print; returns an exit code. */
+/* Solve a validated request through the codec's pipeline and print; returns an exit code. */
 static int cli_solve(const cli_args *a, const codec_request *req, codec_errors *errs)
 {
-    sm_model *m = NULL;
-    sm_result *res = NULL;
-    sm_diag d;
-    const double *speeds;
-    int n, st, rc;
+    codec_run_out out;
+    int rc;
 
-    st = codec_model_new(&m, req, errs, &d);
-    if (st == SM_NOMEM) {
-        rc = cli_fail("model", st);
-        goto done;
-    }
-    if (st != SM_OK) {
+    switch (codec_run(req, a->csv ? CODEC_RUN_CSV : CODEC_RUN_JSON, NULL, NULL, errs, &out)) {
+    case CODEC_RUN_DONE:
+    case CODEC_RUN_PARTIAL:
+        rc = cli_output(a, &out);
+        break;
+    case CODEC_RUN_INVALID:
         rc = cli_problem(errs);
-        goto done;
+        break;
+    case CODEC_RUN_FAILED:
+        fprintf(stderr, "spinmodal: solve: %s\n", out.message);
+        rc = CLI_FAILED;
+        break;
+    default: /* NOMEM; CANCELED cannot happen without a callback */
+        rc = cli_fail("solve", out.status);
+        break;
     }
-    speeds = codec_request_speeds(req, &n);
-    memset(&d, 0, sizeof(d));
-    st = sm_solve(m, speeds, n, NULL, NULL, &res, &d);
-    if (st == SM_INVALID_INPUT) {
-        if (codec_diag_error(req, &d, errs))
-            rc = cli_fail("solve", SM_NOMEM);
-        else
-            rc = cli_problem(errs);
-        goto done;
-    }
-    if (st != SM_OK) {
-        if (d.message[0])
-            fprintf(stderr, "spinmodal: solve: %s\n", d.message);
-        rc = cli_fail("solve", st);
-        goto done;
-    }
-    rc = cli_output(a, req, m, res);
-done:
-    sm_result_free(res);
-    sm_model_free(m);
+    codec_run_clear(&out);
     return rc;
 }
 

@@ -211,4 +211,7 @@ int codec_errors_http_status(const codec_errors *e);
 }
 #endif
 
+#include "jobdoc.h" /* documents about jobs (status, listing, validate, error object) */
+#include "run.h"    /* the pipeline: request -> model -> solve -> documents */
+
 #endif /* SPINMODAL_CODEC_H */

@@ -131,13 +131,6 @@ typedef struct http_hdr {
     const char *value;
 } http_hdr;
 
-/* A growing text buffer; nomem is sticky. */
-typedef struct http_buf {
-    char *p;
-    size_t len, cap;
-    int nomem;
-} http_buf;
-
 static const char http_oom_body[] =
     "{\"type\":\"" HTTP_PROBLEMS "unavailable\",\"title\":\"Service Unavailable\","
     "\"status\":503,\"detail\":\"The server is out of memory; retry later.\"}";
@@ -230,114 +223,29 @@ static int http_ct_equal(const char *a, const char *b, size_t n)
     return d == 0;
 }
 
-/* ---------------------------------------------------------- text buffer */
-
-static void http_buf_put(http_buf *b, const char *s, size_t n)
-{
-    if (b->nomem)
-        return;
-    if (b->len + n + 1 > b->cap) {
-        size_t ncap = b->cap ? b->cap : 1024;
-        char *np;
-        while (ncap < b->len + n + 1)
-            ncap *= 2;
-        np = realloc(b->p, ncap);
-        if (!np) {
-            b->nomem = 1;
-            return;
-        }
-        b->p = np;
-        b->cap = ncap;
-    }
-    memcpy(b->p + b->len, s, n);
-    b->len += n;
-    b->p[b->len] = '\0';
-}
-
-/* Make room for n more bytes at once (large spliced results); nomem is sticky. */
-static void http_buf_reserve(http_buf *b, size_t n)
-{
-    char *np;
-
-    if (b->nomem || b->len + n + 1 <= b->cap)
-        return;
-    np = realloc(b->p, b->len + n + 1);
-    if (!np) {
-        b->nomem = 1;
-        return;
-    }
-    b->p = np;
-    b->cap = b->len + n + 1;
-}
-
-static void http_buf_puts(http_buf *b, const char *s)
-{
-    http_buf_put(b, s, strlen(s));
-}
-
-#if defined(__GNUC__)
-__attribute__((format(printf, 2, 3)))
-#endif
-static void http_buf_printf(http_buf *b, const char *fmt, ...)
-{
-    char tmp[256];
-    va_list ap;
-    int n;
-
-    va_start(ap, fmt);
-    n = vsnprintf(tmp, sizeof(tmp), fmt, ap);
-    va_end(ap);
-    if (n < 0 || (size_t)n >= sizeof(tmp)) { /* callers format short fields only */
-        b->nomem = 1;
-        return;
-    }
-    http_buf_put(b, tmp, (size_t)n);
-}
-
-/* A JSON timestamp (RFC 3339 UTC, ms) or null when t is 0. */
-static void http_buf_time(http_buf *b, double t)
-{
-    char ts[32];
-
-    if (t <= 0.0) {
-        http_buf_puts(b, "null");
-        return;
-    }
-    log_time(t, ts);
-    http_buf_printf(b, "\"%s\"", ts);
-}
-
 /* -------------------------------------------------------- status document */
 
-/*
- * Append the status document of jb (DAEMON.md); with_result splices the
- * stored result text in verbatim when jb->result is loaded.
- */
-static void http_buf_status(http_buf *b, const store_job *jb, int with_result)
+/* Describe a stored job for the codec's documents; with_result links its result text. */
+static codec_job_view http_view(const store_job *jb, int with_result)
 {
-    int done = jb->state == STORE_DONE ? jb->speeds_total : jb->speeds_done;
+    codec_job_view v;
 
-    http_buf_printf(b, "{\"id\":\"%s\",\"state\":\"%s\",\"progress\":{\"done\":%d,\"total\":%d}",
-                    jb->id, store_state_name(jb->state), done, jb->speeds_total);
-    http_buf_puts(b, ",\"created_at\":");
-    http_buf_time(b, jb->created_at);
-    http_buf_puts(b, ",\"started_at\":");
-    http_buf_time(b, jb->started_at);
-    http_buf_puts(b, ",\"finished_at\":");
-    http_buf_time(b, jb->finished_at);
-    http_buf_printf(b, ",\"attempts\":%d,\"cancel_requested\":%s,\"error\":", jb->attempts,
-                    jb->cancel_requested ? "true" : "false");
-    if (jb->error && jb->error[0])
-        http_buf_puts(b, jb->error);
-    else
-        http_buf_puts(b, "null");
-    http_buf_printf(b, ",\"links\":{\"self\":\"/v1/analyses/%s\",", jb->id);
-    http_buf_printf(b, "\"result\":\"/v1/analyses/%s/result\"}", jb->id);
+    memset(&v, 0, sizeof(v));
+    v.id = jb->id;
+    v.state = store_state_name(jb->state);
+    v.done = jb->state == STORE_DONE ? jb->speeds_total : jb->speeds_done;
+    v.total = jb->speeds_total;
+    v.created_at = jb->created_at;
+    v.started_at = jb->started_at;
+    v.finished_at = jb->finished_at;
+    v.attempts = jb->attempts;
+    v.cancel_requested = jb->cancel_requested;
+    v.error = jb->error;
     if (with_result && jb->result) {
-        http_buf_puts(b, ",\"result\":");
-        http_buf_put(b, jb->result, jb->result_len);
+        v.result = jb->result;
+        v.result_len = jb->result_len;
     }
-    http_buf_puts(b, "}");
+    return v;
 }
 
 /* ------------------------------------------------------------ responses */
@@ -426,7 +334,7 @@ static enum MHD_Result http_respond(struct MHD_Connection *c, http_req *r, int s
 
 /* Queue a JSON document held in b (taken); 503 when b ran out of memory. */
 static enum MHD_Result http_respond_buf(struct MHD_Connection *c, http_req *r, int status,
-                                        const char *ctype, http_buf *b, const http_hdr *hdrs,
+                                        const char *ctype, codec_text *b, const http_hdr *hdrs,
                                         int n)
 {
     if (b->nomem || !b->p) {
@@ -629,14 +537,14 @@ static enum MHD_Result http_read_failed(struct MHD_Connection *c, http_req *r, i
 static enum MHD_Result http_send_status(struct MHD_Connection *c, http_req *r, int status,
                                         const store_job *jb)
 {
-    http_buf b = {0};
+    codec_text b = {0};
     char location[96];
     http_hdr loc = {MHD_HTTP_HEADER_LOCATION, location};
 
+    codec_job_view v = http_view(jb, 1);
+
     snprintf(location, sizeof(location), "/v1/analyses/%s", jb->id);
-    http_buf_reserve(&b, 1024 + (jb->result ? jb->result_len : 0) +
-                             (jb->error ? strlen(jb->error) : 0));
-    http_buf_status(&b, jb, 1);
+    codec_job_status(&b, &v);
     return http_respond_buf(c, r, status, "application/json", &b, &loc,
                             status == MHD_HTTP_ACCEPTED ? 1 : 0);
 }
@@ -720,19 +628,14 @@ static enum MHD_Result http_get_result(struct MHD_Connection *c, http_req *r)
     return q;
 }
 
-/* The listing's "next" link and closing brace. */
-static void http_buf_list_end(http_buf *b, int more, long long limit, long long last_seq,
-                              int filter)
+/* The listing's "next" link into next[cap]. */
+static void http_list_next(char *next, size_t cap, long long limit, long long last_seq,
+                           int filter)
 {
-    http_buf_puts(b, "],\"next\":");
-    if (!more) {
-        http_buf_puts(b, "null}");
-        return;
-    }
-    http_buf_printf(b, "\"/v1/analyses?limit=%lld&before=%lld", limit, last_seq);
-    if (filter >= 0)
-        http_buf_printf(b, "&state=%s", store_state_name((store_state)filter));
-    http_buf_puts(b, "\"}");
+    int n = snprintf(next, cap, "/v1/analyses?limit=%lld&before=%lld", limit, last_seq);
+
+    if (filter >= 0 && n > 0 && (size_t)n < cap)
+        snprintf(next + n, cap - (size_t)n, "&state=%s", store_state_name((store_state)filter));
 }
 
 /* Fill the live progress of the running jobs of a listing (best effort). */
@@ -792,31 +695,36 @@ static enum MHD_Result http_list(struct MHD_Connection *c, http_req *r)
     long long limit, before;
     int filter, n = 0, more = 0, i;
     store_job *items;
+    codec_job_view *views;
     enum MHD_Result q;
-    http_buf b = {0};
+    codec_text b = {0};
+    char next[160];
 
     if (http_list_query(c, r, &limit, &before, &filter, &q))
         return q;
     items = calloc((size_t)limit, sizeof(*items));
-    if (!items)
+    views = calloc((size_t)limit, sizeof(*views));
+    if (!items || !views) {
+        free(items);
+        free(views);
         return http_send_oom(c, r);
+    }
     if (store_list(r->h->st, before, filter, (int)limit, items, &n, &more) != STORE_OK) {
         q = http_unavailable(c, r, "unavailable");
         goto done;
     }
     http_list_progress(r->h, items, n);
-    http_buf_puts(&b, "{\"items\":[");
-    for (i = 0; i < n; i++) {
-        if (i)
-            http_buf_puts(&b, ",");
-        http_buf_status(&b, &items[i], 0);
-    }
-    http_buf_list_end(&b, more && n > 0, limit, n > 0 ? items[n - 1].seq : 0, filter);
+    for (i = 0; i < n; i++)
+        views[i] = http_view(&items[i], 0);
+    if (more && n > 0)
+        http_list_next(next, sizeof(next), limit, items[n - 1].seq, filter);
+    codec_job_list(&b, views, n, more && n > 0 ? next : NULL);
     q = http_respond_buf(c, r, MHD_HTTP_OK, "application/json", &b, NULL, 0);
 done:
     for (i = 0; i < n; i++)
         store_job_clear(&items[i]);
     free(items);
+    free(views);
     return q;
 }
 
@@ -994,7 +902,7 @@ static void http_raw_drain(int fd)
 static enum MHD_Result http_early_too_large(struct MHD_Connection *c, http_req *r)
 {
     const union MHD_ConnectionInfo *ci;
-    http_buf b = {0};
+    codec_text b = {0};
     char *body = NULL;
     json_t *doc;
     size_t len;
@@ -1011,16 +919,16 @@ static enum MHD_Result http_early_too_large(struct MHD_Connection *c, http_req *
         return MHD_NO;
     }
     len = strlen(body);
-    http_buf_printf(&b, "HTTP/1.1 413 %s\r\nConnection: close\r\nContent-Type: "
+    codec_text_printf(&b, "HTTP/1.1 413 %s\r\nConnection: close\r\nContent-Type: "
                         "application/problem+json\r\nContent-Length: %zu\r\n",
                     MHD_get_reason_phrase_for(MHD_HTTP_CONTENT_TOO_LARGE), len);
     if (r->h->cors_origin) {
-        http_buf_puts(&b, "Access-Control-Allow-Origin: ");
-        http_buf_puts(&b, r->h->cors_origin);
-        http_buf_puts(&b, "\r\n");
+        codec_text_puts(&b, "Access-Control-Allow-Origin: ");
+        codec_text_puts(&b, r->h->cors_origin);
+        codec_text_puts(&b, "\r\n");
     }
-    http_buf_puts(&b, "\r\n");
-    http_buf_put(&b, body, len);
+    codec_text_puts(&b, "\r\n");
+    codec_text_put(&b, body, len);
     if (!b.nomem && http_raw_send(ci->connect_fd, b.p, b.len) == 0) {
         r->status = MHD_HTTP_CONTENT_TOO_LARGE;
         r->bytes = len;
@@ -1152,15 +1060,12 @@ static enum MHD_Result http_submit(struct MHD_Connection *c, http_req *r,
 static enum MHD_Result http_validated(struct MHD_Connection *c, http_req *r,
                                       const codec_request *req)
 {
-    http_buf b = {0};
+    codec_text b = {0};
     char id[65];
 
-    if (jobs_id(req, id) != JOBS_OK)
+    if (codec_job_id(req, id) != SM_OK)
         return http_send_oom(c, r);
-    http_buf_printf(&b, "{\"valid\":true,\"id\":\"%s\",\"request_sha256\":\"%s\",\"canonical\":",
-                    id, codec_request_sha256(req));
-    http_buf_puts(&b, codec_request_canonical_text(req));
-    http_buf_puts(&b, "}");
+    codec_validate_doc(&b, id, req);
     return http_respond_buf(c, r, MHD_HTTP_OK, "application/json", &b, NULL, 0);
 }
 
@@ -1178,7 +1083,7 @@ static int http_check_model(http_req *r, const codec_request *req, codec_errors 
     int st, known = 0;
 
     memset(&jb, 0, sizeof(jb));
-    if (r->route == R_ANALYSES && jobs_id(req, id) == JOBS_OK &&
+    if (r->route == R_ANALYSES && codec_job_id(req, id) == SM_OK &&
         http_job_read(r->h, id, 0, &jb) == JOBS_OK)
         known = jb.state != STORE_FAILED && jb.state != STORE_CANCELED;
     store_job_clear(&jb);
@@ -1232,7 +1137,7 @@ static enum MHD_Result http_readyz(struct MHD_Connection *c, http_req *r)
     jobs_stats s = {0, 0, 0, 0};
     int db_ok = store_check_writable(r->h->st) == STORE_OK, stopping = 1;
     char workers[48];
-    http_buf b = {0};
+    codec_text b = {0};
 
     if (http_enter(r->h) == 0) {
         jobs_get_stats(r->h->j, &s);
@@ -1241,16 +1146,16 @@ static enum MHD_Result http_readyz(struct MHD_Connection *c, http_req *r)
     }
     snprintf(workers, sizeof(workers), "%d/%d", s.workers_alive, s.workers);
     if (db_ok && !stopping && s.workers_alive == s.workers && s.workers > 0) {
-        http_buf_printf(&b, "{\"status\":\"ready\",\"checks\":{\"database\":\"ok\","
+        codec_text_printf(&b, "{\"status\":\"ready\",\"checks\":{\"database\":\"ok\","
                             "\"workers\":\"%s\"}}", workers);
         return http_respond_buf(c, r, MHD_HTTP_OK, "application/json", &b, NULL, 0);
     }
-    http_buf_printf(&b, "{\"type\":\"" HTTP_PROBLEMS "not-ready\",\"title\":\"Service "
+    codec_text_printf(&b, "{\"type\":\"" HTTP_PROBLEMS "not-ready\",\"title\":\"Service "
                         "Unavailable\",\"status\":503,\"detail\":\"%s\",",
                     stopping ? "The daemon is stopping."
                     : !db_ok ? "The database is not writable."
                              : "A worker thread is gone.");
-    http_buf_printf(&b, "\"checks\":{\"database\":\"%s\","
+    codec_text_printf(&b, "\"checks\":{\"database\":\"%s\","
                         "\"workers\":\"%s\"}}", db_ok ? "ok" : "unwritable", workers);
     if (stopping)
         retry.value = HTTP_RETRY_BUSY;

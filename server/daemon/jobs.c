@@ -130,55 +130,6 @@ static int jobs_map_store(int rc)
     }
 }
 
-int jobs_id(const codec_request *req, char id[65])
-{
-    char buf[64 + 1 + 64];
-    int n = snprintf(buf, sizeof(buf), "%s:%s", codec_request_sha256(req), sm_version());
-
-    if (n < 0 || (size_t)n >= sizeof(buf))
-        return JOBS_NOMEM;
-    return codec_sha256_hex(buf, (size_t)n, id) == SM_OK ? JOBS_OK : JOBS_NOMEM;
-}
-
-/* ------------------------------------------------------------ the error */
-
-/*
- * The error object of a failed job as JSON text (malloc'd, or NULL when out
- * of memory): {"type","title","detail"[,"errors"][,"diagnostics"]}.
- * errors and diagnostics are stolen (may be NULL).
- */
-static char *jobs_error_text(const char *type, const char *title, const char *detail,
-                             json_t *errors, json_t *diagnostics)
-{
-    json_t *e = json_object();
-    char *text = NULL;
-
-    if (!e)
-        goto done;
-    if (json_object_set_new(e, "type", json_string(type)) ||
-        json_object_set_new(e, "title", json_string(title)) ||
-        json_object_set_new(e, "detail", json_string(detail ? detail : "")))
-        goto done;
-    if (errors && json_object_set_new(e, "errors", json_incref(errors)))
-        goto done;
-    if (diagnostics && json_object_set_new(e, "diagnostics", json_incref(diagnostics)))
-        goto done;
-    text = json_dumps(e, JSON_COMPACT | JSON_REAL_PRECISION(17));
-done:
-    json_decref(errors);
-    json_decref(diagnostics);
-    json_decref(e);
-    return text;
-}
-
-/* Diagnostics of case c (no equilibrium). */
-static json_t *jobs_case_diag(const sm_case *c)
-{
-    return json_pack("{s:f, s:f, s:i, s:f, s:s}", "omega", c->omega, "last_omega",
-                     c->last_omega, "iterations", c->iterations, "residual",
-                     isfinite(c->residual) ? c->residual : -1.0, "message", c->message);
-}
-
 /* ---------------------------------------------------------------- a job */
 
 /* What a worker produced for one job, handed to store_finish. */
@@ -214,65 +165,48 @@ static int jobs_progress_cb(void *user, int done, int total)
     return stop;
 }
 
-/* Result (and CSV) of a solved request; fills rec (state DONE or FAILED). */
-static int jobs_encode(const codec_request *req, const sm_model *m, const sm_result *res,
-                       jobs_outcome_rec *rec)
-{
-    json_t *doc = NULL;
-    const sm_case *bad = NULL;
-    int i, n_bad = 0;
-    char detail[512];
-
-    if (codec_result_encode(&doc, req, m, res) != SM_OK)
-        return SM_NOMEM;
-    rec->result = json_dumps(doc, JSON_COMPACT | JSON_REAL_PRECISION(17));
-    json_decref(doc);
-    if (!rec->result || codec_result_csv(&rec->csv, &rec->csv_len, res) != SM_OK)
-        return SM_NOMEM;
-    for (i = 0; i < res->n_cases; i++)
-        if (res->cases[i].status == SM_CASE_NO_EQUILIBRIUM) {
-            if (!bad)
-                bad = &res->cases[i];
-            n_bad++;
-        }
-    rec->speeds_done = res->n_cases;
-    rec->state = STORE_DONE;
-    if (bad) {
-        snprintf(detail, sizeof(detail),
-                 "no dynamic equilibrium at %d of %d speeds, first at omega = %.6g rad/s "
-                 "(last speed reached %.6g rad/s): %s; the other speeds are in the result",
-                 n_bad, res->n_cases, bad->omega, bad->last_omega, bad->message);
-        rec->error = jobs_error_text("no_equilibrium", "No dynamic equilibrium", detail, NULL,
-                                     jobs_case_diag(bad));
-        if (!rec->error)
-            return SM_NOMEM;
-        rec->state = STORE_FAILED;
-    }
-    return SM_OK;
-}
-
-/* A failure before or inside the core: fills rec->state/error. */
+/* A failure outside the pipeline (timeout, too many attempts): fills rec->state/error. */
 static void jobs_fail(jobs_outcome_rec *rec, const char *type, const char *title,
-                      const char *detail, json_t *errors)
+                      const char *detail)
 {
     rec->state = STORE_FAILED;
-    rec->error = jobs_error_text(type, title, detail, errors, NULL);
+    rec->error = codec_job_error_text(type, title, detail, NULL, NULL);
 }
 
-/* Run the claimed job through codec and core; fills rec. */
+/* The state a stopped run leaves its job in: timed out, canceled or back to the queue. */
+static void jobs_stopped(jobs *j, jobs_slot *slot, int total, jobs_outcome_rec *rec)
+{
+    char detail[256];
+    int timed_out;
+
+    pthread_mutex_lock(&j->lock);
+    timed_out = slot->timed_out;
+    rec->state = slot->cancel ? STORE_CANCELED : STORE_QUEUED;
+    pthread_mutex_unlock(&j->lock);
+    if (!timed_out)
+        return;
+    snprintf(detail, sizeof(detail),
+             "the job ran longer than the limit of %g s (--job-timeout) and was "
+             "stopped after %d of %d speeds",
+             j->cfg.job_timeout, rec->speeds_done, total);
+    jobs_fail(rec, "timeout", "Job time limit exceeded", detail);
+}
+
+/*
+ * Run the claimed job through the codec's pipeline (parse the stored
+ * canonical request, then codec_run); fills rec.
+ */
 static void jobs_run(jobs *j, jobs_slot *slot, const store_job *job, jobs_outcome_rec *rec)
 {
     codec_errors *errs = codec_errors_new();
     codec_request *req = NULL;
-    sm_model *m = NULL;
-    sm_result *res = NULL;
-    sm_diag d;
     jobs_cb_ctx ctx = {j, slot, jobs_clock()};
-    const double *speeds;
-    char detail[512];
-    int n, st;
+    codec_run_out out;
+    int st;
 
+    memset(&out, 0, sizeof(out));
     rec->solve_seconds = -1;
+    rec->state = STORE_FAILED;
     if (!errs)
         goto nomem;
     st = codec_request_parse(&req, job->request ? job->request : "", job->request_len,
@@ -280,56 +214,34 @@ static void jobs_run(jobs *j, jobs_slot *slot, const store_job *job, jobs_outcom
     if (st == SM_NOMEM)
         goto nomem;
     if (st != SM_OK) {
-        jobs_fail(rec, "invalid", "Stored request is no longer valid",
-                  "the request was accepted earlier but this spinmodald rejects it",
-                  codec_errors_to_json(errs));
+        rec->error = codec_job_error_text(
+            "invalid", "Stored request is no longer valid",
+            "the request was accepted earlier but this spinmodald rejects it",
+            codec_errors_to_json(errs), NULL);
         goto done;
     }
-    memset(&d, 0, sizeof(d));
-    st = codec_model_new(&m, req, errs, &d);
-    if (st == SM_NOMEM)
-        goto nomem;
-    if (st != SM_OK) {
-        snprintf(detail, sizeof(detail), "the model could not be built: %s", sm_strerror(st));
-        jobs_fail(rec, st == SM_INVALID_INPUT ? "invalid" : "solver_error",
-                  "Model construction failed", detail, codec_errors_to_json(errs));
+    codec_run(req, CODEC_RUN_JSON | CODEC_RUN_CSV, jobs_progress_cb, &ctx, errs, &out);
+    rec->solve_seconds = out.seconds;
+    rec->speeds_done = out.speeds_done;
+    switch (out.outcome) {
+    case CODEC_RUN_CANCELED:
+        jobs_stopped(j, slot, out.speeds_total, rec);
         goto done;
+    case CODEC_RUN_DONE:
+    case CODEC_RUN_PARTIAL:
+        rec->result = json_dumps(out.result, JSON_COMPACT | JSON_REAL_PRECISION(17));
+        if (!rec->result)
+            goto nomem;
+        rec->csv = out.csv;
+        rec->csv_len = out.csv_len;
+        out.csv = NULL;
+        rec->state = out.outcome == CODEC_RUN_DONE ? STORE_DONE : STORE_FAILED;
+        break;
+    default: /* INVALID, FAILED, NOMEM: the pipeline wrote the error object */
+        break;
     }
-    speeds = codec_request_speeds(req, &n);
-    memset(&d, 0, sizeof(d));
-    st = sm_solve(m, speeds, n, jobs_progress_cb, &ctx, &res, &d);
-    rec->solve_seconds = jobs_clock() - ctx.t0;
-    pthread_mutex_lock(&j->lock);
-    rec->speeds_done = slot->done;
-    pthread_mutex_unlock(&j->lock);
-    if (st == SM_CANCELED) {
-        pthread_mutex_lock(&j->lock);
-        if (slot->timed_out) {
-            pthread_mutex_unlock(&j->lock);
-            snprintf(detail, sizeof(detail),
-                     "the job ran longer than the limit of %g s (--job-timeout) and was "
-                     "stopped after %d of %d speeds",
-                     j->cfg.job_timeout, rec->speeds_done, n);
-            jobs_fail(rec, "timeout", "Job time limit exceeded", detail, NULL);
-        } else {
-            rec->state = slot->cancel ? STORE_CANCELED : STORE_QUEUED;
-            pthread_mutex_unlock(&j->lock);
-        }
-        goto done;
-    }
-    if (st == SM_NOMEM)
-        goto nomem;
-    if (st != SM_OK) {
-        snprintf(detail, sizeof(detail), "%s%s%s", sm_strerror(st), d.message[0] ? ": " : "",
-                 d.message);
-        if (st == SM_INVALID_INPUT)
-            codec_diag_error(req, &d, errs);
-        jobs_fail(rec, st == SM_INVALID_INPUT ? "invalid" : "solver_error", "Solver error",
-                  detail, codec_errors_count(errs) ? codec_errors_to_json(errs) : NULL);
-        goto done;
-    }
-    if (jobs_encode(req, m, res, rec) != SM_OK)
-        goto nomem;
+    rec->error = out.error; /* NULL when done; a partial result keeps its error */
+    out.error = NULL;
     goto done;
 nomem:
     free(rec->result);
@@ -337,11 +249,11 @@ nomem:
     free(rec->error);
     rec->result = rec->csv = NULL;
     rec->csv_len = 0;
-    jobs_fail(rec, "solver_error", "Out of memory", "the daemon ran out of memory running this job",
-              NULL);
+    rec->state = STORE_FAILED;
+    rec->error = codec_job_error_text("solver_error", "Out of memory",
+                                      "the daemon ran out of memory running this job", NULL, NULL);
 done:
-    sm_result_free(res);
-    sm_model_free(m);
+    codec_run_clear(&out);
     codec_request_free(req);
     codec_errors_free(errs);
 }
@@ -423,8 +335,7 @@ static void jobs_handle(jobs *j, jobs_slot *slot, store_job *job)
         rec.solve_seconds = -1;
         jobs_fail(&rec, "interrupted", "Job interrupted repeatedly",
                   "the job was interrupted (crash or kill) every time it ran; it is not retried "
-                  "again — resubmit it to try once more",
-                  NULL);
+                  "again — resubmit it to try once more");
     } else {
         jobs_run(j, slot, job, &rec);
     }
@@ -613,7 +524,7 @@ int jobs_submit(jobs *j, const codec_request *req, jobs_outcome *outcome, store_
     *outcome = JOBS_EXISTING;
     if (jobs_stopping(j))
         return JOBS_STOPPING;
-    if (jobs_id(req, id) != JOBS_OK)
+    if (codec_job_id(req, id) != SM_OK)
         return JOBS_NOMEM;
     /* cache hit: a read, no write transaction */
     rc = store_get(j->st, id, 0, jb);

@@ -68,16 +68,13 @@ int jobs_stopping(jobs *j);
 
 /**
  * Submit a validated request (borrowed).  The id is derived from the
- * request's SHA-256 and SM_VERSION (jobs_id).  The job is committed to the
+ * request's SHA-256 and SM_VERSION (codec_job_id).  The job is committed to the
  * store before this returns.  *outcome says what happened; *job (may be
  * NULL) receives the job as stored, without large texts.  Cache hits and
  * misses are counted in the metrics.  Returns JOBS_OK, JOBS_FULL (nothing
  * stored), JOBS_STOPPING, JOBS_STORE_ERROR or JOBS_NOMEM.
  */
 int jobs_submit(jobs *j, const codec_request *req, jobs_outcome *outcome, store_job *job);
-
-/** The job id of a request: sha256_hex(request_sha256 ":" SM_VERSION) into id[65]. */
-int jobs_id(const codec_request *req, char id[65]);
 
 /**
  * Cancel a queued job (it becomes canceled at once) or ask a running one to

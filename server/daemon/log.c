@@ -5,6 +5,8 @@
  */
 #include "log.h"
 
+#include "codec.h"
+
 #include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -31,20 +33,7 @@ double log_now(void)
 
 void log_time(double t, char buf[32])
 {
-    time_t s = (time_t)t;
-    int ms = (int)((t - (double)s) * 1000.0);
-    struct tm tm;
-    char ymdhms[24];
-    size_t n;
-
-    if (ms < 0)
-        ms = 0;
-    if (ms > 999)
-        ms = 999;
-    gmtime_r(&s, &tm);
-    n = strftime(ymdhms, sizeof(ymdhms), "%Y-%m-%dT%H:%M:%S", &tm);
-    ymdhms[n] = '\0';
-    snprintf(buf, 32, "%.20s.%03dZ", ymdhms, ms % 1000);
+    codec_time_rfc3339(t, buf);
 }
 
 /* Append text to line (cap bytes), truncating. */
