@@ -215,12 +215,19 @@ static enum MHD_Result http_get(struct MHD_Connection *c, http_req *r)
     }
 }
 
+/* 1 for the routes whose reads need the token under --auth-reads (jobs, metrics). */
+static int http_read_needs_token(http_route route)
+{
+    return route == R_ANALYSES || route == R_ANALYSIS || route == R_RESULT ||
+           route == R_METRICS;
+}
+
 /* Answer a request other than a POST with a body (all of it is in). */
 static enum MHD_Result http_answer(struct MHD_Connection *c, http_req *r)
 {
     unsigned allowed = http_route_methods(r->route);
 
-    if (r->method == M_OPTIONS && r->h->cors_origin)
+    if (r->method == M_OPTIONS && r->h->cors_origin && r->route != R_OTHER)
         return http_preflight(c, r);
     if (r->method == M_OPTIONS && strcmp(r->path, "*") == 0)
         return http_not_allowed(c, r, M_GET | M_HEAD | M_POST | M_DELETE);
@@ -228,6 +235,9 @@ static enum MHD_Result http_answer(struct MHD_Connection *c, http_req *r)
         return http_not_found(c, r, 0);
     if (!(allowed & r->method))
         return http_not_allowed(c, r, allowed);
+    if ((r->method == M_GET || r->method == M_HEAD) && http_read_needs_token(r->route) &&
+        r->h->auth_reads && !http_authorized(r->h, c))
+        return http_unauthorized(c, r);
     if (r->method == M_GET || r->method == M_HEAD)
         return http_get(c, r);
     if (!http_authorized(r->h, c))
@@ -306,6 +316,7 @@ static enum MHD_Result http_handler(void *cls, struct MHD_Connection *c, const c
             return http_early_too_large(c, r);
         return MHD_YES;
     }
+    http_guard_answering(h, c);
     return r->collect ? http_post_end(c, r) : http_answer(c, r);
 }
 
@@ -336,8 +347,7 @@ static void http_completed(void *cls, struct MHD_Connection *c, void **req_cls,
     http_req *r = *req_cls;
     char status[16], ms[32], bytes[32];
 
-    (void)cls;
-    (void)c;
+    http_guard_answered(cls, c);
     if (!r)
         return;
     if (r->status)
@@ -418,13 +428,17 @@ void http_default_config(http_config *cfg)
     codec_default_limits(&cfg->limits);
     cfg->limits.max_request_bytes = cfg->max_body;
     cfg->connection_limit = 512;
+    cfg->per_client_limit = 64;
     cfg->connection_timeout = 60;
+    cfg->request_deadline = 30.0;
 }
 
 /* Copy the settings of cfg into h; 0 or HTTP_NOMEM. */
 static int http_configure(http *h, const http_config *cfg)
 {
     h->max_body = cfg->max_body;
+    h->auth_reads = cfg->auth_reads && cfg->token;
+    h->request_deadline = cfg->request_deadline > 0.0 ? cfg->request_deadline : 30.0;
     h->limits = cfg->limits;
     h->limits.max_request_bytes = cfg->max_body;
     if (cfg->cors_origin) {
@@ -450,8 +464,10 @@ static int http_listen(http *h, const http_config *cfg, const struct addrinfo *a
                             MHD_OPTION_EXTERNAL_LOGGER, &http_mhd_log, h,
                             MHD_OPTION_SOCK_ADDR, ai->ai_addr,
                             MHD_OPTION_CONNECTION_LIMIT, (unsigned)cfg->connection_limit,
+                            MHD_OPTION_PER_IP_CONNECTION_LIMIT, (unsigned)cfg->per_client_limit,
                             MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg->connection_timeout,
                             MHD_OPTION_NOTIFY_COMPLETED, &http_completed, h,
+                            MHD_OPTION_NOTIFY_CONNECTION, &http_guard_notify, h,
                             MHD_OPTION_END);
     if (!h->d)
         return HTTP_LISTEN;
@@ -464,6 +480,8 @@ static void http_free(http *h)
 {
     if (!h)
         return;
+    pthread_cond_destroy(&h->guard_cv);
+    pthread_mutex_destroy(&h->guard_lock);
     pthread_cond_destroy(&h->idle);
     pthread_mutex_destroy(&h->lock);
     free(h->cors_origin);
@@ -490,6 +508,19 @@ int http_start(http **out, const http_config *cfg, jobs *j, store *st, metrics *
         free(h);
         return HTTP_NOMEM;
     }
+    if (pthread_mutex_init(&h->guard_lock, NULL)) {
+        pthread_cond_destroy(&h->idle);
+        pthread_mutex_destroy(&h->lock);
+        free(h);
+        return HTTP_NOMEM;
+    }
+    if (pthread_cond_init(&h->guard_cv, NULL)) {
+        pthread_mutex_destroy(&h->guard_lock);
+        pthread_cond_destroy(&h->idle);
+        pthread_mutex_destroy(&h->lock);
+        free(h);
+        return HTTP_NOMEM;
+    }
     h->j = j;
     h->st = st;
     h->mx = mx;
@@ -506,10 +537,14 @@ int http_start(http **out, const http_config *cfg, jobs *j, store *st, metrics *
         rc = HTTP_ADDRESS;
         goto fail;
     }
-    rc = http_listen(h, cfg, ai);
+    rc = http_guard_start(h);
+    if (rc == HTTP_OK)
+        rc = http_listen(h, cfg, ai);
     freeaddrinfo(ai);
-    if (rc)
+    if (rc) {
+        http_guard_stop(h);
         goto fail;
+    }
     *out = h;
     return HTTP_OK;
 fail:
@@ -538,6 +573,7 @@ void http_stop(http *h)
     if (!h)
         return;
     http_begin_stop(h);
+    http_guard_stop(h);
     MHD_stop_daemon(h->d);
     http_free(h);
 }

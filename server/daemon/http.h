@@ -44,13 +44,18 @@ typedef struct http_config {
     codec_limits limits;         /* request validation limits (max_request_bytes = max_body) */
     const char *token;           /* bearer token for POST/DELETE, NULL = no auth; copied */
     const char *cors_origin;     /* Access-Control-Allow-Origin, NULL = no CORS; copied */
+    int auth_reads;              /* 1: with a token, reads of jobs, /metrics and /v1/validate
+                                    need it too (probes and static files never do) */
     unsigned connection_limit;   /* concurrent connections (threads), >= 1 */
+    unsigned per_client_limit;   /* concurrent connections from one IP address, 0 = no limit */
     unsigned connection_timeout; /* s of idleness before a connection is closed */
+    double request_deadline;     /* s for a request's head and body to arrive, > 0 */
 } http_config;
 
 /**
  * Defaults: host 127.0.0.1, port 8080, max_body 1 MiB, the codec's default
- * limits, no token, no CORS, 512 connections, 60 s timeout.
+ * limits, no token, no CORS, 512 connections of which at most 64 from one
+ * address, 60 s idle timeout, 30 s request deadline.
  */
 void http_default_config(http_config *cfg);
 

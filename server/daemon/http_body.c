@@ -200,8 +200,9 @@ enum MHD_Result http_early_too_large(struct MHD_Connection *c, http_req *r)
 }
 
 /*
- * Header checks of POST /v1/analyses and /v1/validate (no token, no wait,
- * served while stopping).  Returns 1 when the body should be read, 0 after
+ * Header checks of POST /v1/analyses and /v1/validate (validate needs the
+ * token only under --auth-reads, takes no wait and is served while
+ * stopping).  Returns 1 when the body should be read, 0 after
  * queueing an answer (*q).
  */
 int http_post_begin(struct MHD_Connection *c, http_req *r, enum MHD_Result *q)
@@ -210,7 +211,7 @@ int http_post_begin(struct MHD_Connection *c, http_req *r, enum MHD_Result *q)
     const char *cl;
     long long n = 0;
 
-    if (submit && !http_authorized(r->h, c)) {
+    if ((submit || r->h->auth_reads) && !http_authorized(r->h, c)) {
         *q = http_unauthorized(c, r);
         return 0;
     }

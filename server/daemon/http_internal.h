@@ -2,7 +2,7 @@
  * http_internal.h — what the files of the HTTP front share (private to
  * server/daemon/http*.c; the public interface is http.h).
  *
- * The HTTP front is one module in four files:
+ * The HTTP front is one module in five files:
  *   http.c           libmicrohttpd set-up and stop, the three-phase handler,
  *                    routing, the operational routes (/readyz, /metrics,
  *                    OPTIONS, embedded files), the job-pool guard;
@@ -11,12 +11,16 @@
  *   http_body.c      receiving a POST body: token, content type, size caps,
  *                    the early 413;
  *   http_reply.c     building responses: headers, problem documents, the
- *                    last-resort 503, small parsers of the request line.
+ *                    last-resort 503, small parsers of the request line;
+ *   http_guard.c     the deadline for a request's head and body (slow
+ *                    clients cannot hold connection slots).
  */
 #ifndef SPINMODAL_HTTP_INTERNAL_H
 #define SPINMODAL_HTTP_INTERNAL_H
 
 #include <stddef.h>
+
+#include <pthread.h>
 
 #include <microhttpd.h>
 
@@ -45,6 +49,9 @@ enum {
     M_OPTIONS = 16,
     M_OTHER = 32
 };
+
+/* A tracked connection (http_guard.c). */
+typedef struct http_conn http_conn;
 
 /* Routes of DAEMON.md. */
 typedef enum http_route {
@@ -76,6 +83,15 @@ struct http {
     pthread_cond_t idle;     /* signaled when active drops to 0 while stopping */
     int stopping;            /* http_begin_stop has begun */
     int active;              /* request threads inside a jobs_* call */
+    int auth_reads;          /* 1: reads of jobs, /metrics and /v1/validate need the token too */
+    /* request deadlines (http_guard.c) */
+    double request_deadline; /* s for a request's head and body to arrive */
+    pthread_mutex_t guard_lock; /* guards conns and every http_conn, guard_stop */
+    pthread_cond_t guard_cv; /* wakes the guard thread to stop */
+    http_conn *conns;        /* open connections, newest first */
+    pthread_t guard_thread;
+    int guard_started;       /* 1 while the guard thread runs */
+    int guard_stop;          /* 1: the guard thread leaves */
 };
 
 /* Per-request context (*req_cls), from the first call to http_completed. */
@@ -208,6 +224,24 @@ enum MHD_Result http_delete(struct MHD_Connection *c, http_req *r);
 
 /** Phase 3 of a POST: validate the body, then submit or describe it, and answer. */
 enum MHD_Result http_post_end(struct MHD_Connection *c, http_req *r);
+
+/* ------------------------------------------------------------ http_guard.c */
+
+/** MHD_OPTION_NOTIFY_CONNECTION (cls = the http): track a connection from accept to close. */
+void http_guard_notify(void *cls, struct MHD_Connection *c, void **socket_context,
+                       enum MHD_ConnectionNotificationCode code);
+
+/** The request on c is complete and being answered: no deadline until it is answered. */
+void http_guard_answering(http *h, struct MHD_Connection *c);
+
+/** The request on c was answered: the next one must arrive within the deadline. */
+void http_guard_answered(http *h, struct MHD_Connection *c);
+
+/** Start the guard thread; HTTP_OK or HTTP_NOMEM. */
+int http_guard_start(http *h);
+
+/** Stop and join the guard thread (before MHD_stop_daemon); safe when not started. */
+void http_guard_stop(http *h);
 
 /* ------------------------------------------------------------------ http.c */
 

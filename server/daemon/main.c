@@ -13,6 +13,7 @@
  * Exit status: 0 after a clean stop, 64 on a bad flag, 1 when it cannot
  * start (token file, database, port).
  */
+#include <ctype.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <getopt.h>
@@ -51,7 +52,10 @@ enum {
     F_MAX_SPEEDS,
     F_JOB_TIMEOUT,
     F_TOKEN_FILE,
+    F_AUTH_READS,
     F_CORS_ORIGIN,
+    F_MAX_CONNECTIONS_PER_CLIENT,
+    F_REQUEST_DEADLINE,
     F_SHUTDOWN_GRACE,
     F_LOG_FORMAT,
     F_N
@@ -77,8 +81,14 @@ static const main_flag main_flags[F_N] = {
     {"job-timeout", "SPINMODAL_JOB_TIMEOUT", "S", "300", "seconds of solving before a job fails"},
     {"token-file", "SPINMODAL_TOKEN_FILE", "PATH", "none (no auth)",
      "file holding the bearer token POST and DELETE need"},
+    {"auth-reads", "SPINMODAL_AUTH_READS", "yes|no", "no",
+     "with a token: reading jobs, /metrics and /v1/validate need it too"},
     {"cors-origin", "SPINMODAL_CORS_ORIGIN", "ORIGIN", "none",
-     "Access-Control-Allow-Origin for browsers"},
+     "the one origin (scheme://host[:port]) allowed to call from browsers"},
+    {"max-connections-per-client", "SPINMODAL_MAX_CONNECTIONS_PER_CLIENT", "N", "64",
+     "open connections from one IP address (0 = no limit; behind a proxy raise it)"},
+    {"request-deadline", "SPINMODAL_REQUEST_DEADLINE", "S", "30",
+     "seconds for a request's head and body to arrive, however slowly sent"},
     {"shutdown-grace", "SPINMODAL_SHUTDOWN_GRACE", "S", "10",
      "seconds running jobs get to finish on SIGTERM"},
     {"log-format", "SPINMODAL_LOG_FORMAT", "text|json", "text", "log lines on stderr"},
@@ -94,7 +104,10 @@ typedef struct main_opts {
     double job_timeout;      /* s, > 0 */
     double shutdown_grace;   /* s, >= 0 */
     const char *token_file;  /* NULL = no auth */
+    int auth_reads;          /* 1: reads need the token too */
     const char *cors_origin; /* NULL = no CORS */
+    long per_client;         /* connections per IP address, 0 = no limit */
+    double request_deadline; /* s, > 0 */
     log_format format;
 } main_opts;
 
@@ -203,6 +216,26 @@ static int main_printable(const char *s)
     return 1;
 }
 
+/*
+ * 1 when s is one exact origin, scheme "://" host [":" port], as
+ * Access-Control-Allow-Origin needs: http or https, no path, no wildcard,
+ * no list.
+ */
+static int main_origin(const char *s)
+{
+    const char *host = strncmp(s, "https://", 8) == 0  ? s + 8
+                       : strncmp(s, "http://", 7) == 0 ? s + 7
+                                                       : NULL;
+    const char *p;
+
+    if (!host || !*host || !main_printable(s))
+        return 0;
+    for (p = host; *p; p++)
+        if (!(isalnum((unsigned char)*p) || strchr(".-:[]", *p)))
+            return 0;
+    return 1;
+}
+
 /* Set flag f from value v; 0, or -1 with what a valid value is in *want. */
 static int main_set(main_opts *o, int f, const char *v, const char **want)
 {
@@ -236,10 +269,23 @@ static int main_set(main_opts *o, int f, const char *v, const char **want)
         *want = "a file path";
         o->token_file = v;
         return *v ? 0 : -1;
+    case F_AUTH_READS:
+        *want = "yes or no";
+        if (strcmp(v, "yes") && strcmp(v, "no"))
+            return -1;
+        o->auth_reads = strcmp(v, "yes") == 0;
+        return 0;
     case F_CORS_ORIGIN:
-        *want = "an origin such as https://example.org (printable ASCII)";
+        *want = "one origin such as https://example.org or http://localhost:5173 "
+                "(scheme, host and port only; no '*', path or list)";
         o->cors_origin = v;
-        return main_printable(v) ? 0 : -1;
+        return main_origin(v) ? 0 : -1;
+    case F_MAX_CONNECTIONS_PER_CLIENT:
+        *want = "an integer from 0 (no limit) to 100000";
+        return main_long(v, 0, 100000, &o->per_client);
+    case F_REQUEST_DEADLINE:
+        *want = "a number of seconds from 1 to 3600";
+        return main_seconds(v, 1.0, 3600.0, &o->request_deadline);
     case F_SHUTDOWN_GRACE:
         *want = "a number of seconds from 0 to 3600";
         return main_seconds(v, 0.0, 3600.0, &o->shutdown_grace);
@@ -266,6 +312,8 @@ static void main_defaults(main_opts *o)
     o->max_elements = 2000;
     o->max_speeds = 1001;
     o->job_timeout = 300.0;
+    o->per_client = 64;
+    o->request_deadline = 30.0;
     o->shutdown_grace = 10.0;
     o->format = LOG_TEXT;
 }
@@ -457,7 +505,10 @@ static int main_serve(const main_opts *o, const char *token, main_daemon *d)
     hc.limits.max_elements = (int)o->max_elements;
     hc.limits.max_speeds = (int)o->max_speeds;
     hc.token = token;
+    hc.auth_reads = o->auth_reads;
     hc.cors_origin = o->cors_origin;
+    hc.per_client_limit = (unsigned)o->per_client;
+    hc.request_deadline = o->request_deadline;
     jc.workers = (int)o->workers;
     jc.queue_max = (int)o->queue_max;
     jc.job_timeout = o->job_timeout;
@@ -583,6 +634,11 @@ int main(int argc, char **argv)
     rc = main_parse(argc, argv, &o);
     if (rc)
         return rc < 0 ? 0 : rc;
+    if (o.auth_reads && !o.token_file) {
+        fprintf(stderr, "spinmodald: --auth-reads yes needs a token: give --token-file too.\n"
+                        "Try 'spinmodald --help'.\n");
+        return EXIT_USAGE;
+    }
     log_init(o.format, 1);
     if (o.token_file && main_token(o.token_file, &token))
         return EXIT_START;

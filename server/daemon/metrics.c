@@ -37,6 +37,7 @@ struct metrics {
     double solve_sum;                         /* s */
     unsigned long long solve_count;
     unsigned long long cache_hits, cache_misses;
+    unsigned long long deadline_closed; /* connections closed by the request deadline */
     unsigned long long finished[STORE_N_STATES];
 };
 
@@ -127,6 +128,13 @@ void metrics_cache(metrics *m, int hit)
     pthread_mutex_unlock(&m->lock);
 }
 
+void metrics_deadline_closed(metrics *m, int n)
+{
+    pthread_mutex_lock(&m->lock);
+    m->deadline_closed += (unsigned long long)(n > 0 ? n : 0);
+    pthread_mutex_unlock(&m->lock);
+}
+
 void metrics_job_finished(metrics *m, store_state s)
 {
     if ((int)s < 0 || s >= STORE_N_STATES)
@@ -211,6 +219,11 @@ static void metrics_render_locked(const metrics *m, metrics_buf *b)
                       "# TYPE spinmodal_cache_misses_total counter\n"
                       "spinmodal_cache_misses_total %llu\n",
                    m->cache_hits, m->cache_misses);
+    metrics_printf(b, "# HELP spinmodal_http_deadline_closed_total Connections closed because a "
+                      "request's head and body did not arrive within --request-deadline.\n"
+                      "# TYPE spinmodal_http_deadline_closed_total counter\n"
+                      "spinmodal_http_deadline_closed_total %llu\n",
+                   m->deadline_closed);
     metrics_printf(b, "# HELP spinmodal_jobs_finished_total Jobs that ended, by final state.\n"
                       "# TYPE spinmodal_jobs_finished_total counter\n");
     for (i = STORE_DONE; i < STORE_N_STATES; i++)

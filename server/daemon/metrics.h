@@ -38,6 +38,9 @@ void metrics_solve_seconds(metrics *m, double seconds);
 /** Count a submission: hit = 1 when the job already existed. */
 void metrics_cache(metrics *m, int hit);
 
+/** Count n connections closed because their request missed --request-deadline. */
+void metrics_deadline_closed(metrics *m, int n);
+
 /** Count a job that ended in state s (done, failed or canceled). */
 void metrics_job_finished(metrics *m, store_state s);
 

@@ -1,0 +1,179 @@
+/*
+ * http_guard.c — a deadline for every request: its head and body must have
+ * arrived within --request-deadline seconds, however slowly the bytes trickle.
+ *
+ * Why: libmicrohttpd's connection timeout is an idle timeout, which a client
+ * sending one byte every few seconds resets forever; 600 such sockets held
+ * every connection slot and /livez stopped answering.  The per-client
+ * connection limit (MHD_OPTION_PER_IP_CONNECTION_LIMIT, set in http.c) keeps
+ * one client from taking every slot; this file bounds how long any slot is
+ * held by a request that is not complete.
+ *
+ * How: libmicrohttpd tells us of every connection (MHD_OPTION_NOTIFY_CONNECTION);
+ * each gets a guard record in a list, with its socket and a deadline:
+ *   - connection accepted, or the previous request on it answered: now + D
+ *     (the next request's head and body must be in by then; an idle
+ *     keep-alive connection is closed then too);
+ *   - the request is complete and being answered (?wait, a large result):
+ *     no deadline (the idle timeout still applies to a reader that stops).
+ * A guard thread wakes once a second and shuts down (shutdown(2), not
+ * close) the socket of every record past its deadline; the connection's own
+ * thread then sees the end of the stream and libmicrohttpd closes it.  The
+ * record is removed under the same lock in the CLOSED notification, which
+ * libmicrohttpd sends before it closes the socket, so the guard never
+ * touches a descriptor that was closed and reused.
+ */
+#include "http_internal.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <time.h>
+
+#include "log.h"
+
+/* One connection: its socket and deadline; a node of http->conns. */
+struct http_conn {
+    int fd;                  /* the connection's socket */
+    double deadline;         /* monotonic s; 0 = none (a request is being answered) */
+    int expired;             /* 1 once the guard shut the socket down */
+    struct http_conn *prev, *next;
+};
+
+/* MHD_OPTION_NOTIFY_CONNECTION: track connections from accept to close. */
+void http_guard_notify(void *cls, struct MHD_Connection *c, void **socket_context,
+                       enum MHD_ConnectionNotificationCode code)
+{
+    http *h = cls;
+    http_conn *k = *socket_context;
+    const union MHD_ConnectionInfo *ci;
+
+    if (code == MHD_CONNECTION_NOTIFY_STARTED) {
+        ci = MHD_get_connection_info(c, MHD_CONNECTION_INFO_CONNECTION_FD);
+        k = calloc(1, sizeof(*k));
+        if (!k || !ci) { /* untracked: only the idle timeout applies */
+            free(k);
+            return;
+        }
+        k->fd = ci->connect_fd;
+        pthread_mutex_lock(&h->guard_lock);
+        k->deadline = http_mono() + h->request_deadline;
+        k->next = h->conns;
+        if (h->conns)
+            h->conns->prev = k;
+        h->conns = k;
+        pthread_mutex_unlock(&h->guard_lock);
+        *socket_context = k;
+        return;
+    }
+    if (!k)
+        return;
+    pthread_mutex_lock(&h->guard_lock);
+    if (k->prev)
+        k->prev->next = k->next;
+    else
+        h->conns = k->next;
+    if (k->next)
+        k->next->prev = k->prev;
+    pthread_mutex_unlock(&h->guard_lock);
+    free(k);
+    *socket_context = NULL;
+}
+
+/* The guard record of connection c, or NULL when it is not tracked. */
+static http_conn *http_guard_of(struct MHD_Connection *c)
+{
+    const union MHD_ConnectionInfo *ci =
+        MHD_get_connection_info(c, MHD_CONNECTION_INFO_SOCKET_CONTEXT);
+
+    return ci ? ci->socket_context : NULL;
+}
+
+void http_guard_answering(http *h, struct MHD_Connection *c)
+{
+    http_conn *k = http_guard_of(c);
+
+    if (!k)
+        return;
+    pthread_mutex_lock(&h->guard_lock);
+    k->deadline = 0.0;
+    pthread_mutex_unlock(&h->guard_lock);
+}
+
+void http_guard_answered(http *h, struct MHD_Connection *c)
+{
+    http_conn *k = c ? http_guard_of(c) : NULL;
+
+    if (!k)
+        return;
+    pthread_mutex_lock(&h->guard_lock);
+    if (!k->expired)
+        k->deadline = http_mono() + h->request_deadline;
+    pthread_mutex_unlock(&h->guard_lock);
+}
+
+/* Shut down the sockets past their deadline; returns how many. */
+static int http_guard_sweep(http *h, double now)
+{
+    http_conn *k;
+    int n = 0;
+
+    for (k = h->conns; k; k = k->next)
+        if (!k->expired && k->deadline > 0.0 && now > k->deadline) {
+            k->expired = 1;
+            shutdown(k->fd, SHUT_RDWR);
+            n++;
+        }
+    return n;
+}
+
+static void *http_guard_main(void *arg)
+{
+    http *h = arg;
+    struct timespec ts;
+    char count[16];
+    int n;
+
+    pthread_mutex_lock(&h->guard_lock);
+    while (!h->guard_stop) {
+        clock_gettime(CLOCK_REALTIME, &ts);
+        ts.tv_sec += 1;
+        pthread_cond_timedwait(&h->guard_cv, &h->guard_lock, &ts);
+        if (h->guard_stop)
+            break;
+        n = http_guard_sweep(h, http_mono());
+        if (n > 0) {
+            pthread_mutex_unlock(&h->guard_lock);
+            snprintf(count, sizeof(count), "%d", n);
+            log_event("warn", "request_deadline", "closed", count, "reason",
+                      "request head or body not complete within --request-deadline",
+                      (const char *)NULL);
+            metrics_deadline_closed(h->mx, n);
+            pthread_mutex_lock(&h->guard_lock);
+        }
+    }
+    pthread_mutex_unlock(&h->guard_lock);
+    return NULL;
+}
+
+int http_guard_start(http *h)
+{
+    if (pthread_create(&h->guard_thread, NULL, http_guard_main, h))
+        return HTTP_NOMEM;
+    h->guard_started = 1;
+    return HTTP_OK;
+}
+
+void http_guard_stop(http *h)
+{
+    if (!h->guard_started)
+        return;
+    pthread_mutex_lock(&h->guard_lock);
+    h->guard_stop = 1;
+    pthread_cond_broadcast(&h->guard_cv);
+    pthread_mutex_unlock(&h->guard_lock);
+    pthread_join(h->guard_thread, NULL);
+    h->guard_started = 0;
+}
