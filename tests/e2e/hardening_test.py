@@ -1,0 +1,216 @@
+#!/usr/bin/env python3
+"""Hardening tests of spinmodald (issue 10): slow clients, read authentication, CORS.
+
+usage: hardening_test.py SPINMODALD SCENARIO
+
+Each scenario starts its own daemon (tests/e2e/daemon.py) on 127.0.0.1:0 with a
+temporary database.  Waits are upper bounds that end as soon as the condition
+holds; none decides a pass by elapsed time.
+
+  slow_clients  600 sockets from 127.0.0.2 trickling a request head one byte
+                at a time cannot take every slot: the per-client limit refuses
+                most of them, /livez from 127.0.0.1 still answers while they
+                trickle, and the request deadline closes the trickling ones
+                (counted in /metrics) although bytes keep arriving.
+  auth_reads    with --auth-reads yes, reading jobs, /metrics and POST
+                /v1/validate need the token; probes and static files do not;
+                without a token file the flag is refused.
+  cors          --cors-origin accepts one exact origin only ('*', lists and
+                paths are refused at start); OPTIONS answers 204 on a route and
+                404 on an unknown path.
+"""
+import os
+import socket
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from daemon import Daemon  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+EXAMPLE = os.path.join(HERE, os.pardir, os.pardir, "examples", "angled-beam-90.json")
+SLOW = float(os.environ.get("SPINMODAL_TEST_SLOWNESS", "1") or "1")  # > 1 on a slow machine
+
+failures = []
+
+
+def check(ok, what):
+    print(("ok   " if ok else "FAIL ") + what)
+    if not ok:
+        failures.append(what)
+
+
+def wait_until(cond, limit):
+    """Poll cond() until it is true or limit seconds (times the slowness) pass; its last value."""
+    end = time.monotonic() + limit * SLOW
+    while True:
+        v = cond()
+        if v or time.monotonic() > end:
+            return v
+        time.sleep(0.1)
+
+
+def metric(d, name, headers=None):
+    r = d.get("/metrics", headers=headers or {})
+    for line in r.body.decode("utf-8", "replace").splitlines():
+        if line.startswith(name + " "):
+            return float(line.split()[1])
+    return None
+
+
+def connect_from(source, port):
+    s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    s.bind((source, 0))
+    s.settimeout(5 * SLOW)
+    s.connect(("127.0.0.1", port))
+    return s
+
+
+def open_or_closed(s):
+    """'open' when the peer has not closed s, else 'closed'."""
+    s.setblocking(False)
+    try:
+        data = s.recv(4096)
+        return "closed" if data == b"" else "open"
+    except BlockingIOError:
+        return "open"
+    except OSError:
+        return "closed"
+    finally:
+        s.setblocking(True)
+
+
+def scenario_slow_clients(exe, tmp):
+    per_client, deadline, n = 16, 3, 600
+    d = Daemon(exe, tmp, ["--workers", "1", "--max-connections-per-client", str(per_client),
+                          "--request-deadline", str(deadline)])
+    d.start()
+    port = d.port
+    socks = []
+    head = b"GET /livez HTTP/1.1\r\nHost: x\r\nX-Slow: "
+    try:
+        for _ in range(n):
+            try:
+                s = connect_from("127.0.0.2", port)
+                s.send(head[:1])
+                socks.append(s)
+            except OSError:
+                pass
+        time.sleep(0.5)
+        held = [s for s in socks if open_or_closed(s) == "open"]
+        check(len(held) <= per_client,
+              "per-client limit: %d of %d connections from one address stay open (limit %d)"
+              % (len(held), n, per_client))
+        r = d.get("/livez", timeout=10 * SLOW)
+        check(r.status == 200, "/livez from another address answers while %d trickle (got %s)"
+              % (len(held), r.status))
+        # keep trickling one byte per second into the held connections until
+        # the deadline closes them all
+        sent = 1
+
+        def all_closed():
+            nonlocal sent
+            alive = 0
+            for s in held:
+                if open_or_closed(s) == "open":
+                    try:
+                        s.send(head[sent:sent + 1] if sent < len(head) else b"a")
+                        alive += 1
+                    except OSError:
+                        pass
+            sent += 1
+            time.sleep(1.0)
+            return alive == 0
+        closed = wait_until(all_closed, 10 * deadline)
+        check(closed, "every trickling connection is closed by the %d s request deadline "
+              "although a byte arrives every second" % deadline)
+        got = metric(d, "spinmodal_http_deadline_closed_total")
+        check(got is not None and got >= len(held),
+              "spinmodal_http_deadline_closed_total counts them (%s >= %d)" % (got, len(held)))
+        check(wait_until(lambda: d.log_count() and any("request_deadline" in l for l in d.log_lines()), 5),
+              "the closures are logged (event=request_deadline)")
+        # a normal client is not hurt: a full request within the deadline works
+        r = d.request("POST", "/v1/validate", body=open(EXAMPLE, "rb").read(),
+                      headers={"Content-Type": "application/json"})
+        check(r.status == 200, "a normal POST /v1/validate still answers 200 (got %s)" % r.status)
+    finally:
+        for s in socks:
+            s.close()
+    check(d.stop() == 0, "daemon stops cleanly")
+
+
+def scenario_auth_reads(exe, tmp):
+    token = os.path.join(tmp, "token")
+    with open(token, "w") as f:
+        f.write("s3cret\n")
+    p = subprocess.run([exe, "--auth-reads", "yes"], capture_output=True, text=True, timeout=30)
+    check(p.returncode == 64 and "--token-file" in p.stderr,
+          "--auth-reads yes without a token is a usage error naming --token-file (exit %d)"
+          % p.returncode)
+    d = Daemon(exe, tmp, ["--workers", "1", "--token-file", token, "--auth-reads", "yes"])
+    d.start()
+    auth = {"Authorization": "Bearer s3cret"}
+    body = open(EXAMPLE, "rb").read()
+    js = {"Content-Type": "application/json"}
+    r = d.request("POST", "/v1/analyses", body=body, headers=dict(js, **auth))
+    check(r.status in (200, 202), "POST with the token is accepted (%s)" % r.status)
+    job = r.json()["id"]
+    for path in ("/v1/analyses", "/v1/analyses/" + job, "/v1/analyses/" + job + "/result",
+                 "/metrics"):
+        r = d.get(path)
+        check(r.status == 401 and r.headers.get("WWW-Authenticate"),
+              "GET %s without the token: 401 with WWW-Authenticate (got %s)" % (path, r.status))
+        r = d.get(path, headers={"Authorization": "Bearer wrong"})
+        check(r.status == 401, "GET %s with a wrong token: 401 (got %s)" % (path, r.status))
+    r = d.get("/v1/analyses/" + job + "?wait=30", headers=auth)
+    check(r.status == 200, "GET of the job with the token: 200 (got %s)" % r.status)
+    r = d.request("POST", "/v1/validate", body=body, headers=js)
+    check(r.status == 401 and job.encode() not in r.body,
+          "POST /v1/validate without the token: 401, no job id revealed (got %s)" % r.status)
+    r = d.request("POST", "/v1/validate", body=body, headers=dict(js, **auth))
+    check(r.status == 200 and r.json().get("id") == job,
+          "POST /v1/validate with the token: 200 with the id (got %s)" % r.status)
+    for path in ("/livez", "/readyz", "/openapi.json", "/v1/schemas/request"):
+        r = d.get(path)
+        check(r.status == 200, "GET %s needs no token (probes, documents): %s" % (path, r.status))
+    check(d.stop() == 0, "daemon stops cleanly")
+    # without --auth-reads, reads stay open (today's behaviour)
+    d2 = Daemon(exe, tmp, ["--workers", "1", "--token-file", token], name="open-reads")
+    d2.start()
+    r = d2.get("/v1/analyses")
+    check(r.status == 200, "without --auth-reads a read needs no token (%s)" % r.status)
+    check(d2.stop() == 0, "second daemon stops cleanly")
+
+
+def scenario_cors(exe, tmp):
+    for bad in ("*", "https://a.example, https://b.example", "https://a.example/path",
+                "a.example", "ftp://a.example", ""):
+        p = subprocess.run([exe, "--cors-origin", bad], capture_output=True, text=True,
+                           timeout=30)
+        check(p.returncode == 64 and "--cors-origin" in p.stderr,
+              "--cors-origin %r refused at start (exit %d)" % (bad, p.returncode))
+    d = Daemon(exe, tmp, ["--workers", "1", "--cors-origin", "http://localhost:5173"])
+    d.start()
+    r = d.request("OPTIONS", "/v1/analyses", headers={"Origin": "http://localhost:5173"})
+    check(r.status == 204 and r.headers.get("Access-Control-Allow-Origin") ==
+          "http://localhost:5173", "OPTIONS on a route: 204 with the origin (got %s)" % r.status)
+    r = d.request("OPTIONS", "/no/such/path", headers={"Origin": "http://localhost:5173"})
+    check(r.status == 404, "OPTIONS on an unknown path: 404, not 204 (got %s)" % r.status)
+    check(d.stop() == 0, "daemon stops cleanly")
+
+
+def main():
+    exe, name = sys.argv[1], sys.argv[2]
+    with tempfile.TemporaryDirectory(prefix="spinmodal-hardening-") as tmp:
+        globals()["scenario_" + name](exe, tmp)
+    if failures:
+        print("%d failed" % len(failures))
+        return 1
+    print("all passed")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
