@@ -99,14 +99,7 @@ static double eq_residual(const sm_model *m, const double *q, double s, eq_ws *w
 static int eq_tangent(const sm_model *m, const double *q, double s, eq_ws *w)
 {
     int n = m->n;
-    lin_mass(m, &w->kin, &w->M, &w->W);
-    dm_zero(&w->H);
-    frames_hessian(m, q, &w->kin, &w->H, w->work);
-    for (size_t i = 0; i < (size_t)n * n; i++)
-        w->Kt.a[i] = -s * (w->M.a[i] + w->H.a[i]);
-    lin_elastic_add(m, &w->Kt);
-    if (m->opt.geometric_stiffening)
-        lin_geometric_tangent(m, q, 0, &w->Kt, w->work);
+    lin_tangent(m, q, &w->kin, s, 0, &w->Kt, &w->M, &w->H, &w->W, w->work);
     return LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, n, n, w->Kt.a, n, w->ipiv) == 0 ? SM_OK : SM_SINGULAR;
 }
 

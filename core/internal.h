@@ -130,6 +130,8 @@ void lin_elastic_force(const sm_model *m, const double *q, double *f);
 void lin_elastic_add(const sm_model *m, dmat *Kt);
 void lin_mass(const sm_model *m, const sm_kin *k, dmat *M, dmat *W);
 void lin_gyro(const sm_model *m, const sm_kin *k, double omega, dmat *C, dmat *W, dmat *X);
+void lin_tangent(const sm_model *m, const double *q, const sm_kin *k, double s, int frozen, dmat *Kt,
+                 dmat *M, dmat *H, dmat *W, double *work);
 
 /* ------------------------------------------------------- equilibrium.c */
 typedef struct sm_eq_out {

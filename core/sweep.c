@@ -80,16 +80,9 @@ static void sweep_linearize(const sm_model *m, const double *q, double omega, sw
     int n = m->n;
     double s = omega * omega;
     frames_eval(m, q, &L->kin);
-    lin_mass(m, &L->kin, &L->M, &L->W);
+    lin_tangent(m, q, &L->kin, s, 1, &L->K, &L->M, &L->H, &L->W, L->work); /* K*, P frozen; M* */
     if (m->opt.coriolis)
         lin_gyro(m, &L->kin, omega, &L->C, &L->W, &L->X);
-    dm_zero(&L->H);
-    frames_hessian(m, q, &L->kin, &L->H, L->work);
-    for (size_t i = 0; i < (size_t)n * n; i++)
-        L->K.a[i] = -s * (L->M.a[i] + L->H.a[i]);
-    lin_elastic_add(m, &L->K);
-    if (m->opt.geometric_stiffening)
-        lin_geometric_tangent(m, q, 1, &L->K, L->work);
     for (int j = 0; j < n; j++) /* symmetric up to round-off: make it exact */
         for (int i = 0; i < j; i++)
             DM(&L->K, i, j) = DM(&L->K, j, i) = 0.5 * (DM(&L->K, i, j) + DM(&L->K, j, i));
