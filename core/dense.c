@@ -1,9 +1,11 @@
 /*
- * dense.c — storage helpers for the column-major dmat used by the core.
+ * dense.c — storage helpers for the column-major dmat used by the core, and
+ * the one mapping from LAPACK info values to sm_status.
  */
 #include "dense.h"
 #include "spinmodal.h"
 
+#include <lapacke.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -50,4 +52,13 @@ double dm_norm(const double *x, int n)
         }
     }
     return scale * sqrt(ssq);
+}
+
+int dm_lapack_status(int info, int on_positive)
+{
+    if (info == 0)
+        return SM_OK;
+    if (info == LAPACK_WORK_MEMORY_ERROR)
+        return SM_NOMEM;
+    return info < 0 ? SM_LAPACK_FAILED : on_positive;
 }

@@ -108,8 +108,8 @@ static int modes_lumped(const sm_model *m, sm_sub *b, const dmat *K)
     for (int i = 0; i < F; i++)
         for (int j = 0; j < T; j++)
             DM(&X, i, j) = -DM(K, 3 * i + 2, 3 * (j / 2) + j % 2);
-    rc = SM_SINGULAR;
-    if (LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', F, T, Krr.a, F, X.a, F) != 0)
+    rc = dm_lapack_status(LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', F, T, Krr.a, F, X.a, F), SM_SINGULAR);
+    if (rc < 0)
         goto done;
     /* Kc = Ktt + Ktr X, scaled: D^-1/2 Kc D^-1/2 with D the node masses */
     for (int i = 0; i < T; i++)
@@ -121,8 +121,8 @@ static int modes_lumped(const sm_model *m, sm_sub *b, const dmat *K)
                 s += DM(K, 3 * (i / 2) + i % 2, 3 * p + 2) * DM(&X, p, j);
             DM(&Kc, i, j) = s * sq[i] * sq[j];
         }
-    rc = SM_LAPACK_FAILED;
-    if (LAPACKE_dsyevd(LAPACK_COL_MAJOR, 'V', 'U', T, Kc.a, T, w) != 0)
+    rc = dm_lapack_status(LAPACKE_dsyevd(LAPACK_COL_MAJOR, 'V', 'U', T, Kc.a, T, w), SM_LAPACK_FAILED);
+    if (rc < 0)
         goto done;
     rc = SM_NOMEM;
     b->m = nm + na;
@@ -153,8 +153,9 @@ static int modes_lumped(const sm_model *m, sm_sub *b, const dmat *K)
             for (int a = 0; a < na; a++)
                 DM(&Y, i, a) = -DM(K, 3 * cidx[i] + 2, 3 * b->attach[a] + 2);
         }
-        rc = SM_SINGULAR;
-        if (nc > 0 && LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', nc, na, Kcc.a, nc, Y.a, nc) != 0)
+        if (nc > 0 &&
+            (rc = dm_lapack_status(LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', nc, na, Kcc.a, nc, Y.a, nc),
+                                   SM_SINGULAR)) < 0)
             goto done;
         for (int a = 0; a < na; a++) {
             DM(&b->N, 3 * b->attach[a] + 2, nm + a) = 1.0;
@@ -187,8 +188,10 @@ static int modes_consistent(const sm_model *m, sm_sub *b, const dmat *K, const d
         goto done;
     memcpy(A.a, K->a, (size_t)D * D * sizeof(double));
     memcpy(B.a, M->a, (size_t)D * D * sizeof(double));
-    rc = SM_LAPACK_FAILED;
-    if (LAPACKE_dsygvd(LAPACK_COL_MAJOR, 1, 'V', 'U', D, A.a, D, B.a, D, w) != 0)
+    /* info > D: the mass matrix is not positive definite; 0 < info <= D: no convergence */
+    int info = LAPACKE_dsygvd(LAPACK_COL_MAJOR, 1, 'V', 'U', D, A.a, D, B.a, D, w);
+    rc = dm_lapack_status(info, info > D ? SM_SINGULAR : SM_LAPACK_FAILED);
+    if (rc < 0)
         goto done;
     rc = SM_NOMEM;
     b->m = nm + na;
@@ -202,8 +205,8 @@ static int modes_consistent(const sm_model *m, sm_sub *b, const dmat *K, const d
         double *rhs = b->N.a + (size_t)D * nm;
         for (int a = 0; a < na; a++)
             rhs[(size_t)D * a + 3 * b->attach[a] + 2] = 1.0;
-        rc = SM_SINGULAR;
-        if (LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', D, na, F.a, D, rhs, D) != 0)
+        rc = dm_lapack_status(LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', D, na, F.a, D, rhs, D), SM_SINGULAR);
+        if (rc < 0)
             goto done;
         /* M-orthogonalise each static mode against the kept modes and earlier ones */
         for (int a = 0; a < nm + na; a++) {
