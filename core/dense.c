@@ -54,6 +54,15 @@ double dm_norm(const double *x, int n)
     return scale * sqrt(ssq);
 }
 
+int dm_finite(const dmat *m)
+{
+    size_t n = (size_t)m->rows * (size_t)m->cols;
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(m->a[i]))
+            return 0;
+    return 1;
+}
+
 int dm_lapack_status(int info, int on_positive)
 {
     if (info == 0)

@@ -26,6 +26,8 @@ void dm_zero(dmat *m);
 double *dm_vec(size_t n);
 /** Euclidean norm of x[0..n). */
 double dm_norm(const double *x, int n);
+/** 1 when every entry of m is finite (no NaN, no infinity), else 0. */
+int dm_finite(const dmat *m);
 /**
  * The sm_status of a LAPACKE call's info: 0 -> SM_OK; LAPACK_WORK_MEMORY_ERROR
  * (a high-level LAPACKE wrapper could not allocate its workspace) -> SM_NOMEM;

@@ -204,7 +204,10 @@ typedef int (*sm_progress_fn)(void *user, int done, int total);
 typedef enum sm_case_status {
     SM_CASE_SOLVED = 0,       /* equilibrium found, steady state stable */
     SM_CASE_UNSTABLE,         /* equilibrium found, K* has negative eigenvalues or Re(lambda) > 0 */
-    SM_CASE_NO_EQUILIBRIUM    /* continuation/Newton failed: see diagnostics */
+    SM_CASE_NO_EQUILIBRIUM,   /* continuation/Newton failed: see diagnostics */
+    SM_CASE_EIGEN_FAILED      /* equilibrium found (converged = 1, its fields filled), but the
+                                 eigen-analysis failed: message says why; no modes, and the
+                                 stability fields are 0 (unknown) */
 } sm_case_status;
 
 /* Inside a frame the kinematics are linear (small rotations).  An
@@ -255,7 +258,9 @@ typedef struct sm_result {
  * Solve at each speed of omegas (rad/s, finite, >= 0 in any order: they are
  * processed in ascending order with continuation, reported in input order).
  * A speed without equilibrium is a reported case (SM_CASE_NO_EQUILIBRIUM),
- * not an error; continuation restarts from rest for the next speed.
+ * not an error; continuation restarts from rest for the next speed.  An
+ * eigen-analysis that fails at a converged equilibrium is a reported case too
+ * (SM_CASE_EIGEN_FAILED); continuation goes on from that equilibrium.
  * Returns SM_OK (every case has a status), SM_CANCELED, SM_NOMEM,
  * SM_INVALID_INPUT (bad speeds) or SM_LAPACK_FAILED.  *out is set only on
  * SM_OK and is owned by the caller (sm_result_free).  cb and diag may be NULL.
