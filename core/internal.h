@@ -97,6 +97,7 @@ int mesh_build(sm_model *m, const sm_structure *st, sm_diag *diag);
 
 /* ------------------------------------------------------------- modes.c */
 int modes_build(sm_model *m, sm_diag *diag);
+int modes_count(const sm_options *o, const sm_sub *b, int *nm, int *na);
 
 /* ------------------------------------------------------------ frames.c */
 /* Kinematic state at q: frames, point positions and Jacobians. */

@@ -39,6 +39,8 @@ static int mesh_positive(double v)
 /* Check numbers, indices and options; topology is checked by mesh_walk. */
 static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
 {
+    if (!st)
+        return mesh_fail(d, SM_ITEM_NONE, -1, "", "no structure");
     if (st->n_joints < 1 || st->n_joints > MESH_MAX_ITEMS || !st->joint_xy)
         return mesh_fail(d, SM_ITEM_NONE, -1, "", "the structure has no joints");
     if (st->n_members < 1 || st->n_members > MESH_MAX_ITEMS || !st->members)

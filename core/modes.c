@@ -79,6 +79,29 @@ static void modes_assemble(const sm_model *m, const sm_sub *b, dmat *K, dmat *M)
         }
 }
 
+/**
+ * The number of modal coordinates substructure b gets under the options,
+ * from its topology alone (nfree, n_attach): *nm component modes plus *na
+ * attachment columns; returns *nm + *na.  Lumped mass: 2F condensed modes
+ * (F free nodes), truncated to modes_per_frame, plus the attachment nodes for
+ * the augmented basis.  Consistent mass: 3F modes, truncated, plus static
+ * attachment modes for the augmented basis only when truncated (the full
+ * basis already spans them).  modes_lumped/modes_consistent size N with it,
+ * and sm_structure_check predicts the model's sizes with it.
+ */
+int modes_count(const sm_options *o, const sm_sub *b, int *nm, int *na)
+{
+    int full = o->mass == SM_MASS_CONSISTENT ? 3 * b->nfree : 2 * b->nfree;
+    *nm = o->modes_per_frame > 0 && o->modes_per_frame < full ? o->modes_per_frame : full;
+    if (o->basis != SM_BASIS_AUGMENTED)
+        *na = 0;
+    else if (o->mass == SM_MASS_CONSISTENT)
+        *na = *nm < full ? b->n_attach : 0;
+    else
+        *na = b->n_attach;
+    return *nm + *na;
+}
+
 static int modes_is_attach(const sm_sub *b, int i)
 {
     for (int a = 0; a < b->n_attach; a++)
@@ -93,9 +116,8 @@ static int modes_is_attach(const sm_sub *b, int i)
  */
 static int modes_lumped(const sm_model *m, sm_sub *b, const dmat *K)
 {
-    int F = b->nfree, T = 2 * F, rc = SM_NOMEM;
-    int nm = m->opt.modes_per_frame > 0 && m->opt.modes_per_frame < T ? m->opt.modes_per_frame : T;
-    int na = m->opt.basis == SM_BASIS_AUGMENTED ? b->n_attach : 0;
+    int F = b->nfree, T = 2 * F, rc = SM_NOMEM, nm, na;
+    modes_count(&m->opt, b, &nm, &na);
     dmat Krr = {0}, X = {0}, Kc = {0}, Kcc = {0}, Y = {0};
     double *w = dm_vec((size_t)T), *sq = dm_vec((size_t)T);
     int *cidx = malloc((size_t)F * sizeof(int));
@@ -179,9 +201,8 @@ done:
 /* Consistent mass: modes of the full substructure (+ static attachment modes). */
 static int modes_consistent(const sm_model *m, sm_sub *b, const dmat *K, const dmat *M)
 {
-    int D = 3 * b->nfree, rc = SM_NOMEM;
-    int nm = m->opt.modes_per_frame > 0 && m->opt.modes_per_frame < D ? m->opt.modes_per_frame : D;
-    int na = (m->opt.basis == SM_BASIS_AUGMENTED && nm < D) ? b->n_attach : 0;
+    int D = 3 * b->nfree, rc = SM_NOMEM, nm, na;
+    modes_count(&m->opt, b, &nm, &na);
     dmat A = {0}, B = {0}, F = {0};
     double *w = dm_vec((size_t)D), *mx = dm_vec((size_t)D);
     if (!w || !mx || dm_alloc(&A, D, D) || dm_alloc(&B, D, D))
