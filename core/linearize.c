@@ -190,7 +190,7 @@ void lin_gyro(const sm_model *m, const sm_kin *k, double omega, dmat *C, dmat *W
  * in k (frames_eval): the Newton tangent of F (frozen = 0, equilibrium.c) or
  * the paper's K* with P_e frozen at P_e(q) (frozen != 0, eq. 44, sweep.c).
  * Leaves M* (eq. 42) in M and the Hessian term H in H.  All matrices n x n,
- * W n x 2 n_mp scratch, work >= 4*max m_s + n doubles; nothing is allocated.
+ * W n x 2 n_mp scratch, work >= 4*max m_s doubles; nothing is allocated.
  */
 void lin_tangent(const sm_model *m, const double *q, const sm_kin *k, double s, int frozen, dmat *Kt,
                  dmat *M, dmat *H, dmat *W, double *work)
