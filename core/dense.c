@@ -1,9 +1,11 @@
 /*
- * dense.c — storage helpers for the column-major dmat used by the core.
+ * dense.c — storage helpers for the column-major dmat used by the core, and
+ * the one mapping from LAPACK info values to sm_status.
  */
 #include "dense.h"
 #include "spinmodal.h"
 
+#include <lapacke.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -50,4 +52,22 @@ double dm_norm(const double *x, int n)
         }
     }
     return scale * sqrt(ssq);
+}
+
+int dm_finite(const dmat *m)
+{
+    size_t n = (size_t)m->rows * (size_t)m->cols;
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(m->a[i]))
+            return 0;
+    return 1;
+}
+
+int dm_lapack_status(int info, int on_positive)
+{
+    if (info == 0)
+        return SM_OK;
+    if (info == LAPACK_WORK_MEMORY_ERROR)
+        return SM_NOMEM;
+    return info < 0 ? SM_LAPACK_FAILED : on_positive;
 }

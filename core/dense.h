@@ -26,5 +26,17 @@ void dm_zero(dmat *m);
 double *dm_vec(size_t n);
 /** Euclidean norm of x[0..n). */
 double dm_norm(const double *x, int n);
+/** 1 when every entry of m is finite (no NaN, no infinity), else 0. */
+int dm_finite(const dmat *m);
+/**
+ * The sm_status of a LAPACKE call's info: 0 -> SM_OK; LAPACK_WORK_MEMORY_ERROR
+ * (a high-level LAPACKE wrapper could not allocate its workspace) -> SM_NOMEM;
+ * any other negative value (an illegal argument, or a NaN found by LAPACKE's
+ * input check) -> SM_LAPACK_FAILED; a positive value -> on_positive, whose
+ * meaning depends on the routine (SM_SINGULAR for a factorisation that meets
+ * a zero pivot or a matrix that is not positive definite, SM_LAPACK_FAILED
+ * for an iteration that did not converge).
+ */
+int dm_lapack_status(int info, int on_positive);
 
 #endif

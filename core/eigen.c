@@ -32,17 +32,24 @@ void eig_out_free(sm_eig_out *o)
     memset(o, 0, sizeof *o);
 }
 
-/* Number of negative eigenvalues of the symmetric matrix A (n x n, destroyed). */
-static int eig_inertia(int n, double *A)
+/*
+ * *neg = number of negative eigenvalues of the symmetric matrix A (n x n,
+ * destroyed), from the Bunch-Kaufman factorisation (Sylvester's law of
+ * inertia).  A zero pivot (dsytrf info > 0) still completes the factorisation
+ * and counts as non-negative.  Returns SM_OK, SM_NOMEM or SM_LAPACK_FAILED.
+ */
+static int eig_inertia(int n, double *A, int *neg_out)
 {
+    *neg_out = 0;
     if (n == 0)
-        return 0;
+        return SM_OK;
     int *ipiv = malloc((size_t)n * sizeof(int)), neg = 0;
     if (!ipiv)
-        return -1;
-    if (LAPACKE_dsytrf(LAPACK_COL_MAJOR, 'L', n, A, n, ipiv) < 0) {
+        return SM_NOMEM;
+    int rc = dm_lapack_status(LAPACKE_dsytrf(LAPACK_COL_MAJOR, 'L', n, A, n, ipiv), SM_OK);
+    if (rc < 0) {
         free(ipiv);
-        return -1;
+        return rc;
     }
     for (int k = 0; k < n; k++) {
         double a = A[(size_t)k * n + k];
@@ -56,19 +63,24 @@ static int eig_inertia(int n, double *A)
         }
     }
     free(ipiv);
-    return neg;
+    *neg_out = neg;
+    return SM_OK;
 }
 
-/* Negative eigenvalue count of symmetric A; *chol receives 1 and the lower
- * Cholesky factor in L when A is positive definite. */
-static int eig_definite(int n, const double *A, double *L, int *chol)
+/* *neg = negative eigenvalue count of symmetric A; *chol receives 1 and the
+ * lower Cholesky factor in L when A is positive definite (then *neg = 0).
+ * Returns SM_OK, SM_NOMEM or SM_LAPACK_FAILED. */
+static int eig_definite(int n, const double *A, double *L, int *chol, int *neg)
 {
     memcpy(L, A, (size_t)n * n * sizeof(double));
-    *chol = n == 0 || LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', n, L, n) == 0;
-    if (*chol)
-        return 0;
+    *neg = 0;
+    *chol = 1;
+    int rc = n == 0 ? SM_OK : dm_lapack_status(LAPACKE_dpotrf_work(LAPACK_COL_MAJOR, 'L', n, L, n), SM_SINGULAR);
+    if (rc != SM_SINGULAR) /* SM_OK, or dpotrf itself failed */
+        return rc;
+    *chol = 0; /* not positive definite: count the negative eigenvalues */
     memcpy(L, A, (size_t)n * n * sizeof(double));
-    return eig_inertia(n, L);
+    return eig_inertia(n, L, neg);
 }
 
 typedef struct eig_split {
@@ -91,7 +103,9 @@ static void eig_split_free(eig_split *sp)
     free(sp->Kr);
 }
 
-/* Pivoted Cholesky of M, null space, condensation of K on it. */
+/* Pivoted Cholesky of M, null space, condensation of K on it.  Returns SM_OK,
+ * SM_NOMEM, SM_SINGULAR (M has no range at all, or K_zz is exactly singular)
+ * or SM_LAPACK_FAILED.  sp is filled even on failure (eig_split_free). */
 static int eig_condense(int n, const dmat *M, const dmat *K, eig_split *sp)
 {
     int rc = SM_NOMEM, rank = 0;
@@ -104,8 +118,12 @@ static int eig_condense(int n, const dmat *M, const dmat *K, eig_split *sp)
     double dmax = 0;
     for (int i = 0; i < n; i++)
         dmax = fmax(dmax, DM(M, i, i));
-    rc = SM_LAPACK_FAILED;
-    if (LAPACKE_dpstrf(LAPACK_COL_MAJOR, 'U', n, W, n, piv, &rank, 1e-10 * dmax) < 0 || rank < 1)
+    /* info > 0 only says M is rank deficient: expected (massless directions) */
+    rc = dm_lapack_status(LAPACKE_dpstrf(LAPACK_COL_MAJOR, 'U', n, W, n, piv, &rank, 1e-10 * dmax), SM_OK);
+    if (rc < 0)
+        goto done;
+    rc = SM_SINGULAR; /* no mass at all */
+    if (rank < 1)
         goto done;
     int r = rank, z = n - r;
     sp->r = r;
@@ -162,17 +180,20 @@ static int eig_condense(int n, const dmat *M, const dmat *K, eig_split *sp)
             for (int j = 0; j < z; j++)
                 sp->S[(size_t)i * z + j] = KZ[(size_t)j * n + sp->yi[i]];
         int chol;
-        sp->neg_zz = eig_definite(z, Kzz, Lzz, &chol);
-        rc = SM_SINGULAR;
-        if (chol) {
-            LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'L', z, r, Lzz, z, sp->S, z);
-        } else {
+        if ((rc = eig_definite(z, Kzz, Lzz, &chol, &sp->neg_zz)) < 0)
+            goto done;
+        if (chol) { /* S = Kzz^-1 S by the Cholesky factor */
+            rc = dm_lapack_status(LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'L', z, r, Lzz, z, sp->S, z),
+                                  SM_LAPACK_FAILED);
+        } else { /* indefinite: LU; an exactly singular Kzz is SM_SINGULAR */
             int *ip = malloc((size_t)z * sizeof(int));
-            int bad = !ip || LAPACKE_dgesv_work(LAPACK_COL_MAJOR, z, r, Kzz, z, ip, sp->S, z) != 0;
+            rc = ip ? dm_lapack_status(LAPACKE_dgesv_work(LAPACK_COL_MAJOR, z, r, Kzz, z, ip, sp->S, z),
+                                       SM_SINGULAR)
+                    : SM_NOMEM;
             free(ip);
-            if (bad)
-                goto done;
         }
+        if (rc < 0)
+            goto done;
         /* Kr -= K_yz S */
         for (int j = 0; j < r; j++)
             for (int i = 0; i < r; i++) {
@@ -233,9 +254,12 @@ static int eig_undamped(int n, const eig_split *sp, int k, sm_eig_out *o)
     memcpy(A, sp->Kr, (size_t)r * r * sizeof(double));
     cblas_dtrsm(CblasColMajor, CblasLeft, CblasUpper, CblasTrans, CblasNonUnit, r, r, 1.0, sp->U, r, A, r);
     cblas_dtrsm(CblasColMajor, CblasRight, CblasUpper, CblasNoTrans, CblasNonUnit, r, r, 1.0, sp->U, r, A, r);
-    rc = SM_LAPACK_FAILED;
-    if (LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', r, A, r, 0, 0, 1, k, 0.0, &found, w, V, r, sup) != 0 ||
-        found != k)
+    rc = dm_lapack_status(
+        LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', r, A, r, 0, 0, 1, k, 0.0, &found, w, V, r, sup),
+        SM_LAPACK_FAILED);
+    if (rc == SM_OK && found != k)
+        rc = SM_LAPACK_FAILED;
+    if (rc < 0)
         goto done;
     /* a = U^-1 v */
     cblas_dtrsm(CblasColMajor, CblasLeft, CblasUpper, CblasNoTrans, CblasNonUnit, r, k, 1.0, sp->U, r, V, r);
@@ -295,15 +319,18 @@ static int eig_skew_lowest(int r, const double *B, const double *G, int k, doubl
     int *sup = malloc(2 * (size_t)m2 * sizeof(int));
     if (!A || !ev || !V || !SV || !Yr || !Yi || !SYr || !SYi || !th || !T || !SY || !Q || !sup)
         goto done;
-    rc = SM_LAPACK_FAILED;
     /* lower triangle of S'S */
     cblas_dsyrk(CblasColMajor, CblasLower, CblasNoTrans, r, r, 1.0, B, r, 0.0, A, N2);
     cblas_dgemm(CblasColMajor, CblasNoTrans, CblasTrans, r, r, r, -1.0, G, r, B, r, 0.0, A + r, N2);
     cblas_dsyrk(CblasColMajor, CblasLower, CblasTrans, r, r, 1.0, B, r, 0.0, A + (size_t)r * N2 + r, N2);
     cblas_dsyrk(CblasColMajor, CblasLower, CblasTrans, r, r, 1.0, G, r, 1.0, A + (size_t)r * N2 + r, N2);
-    if (LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', N2, A, N2, 0, 0, 1, m2, 0.0, &found, ev, V, N2, sup) !=
-            0 ||
-        found != m2)
+    rc = dm_lapack_status(
+        LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', N2, A, N2, 0, 0, 1, m2, 0.0, &found, ev, V, N2, sup),
+        SM_LAPACK_FAILED);
+    if (rc < 0)
+        goto done;
+    rc = SM_LAPACK_FAILED; /* from here on: the caller falls back to zheevr */
+    if (found != m2)
         goto done;
     eig_skew_apply(r, B, G, m2, V, SV);
     /* candidates y = v - i S v / w, orthonormalised (twice) against the accepted ones */
@@ -353,7 +380,10 @@ static int eig_skew_lowest(int r, const double *B, const double *G, int k, doubl
     }
     const double complex one = 1, zero = 0;
     cblas_zgemm(CblasColMajor, CblasConjTrans, CblasNoTrans, k, k, N2, &one, Q, N2, SY, N2, &zero, T, k);
-    if (LAPACKE_zheev(LAPACK_COL_MAJOR, 'V', 'L', k, T, k, th) != 0 || !(th[0] > 0))
+    rc = dm_lapack_status(LAPACKE_zheev(LAPACK_COL_MAJOR, 'V', 'L', k, T, k, th), SM_LAPACK_FAILED);
+    if (rc == SM_OK && !(th[0] > 0))
+        rc = SM_LAPACK_FAILED;
+    if (rc < 0)
         goto done;
     cblas_zgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, N2, k, k, &one, Q, N2, T, k, &zero, Y, N2);
     memcpy(w, th, (size_t)k * sizeof(double));
@@ -391,10 +421,12 @@ static int eig_skew_zheevr(int r, const double *B, const double *G, int k, doubl
             if (i >= j)
                 H[(size_t)(r + j) * N2 + (r + i)] = I * G[(size_t)j * r + i]; /* (r+i, r+j) */
         }
-    rc = SM_LAPACK_FAILED;
-    if (LAPACKE_zheevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', N2, H, N2, 0, 0, r + 1, r + k, 0.0, &found, wall,
-                       Y, N2, sup) != 0 ||
-        found != k)
+    rc = dm_lapack_status(LAPACKE_zheevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', N2, H, N2, 0, 0, r + 1, r + k, 0.0,
+                                         &found, wall, Y, N2, sup),
+                          SM_LAPACK_FAILED);
+    if (rc == SM_OK && found != k)
+        rc = SM_LAPACK_FAILED;
+    if (rc < 0)
         goto done;
     memcpy(w, wall, (size_t)k * sizeof(double));
     rc = SM_OK;
@@ -481,14 +513,18 @@ static int eig_gyro_general(int n, const eig_split *sp, const double *Cy, int k,
             T[(size_t)j * r + i] = sp->Kr[(size_t)j * r + i];
             T[(size_t)(r + j) * r + i] = Cy[(size_t)j * r + i];
         }
-    LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'U', r, N2, sp->U, r, T, r);
+    rc = dm_lapack_status(LAPACKE_dpotrs_work(LAPACK_COL_MAJOR, 'U', r, N2, sp->U, r, T, r),
+                          SM_LAPACK_FAILED);
+    if (rc < 0)
+        goto done;
     for (int i = 0; i < r; i++) {
         A[(size_t)(r + i) * N2 + i] = 1.0;
         for (int j = 0; j < N2; j++)
             A[(size_t)j * N2 + r + i] = -T[(size_t)j * r + i];
     }
-    rc = SM_LAPACK_FAILED;
-    if (LAPACKE_dgeev(LAPACK_COL_MAJOR, 'N', 'V', N2, A, N2, wr, wi, NULL, 1, VR, N2) != 0)
+    rc = dm_lapack_status(LAPACKE_dgeev(LAPACK_COL_MAJOR, 'N', 'V', N2, A, N2, wr, wi, NULL, 1, VR, N2),
+                          SM_LAPACK_FAILED);
+    if (rc < 0)
         goto done;
     o->max_re = -INFINITY;
     for (int j = 0; j < N2; j++) {
@@ -558,7 +594,9 @@ int eig_solve(int n, const dmat *M, const dmat *C, const dmat *K, int coriolis, 
     Cy = dm_vec((size_t)r * r);
     if (!L || !Cy)
         goto done;
-    int neg = eig_definite(r, sp.Kr, L, &chol);
+    int neg = 0;
+    if ((rc = eig_definite(r, sp.Kr, L, &chol, &neg)) < 0)
+        goto done;
     out->negative = sp.neg_zz + neg;
     if (!coriolis) {
         rc = eig_undamped(n, &sp, k, out);
@@ -569,6 +607,8 @@ int eig_solve(int n, const dmat *M, const dmat *C, const dmat *K, int coriolis, 
         rc = chol ? eig_gyro_hermitian(n, &sp, L, Cy, k, out) : eig_gyro_general(n, &sp, Cy, k, out);
     }
 done:
+    if (rc < 0)
+        eig_out_free(out); /* no partial results */
     free(L);
     free(Cy);
     eig_split_free(&sp);

@@ -95,19 +95,21 @@ static double eq_residual(const sm_model *m, const double *q, double s, eq_ws *w
     return dm_norm(w->F, n);
 }
 
-/* Kt = K + df_g/dq - s (M* + H) at the kinematics in w->kin, then LU. */
+/* Kt = K + df_g/dq - s (M* + H) at the kinematics in w->kin, then LU.
+ * Returns SM_OK, SM_SINGULAR (an exactly zero pivot: no usable LU) or
+ * SM_LAPACK_FAILED. */
 static int eq_tangent(const sm_model *m, const double *q, double s, eq_ws *w)
 {
     int n = m->n;
-    lin_mass(m, &w->kin, &w->M, &w->W);
-    dm_zero(&w->H);
-    frames_hessian(m, q, &w->kin, &w->H, w->work);
-    for (size_t i = 0; i < (size_t)n * n; i++)
-        w->Kt.a[i] = -s * (w->M.a[i] + w->H.a[i]);
-    lin_elastic_add(m, &w->Kt);
-    if (m->opt.geometric_stiffening)
-        lin_geometric_tangent(m, q, 0, &w->Kt, w->work);
-    return LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, n, n, w->Kt.a, n, w->ipiv) == 0 ? SM_OK : SM_SINGULAR;
+    lin_tangent(m, q, &w->kin, s, 0, &w->Kt, &w->M, &w->H, &w->W, w->work);
+    return dm_lapack_status(LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, n, n, w->Kt.a, n, w->ipiv), SM_SINGULAR);
+}
+
+/* x = Kt^-1 x with the LU in w.  Returns SM_OK or SM_LAPACK_FAILED. */
+static int eq_lu_solve(eq_ws *w, int n, double *x)
+{
+    return dm_lapack_status(LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', n, 1, w->Kt.a, n, w->ipiv, x, n),
+                            SM_LAPACK_FAILED);
 }
 
 /* Sign of det(Kt) from its LU factors: a change between two converged
@@ -141,9 +143,11 @@ static int eq_progress(sm_progress *pr)
 }
 
 /*
- * Newton-Raphson at fixed s from q (in/out).  Returns 1 converged, 0 not,
- * -1 canceled.  On return w->kin holds the kinematics of q and w->Kt the LU
- * of a tangent at an iterate of this call.
+ * Newton-Raphson at fixed s from q (in/out).  Returns 1 converged, 0 not
+ * (including an exactly singular tangent), SM_CANCELED, or SM_LAPACK_FAILED
+ * when a factorisation or solve reports an error.  On return w->kin holds
+ * the kinematics of q and w->Kt the LU of a tangent at an iterate of this
+ * call.
  *
  * The first iteration factors the tangent at the starting point (so the LU
  * always belongs to the new s: the determinant-sign check and the next
@@ -155,7 +159,7 @@ static int eq_progress(sm_progress *pr)
  */
 static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progress *pr)
 {
-    int n = m->n, have_lu = 0;
+    int n = m->n, have_lu = 0, rc;
     double tol = m->opt.tolerance;
     double r = eq_residual(m, q, s, w), prev_step = INFINITY;
     for (int it = 0; it < m->opt.max_iterations; it++) {
@@ -166,7 +170,8 @@ static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progre
         if (have_lu) { /* chord step */
             for (int i = 0; i < n; i++)
                 w->dq[i] = -w->F[i];
-            LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', n, 1, w->Kt.a, n, w->ipiv, w->dq, n);
+            if ((rc = eq_lu_solve(w, n, w->dq)) < 0)
+                return rc;
             step = dm_norm(w->dq, n);
             for (int i = 0; i < n; i++)
                 w->qt[i] = q[i] + w->dq[i];
@@ -177,12 +182,13 @@ static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progre
                 r = eq_residual(m, q, s, w);
         }
         if (!have_lu) { /* full Newton step, damped: halve while the residual grows */
-            if (eq_tangent(m, q, s, w) != SM_OK)
-                return 0;
+            if ((rc = eq_tangent(m, q, s, w)) != SM_OK)
+                return rc == SM_SINGULAR ? 0 : rc;
             have_lu = fresh = 1;
             for (int i = 0; i < n; i++)
                 w->dq[i] = -w->F[i];
-            LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', n, 1, w->Kt.a, n, w->ipiv, w->dq, n);
+            if ((rc = eq_lu_solve(w, n, w->dq)) < 0)
+                return rc;
             step = dm_norm(w->dq, n);
             for (int tries = 0; tries < 8; tries++) {
                 for (int i = 0; i < n; i++)
@@ -197,7 +203,7 @@ static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progre
         w->iterations++;
         w->residual = rt;
         if (eq_progress(pr))
-            return -1;
+            return SM_CANCELED;
         if (!isfinite(rt) || dm_norm(q, n) > 1e12)
             return 0;
         if (alpha == 1.0 && step <= tol * qn)
@@ -212,16 +218,29 @@ static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progre
     return 0;
 }
 
+/* Factor the tangent at (q, s) after a residual evaluation there: *have_lu
+ * receives 1 when an LU is usable (0 for an exactly singular tangent).
+ * Returns SM_OK or SM_LAPACK_FAILED. */
+static int eq_restart(const sm_model *m, const double *q, double s, eq_ws *w, int *have_lu)
+{
+    eq_residual(m, q, s, w);
+    int rc = eq_tangent(m, q, s, w);
+    *have_lu = rc == SM_OK;
+    return rc == SM_SINGULAR ? SM_OK : rc;
+}
+
 /*
  * Continuation from (q, s_from) to s_to in s = Omega^2.  q is the converged
  * state at s_from (zero at rest).  On success q is the equilibrium at s_to.
  * On failure q is the last converged state and out->last_s its s.
+ * Returns SM_OK (whether or not it converged: see out), SM_NOMEM or
+ * SM_LAPACK_FAILED (a LAPACK error, not a property of the structure).
  */
 int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_rest,
              sm_progress *pr, sm_eq_out *out)
 {
     eq_ws w;
-    int n = m->n, rc = eq_ws_alloc(m, &w), incr = 0;
+    int n = m->n, rc = eq_ws_alloc(m, &w), incr = 0, have_lu = 0;
     memset(out, 0, sizeof *out);
     out->last_s = s_from;
     if (rc < 0)
@@ -231,8 +250,8 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
     double h = hmax, hmin = 1e-7 * fmax(s_to, 1e-12), s = s_from;
     const char *why = "";
     /* tangent at the start for the first predictor */
-    eq_residual(m, q, s, &w);
-    int have_lu = eq_tangent(m, q, s, &w) == SM_OK;
+    if ((rc = eq_restart(m, q, s, &w, &have_lu)) < 0)
+        goto fail;
     int sign = have_lu ? eq_det_sign(&w, n) : 1;
     while (s < s_to) {
         if (incr++ >= EQ_MAX_INCREMENTS || w.iterations >= EQ_MAX_TOTAL_ITER) {
@@ -247,17 +266,23 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
         memcpy(w.qp, q, (size_t)n * sizeof(double));
         if (have_lu) {
             memcpy(w.dq, w.g, (size_t)n * sizeof(double));
-            LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', n, 1, w.Kt.a, n, w.ipiv, w.dq, n);
+            if ((rc = eq_lu_solve(&w, n, w.dq)) < 0)
+                goto fail;
             for (int i = 0; i < n; i++)
                 w.qp[i] += (sn - s) * w.dq[i];
         }
         memcpy(q, w.qp, (size_t)n * sizeof(double));
         int it0 = w.iterations;
         int ok = eq_newton(m, q, sn, &w, pr);
-        if (ok < 0) {
+        if (ok == SM_CANCELED) {
             memcpy(q, w.q0, (size_t)n * sizeof(double));
             out->canceled = 1;
             break;
+        }
+        if (ok < 0) {
+            rc = ok;
+            memcpy(q, w.q0, (size_t)n * sizeof(double));
+            goto fail;
         }
         if (ok) {
             /* branch check: the corrector must stay within the predicted step */
@@ -290,8 +315,8 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
                 h = fmin(2.0 * h, hmax);
         } else {
             memcpy(q, w.q0, (size_t)n * sizeof(double));
-            eq_residual(m, q, s, &w);
-            have_lu = eq_tangent(m, q, s, &w) == SM_OK;
+            if ((rc = eq_restart(m, q, s, &w, &have_lu)) < 0)
+                goto fail;
             h *= 0.5;
             if (h < hmin)
                 break;
@@ -306,4 +331,10 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
                  sqrt(out->last_s), sqrt(s_to), why);
     eq_ws_free(&w);
     return SM_OK;
+fail:
+    out->iterations = w.iterations;
+    snprintf(out->message, sizeof out->message, "equilibrium at Omega = %.6g rad/s: %s", sqrt(s_to),
+             sm_strerror(rc));
+    eq_ws_free(&w);
+    return rc;
 }

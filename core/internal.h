@@ -9,6 +9,12 @@
  * global modal coordinate vector q is the concatenation of the substructure
  * coordinates q_s in substructure order, and substructures are numbered so
  * that a parent always comes before its children.
+ *
+ * Every cross-module function is declared here with a doc comment: pointer
+ * arguments are borrowed (the caller keeps ownership) unless the comment says
+ * otherwise; "scratch" arguments are caller-allocated workspace; functions
+ * returning int return an sm_status (SM_OK = 0, failures negative).  Nothing
+ * here keeps global state.
  */
 #ifndef SM_INTERNAL_H
 #define SM_INTERNAL_H
@@ -85,18 +91,52 @@ struct sm_model {
 };
 
 /* ------------------------------------------------------------- fe.c */
+/* Element matrices of one 2-node planar frame element (DOF u1 v1 phi1 u2 v2
+ * phi2), 6x6 column-major a[i + 6*j], written into caller arrays; no status. */
+
+/** k = element stiffness in element coordinates: EA/l axial; 12EI/l^3, 6EI/l^2, 4EI/l, 2EI/l bending. */
 void fe_stiffness_local(double EA, double EI, double l, double k[36]);
+/** m = consistent mass in element coordinates (linear axial, Hermite cubic transverse), mu l/420 [...]. */
 void fe_mass_consistent_local(double mu, double l, double m[36]);
+/** c = C(alpha) of Kim & Yoo eq. 19: element DOFs = C * frame DOFs. */
 void fe_rotation(double alpha, double c[36]);
+/** kfr = C(alpha)' kloc C(alpha): an element matrix rotated into frame coordinates (kloc != kfr). */
 void fe_to_frame(const double kloc[36], double alpha, double kfr[36]);
+/** s = shape functions S(xi) of eq. 16 at xi in [0, 1], 2x6 column-major (s[r + 2*j]). */
 void fe_shape(double xi, double l, double s[12]);
+/** g = bending block of G_e (eq. 23) on (v1, phi1, v2, phi2), 4x4 column-major (axial part is zero). */
 void fe_geometric_bending(double l, double g[16]);
 
 /* ------------------------------------------------------------- mesh.c */
+/**
+ * The mesh phase of a model: check st against m->opt (numbers, indices,
+ * options), walk the members from the clamp (a tree: cycles, disconnected
+ * members, joints on no member), number nodes and elements along the walk
+ * and cut them into substructures (topology, ubar, attachments; not the
+ * bases).  m: a zeroed model with opt set; mesh_build allocates its nodes,
+ * elems, joint_node and subs (freed by sm_model_free, also after a failure).
+ * st is borrowed (not kept).  Returns SM_OK, SM_INVALID_INPUT (diag names the
+ * item, index and field; diag may be NULL) or SM_NOMEM.  Cost linear in the
+ * size of the structure.
+ */
 int mesh_build(sm_model *m, const sm_structure *st, sm_diag *diag);
 
 /* ------------------------------------------------------------- modes.c */
+/**
+ * The component-mode basis of every substructure of m (after mesh_build):
+ * N, K_s, T_e, d_e, G_e, the coordinate offsets q0 and m->n, and the mass
+ * points m->mp.  Everything allocated belongs to m (sm_model_free).  Returns
+ * SM_OK, SM_NOMEM, SM_SINGULAR (a substructure stiffness or mass matrix that
+ * is not positive definite) or SM_LAPACK_FAILED, with diag->status and
+ * diag->message set (diag may be NULL).
+ */
 int modes_build(sm_model *m, sm_diag *diag);
+/**
+ * Modal coordinates substructure b (topology from mesh_build) gets under the
+ * options o: *nm component modes plus *na attachment columns (both written);
+ * returns *nm + *na.  No allocation, no status; cost O(1).
+ */
+int modes_count(const sm_options *o, const sm_sub *b, int *nm, int *na);
 
 /* ------------------------------------------------------------ frames.c */
 /* Kinematic state at q: frames, point positions and Jacobians. */
@@ -116,51 +156,102 @@ typedef struct sm_kin {
     dmat Jp;            /* n x (2*n_mp): columns = (d r_p/dq)' */
 } sm_kin;
 
+/** Allocate the arrays of *k (owned by k, frames_kin_free) for the sizes of m.
+ *  Returns SM_OK or SM_NOMEM (then *k is freed and zeroed). */
 int frames_kin_alloc(const sm_model *m, sm_kin *k);
+/** Free the arrays of *k and zero it; safe on a zeroed or freed sm_kin. */
 void frames_kin_free(sm_kin *k);
+/** Kinematics at q (n coordinates): frame angles and origins through the chain (eq. 36), node
+ *  and mass-point positions and their Jacobians, into k (allocated for m).  No status. */
 void frames_eval(const sm_model *m, const double *q, sm_kin *k);
+/** g (n) = sum_p m_p J_p' r_p at the kinematics k, so the centrifugal force is Omega^2 g. */
 void frames_centrifugal(const sm_model *m, const sm_kin *k, double *g);
+/** H += sum_p m_p r_p . d2 r_p/dq2 (n x n, symmetric) at the kinematics k of q.  Writes the
+ *  scratch fields k->fext and k->Jtha (k is otherwise read-only); work: >= max m_s doubles. */
 void frames_hessian(const sm_model *m, const double *q, const sm_kin *k, dmat *H, double *work);
 
 /* --------------------------------------------------------- linearize.c */
+/* Terms of F(q) and of the linearised equations.  q: n coordinates; matrices
+ * n x n, caller-allocated; nothing is allocated; no status. */
+
+/** fg += f_g(q) = sum_e P_e T_e' G_e T_e q_s (eqs. 22, 24, 26); fg: n. */
 void lin_geometric_force(const sm_model *m, const double *q, double *fg);
+/** Kt += d f_g/dq at q; frozen != 0: P_e held at P_e(q) (the paper's K*, symmetric), else the full
+ *  derivative (Newton).  work: >= 4 max m_s doubles. */
 void lin_geometric_tangent(const sm_model *m, const double *q, int frozen, dmat *Kt, double *work);
+/** P[e] = d_e . q_s, the axial force of every FE element (eq. 24), N; P: n_elems. */
 void lin_axial_forces(const sm_model *m, const double *q, double *P);
+/** f += K q, K = blockdiag(N_s' Kbar_s N_s) (eq. 11); f: n. */
 void lin_elastic_force(const sm_model *m, const double *q, double *f);
+/** Kt += K = blockdiag(K_s) (eq. 11). */
 void lin_elastic_add(const sm_model *m, dmat *Kt);
+/** M = M* = sum_p m_p J_p' J_p (eq. 42) at the kinematics k, full symmetric; W: n x 2 n_mp scratch. */
 void lin_mass(const sm_model *m, const sm_kin *k, dmat *M, dmat *W);
+/** C = C* = 2 omega sum_p m_p J_p' S J_p (eq. 43, skew) at k; W: n x 2 n_mp, X: n x n scratch. */
 void lin_gyro(const sm_model *m, const sm_kin *k, double omega, dmat *C, dmat *W, dmat *X);
+/**
+ * Kt = K + d f_g/dq - s (M* + H) at q with its kinematics in k, s = Omega^2:
+ * the Newton tangent (frozen = 0) or K* with P frozen (frozen != 0, eq. 44).
+ * The one assembly of it; also leaves M* in M and H in H.  W: n x 2 n_mp
+ * scratch; work: >= 4 max m_s doubles.  Writes the scratch fields of k
+ * (frames_hessian).
+ */
+void lin_tangent(const sm_model *m, const double *q, const sm_kin *k, double s, int frozen, dmat *Kt,
+                 dmat *M, dmat *H, dmat *W, double *work);
 
 /* ------------------------------------------------------- equilibrium.c */
+/* Outcome of one continuation (eq_solve). */
 typedef struct sm_eq_out {
-    int converged;
-    int iterations;
-    double residual;
+    int converged;      /* 1 when s_to was reached */
+    int iterations;     /* Newton iterations spent */
+    double residual;    /* ||F(q)|| at the returned q */
     double last_s;      /* last Omega^2 with a converged equilibrium */
-    int canceled;
-    char message[256];
+    int canceled;       /* 1 when the progress callback asked to stop */
+    char message[256];  /* why it did not converge, or the error; "" on success */
 } sm_eq_out;
 
+/* Progress reporting through sm_solve's callback. */
 typedef struct sm_progress {
-    sm_progress_fn cb;
+    sm_progress_fn cb;  /* may be NULL */
     void *user;
-    int done, total;
+    int done, total;    /* speeds finished / requested */
 } sm_progress;
 
+/**
+ * Continuation in s = Omega^2 from the equilibrium q at s_from (q = 0 with
+ * from_rest: at least min_increments steps) to s_to, Newton-Raphson at each
+ * step (DESIGN.md 1.3).  q (n, in/out): the equilibrium at s_to when
+ * out->converged, else the last converged state (at out->last_s).  pr may be
+ * NULL.  Returns SM_OK whether or not it converged or was canceled (see
+ * *out), SM_NOMEM, or SM_LAPACK_FAILED when a factorisation or solve reports
+ * an error (out->message says where).  Allocates only its own workspace.
+ */
 int eq_solve(const sm_model *m, double *q, double s_from, double s_to,
              int from_rest, sm_progress *pr, sm_eq_out *out);
 
 /* -------------------------------------------------------------- eigen.c */
+/* Eigen-analysis output; arrays owned by the struct (eig_out_free). */
 typedef struct sm_eig_out {
     int n_modes;
-    double *wre, *wim;  /* eigenvalues lambda */
+    double *wre, *wim;  /* n_modes eigenvalues lambda */
     double *xre, *xim;  /* n x n_modes modal-coordinate vectors (xim may be zero) */
     int negative;       /* negative eigenvalues of K* */
-    double max_re;
+    double max_re;      /* largest Re(lambda) over the computed roots */
 } sm_eig_out;
 
+/**
+ * Eigen-analysis of the linearised equations (DESIGN.md 1.4): with coriolis,
+ * (lambda^2 M + lambda C + K) x = 0, else K x = w^2 M x, after exact
+ * condensation of the null space of M.  M, C, K: n x n, borrowed (C unused
+ * without coriolis).  *out receives min(modes, rank M) modes, ascending, and
+ * owns its arrays (eig_out_free).  Returns SM_OK, SM_NOMEM, SM_SINGULAR (M
+ * has no range, or the stiffness on its null space is exactly singular) or
+ * SM_LAPACK_FAILED (a LAPACK error, e.g. non-finite input); on failure *out
+ * is empty (nothing to free).
+ */
 int eig_solve(int n, const dmat *M, const dmat *C, const dmat *K, int coriolis,
               int modes, sm_eig_out *out);
+/** Free the arrays of *o and zero it; safe on a zeroed or freed sm_eig_out. */
 void eig_out_free(sm_eig_out *o);
 
 #endif

@@ -184,3 +184,24 @@ void lin_gyro(const sm_model *m, const sm_kin *k, double omega, dmat *C, dmat *W
         for (int i = 0; i < n; i++)
             DM(C, i, j) = 2.0 * omega * (DM(X, i, j) - DM(X, j, i));
 }
+
+/**
+ * Kt = K + d f_g/dq - s (M* + H) at q, s = Omega^2, with the kinematics of q
+ * in k (frames_eval): the Newton tangent of F (frozen = 0, equilibrium.c) or
+ * the paper's K* with P_e frozen at P_e(q) (frozen != 0, eq. 44, sweep.c).
+ * Leaves M* (eq. 42) in M and the Hessian term H in H.  All matrices n x n,
+ * W n x 2 n_mp scratch, work >= 4*max m_s doubles; nothing is allocated.
+ */
+void lin_tangent(const sm_model *m, const double *q, const sm_kin *k, double s, int frozen, dmat *Kt,
+                 dmat *M, dmat *H, dmat *W, double *work)
+{
+    int n = m->n;
+    lin_mass(m, k, M, W);
+    dm_zero(H);
+    frames_hessian(m, q, k, H, work);
+    for (size_t i = 0; i < (size_t)n * n; i++) /* Kt = -s (M* + H) */
+        Kt->a[i] = -s * (M->a[i] + H->a[i]);
+    lin_elastic_add(m, Kt); /* + K (eq. 11) */
+    if (m->opt.geometric_stiffening)
+        lin_geometric_tangent(m, q, frozen, Kt, work); /* + d f_g/dq (eqs. 22-26) */
+}

@@ -39,6 +39,8 @@ static int mesh_positive(double v)
 /* Check numbers, indices and options; topology is checked by mesh_walk. */
 static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
 {
+    if (!st)
+        return mesh_fail(d, SM_ITEM_NONE, -1, "", "no structure");
     if (st->n_joints < 1 || st->n_joints > MESH_MAX_ITEMS || !st->joint_xy)
         return mesh_fail(d, SM_ITEM_NONE, -1, "", "the structure has no joints");
     if (st->n_members < 1 || st->n_members > MESH_MAX_ITEMS || !st->members)
@@ -103,7 +105,10 @@ static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
 /*
  * Breadth-first walk from the clamp: order[] receives the members in visit
  * order, near[] the joint each member is entered from.  Detects cycles,
- * members not connected to the clamp and joints on no member.
+ * members not connected to the clamp and joints on no member.  The members
+ * at each joint are kept in increasing index order (adjacency lists built by
+ * a counting sort), so the walk costs O(joints + members) and visits members
+ * in the same order as a scan of all members per joint would.
  */
 static int mesh_walk(const sm_structure *st, int *order, int *near, sm_diag *d)
 {
@@ -111,16 +116,32 @@ static int mesh_walk(const sm_structure *st, int *order, int *near, sm_diag *d)
     int *seen = calloc((size_t)nj, sizeof(int));
     int *used = calloc((size_t)nm, sizeof(int));
     int *queue = malloc((size_t)nj * sizeof(int));
-    if (!seen || !used || !queue)
+    int *start = calloc((size_t)nj + 1, sizeof(int)); /* adj[start[j] .. start[j+1]): members at joint j */
+    int *adj = malloc(2 * (size_t)nm * sizeof(int));
+    if (!seen || !used || !queue || !start || !adj)
         goto done;
+    for (int i = 0; i < nm; i++) { /* mesh_check: from != to, both valid joints */
+        start[st->members[i].from + 1]++;
+        start[st->members[i].to + 1]++;
+    }
+    for (int j = 0; j < nj; j++)
+        start[j + 1] += start[j];
+    for (int i = 0; i < nm; i++) {
+        adj[start[st->members[i].from]++] = i;
+        adj[start[st->members[i].to]++] = i;
+    }
+    for (int j = nj; j > 0; j--) /* the fill advanced start[j] to start[j+1]: shift back */
+        start[j] = start[j - 1];
+    start[0] = 0;
     int head = 0, tail = 0, count = 0;
     queue[tail++] = st->clamp;
     seen[st->clamp] = 1;
     while (head < tail) {
         int j = queue[head++];
-        for (int i = 0; i < nm; i++) {
+        for (int p = start[j]; p < start[j + 1]; p++) {
+            int i = adj[p];
             const sm_member *b = &st->members[i];
-            if (used[i] || (b->from != j && b->to != j))
+            if (used[i])
                 continue;
             int other = b->from == j ? b->to : b->from;
             if (seen[other]) {
@@ -156,6 +177,8 @@ done:
     free(seen);
     free(used);
     free(queue);
+    free(start);
+    free(adj);
     return rc;
 }
 
@@ -230,7 +253,7 @@ static int mesh_nodes(sm_model *m, const sm_structure *st, const int *order, con
     return SM_OK;
 }
 
-/* Number of elements in each run of a member of ne elements under the scheme. */
+/* 1 when element i (0-based within its member of ne elements) starts a run under the scheme. */
 static int mesh_run_start(const sm_options *o, int i, int ne)
 {
     switch (o->frames) {
@@ -241,12 +264,11 @@ static int mesh_run_start(const sm_options *o, int i, int ne)
     case SM_FRAMES_ELEMENTS_PER_FRAME:
         return i % o->frames_param == 0;
     case SM_FRAMES_PER_MEMBER: {
-        int k = o->frames_param < ne ? o->frames_param : ne;
-        /* run r covers elements [floor(r*ne/k), floor((r+1)*ne/k)) */
-        for (int r = 0; r < k; r++)
-            if ((int)(((long)r * ne) / k) == i)
-                return 1;
-        return 0;
+        long long k = o->frames_param < ne ? o->frames_param : ne;
+        /* run r covers elements [floor(r*ne/k), floor((r+1)*ne/k)); floor(r*ne/k) grows with r,
+         * so i starts a run iff the smallest r with r*ne >= i*k (r = ceil(i*k/ne)) lands on i */
+        long long r = ((long long)i * k + ne - 1) / ne;
+        return r < k && (r * ne) / k == i;
     }
     }
     return 0;

@@ -1,6 +1,8 @@
 /*
  * model.c — the sm_model lifecycle: defaults, construction (mesh.c then
- * modes.c), queries and destruction.
+ * modes.c), queries and destruction, and sm_structure_check, which runs the
+ * same mesh phase (model_mesh) without the component-mode bases and predicts
+ * the sizes with modes_count.
  */
 #include "internal.h"
 
@@ -49,10 +51,15 @@ void sm_model_free(sm_model *m)
     free(m);
 }
 
-int sm_model_new(sm_model **out, const sm_structure *st, const sm_options *opt, sm_diag *diag)
+/*
+ * The phase sm_model_new and sm_structure_check share: reset diag, allocate
+ * a model with the options it will use (opt or the defaults, solver
+ * settings made valid) and run mesh_build (numbers, indices, topology, nodes,
+ * elements, substructures).  *out receives the model, or NULL on failure.
+ * Returns SM_OK, SM_INVALID_INPUT or SM_NOMEM, with d filled.
+ */
+static int model_mesh(sm_model **out, const sm_structure *st, const sm_options *opt, sm_diag *d)
 {
-    sm_diag scratch;
-    sm_diag *d = diag ? diag : &scratch;
     memset(d, 0, sizeof *d);
     d->item_index = -1;
     *out = NULL;
@@ -72,12 +79,7 @@ int sm_model_new(sm_model **out, const sm_structure *st, const sm_options *opt, 
     if (!(m->opt.tolerance > 0))
         m->opt.tolerance = 1e-10;
     int rc = mesh_build(m, st, d);
-    if (rc == SM_OK)
-        rc = modes_build(m, d);
     if (rc < 0) {
-        if (rc == SM_NOMEM && !d->message[0])
-            strcpy(d->message, "out of memory while building the model");
-        d->status = rc;
         sm_model_free(m);
         return rc;
     }
@@ -85,12 +87,72 @@ int sm_model_new(sm_model **out, const sm_structure *st, const sm_options *opt, 
     return SM_OK;
 }
 
-void sm_model_get_info(const sm_model *m, sm_model_info *info)
+/* Sizes that do not need the bases: nodes, elements, frames, max_frame_nodes. */
+static void model_mesh_info(const sm_model *m, sm_model_info *info)
 {
+    memset(info, 0, sizeof *info);
     info->nodes = m->n_nodes;
     info->elements = m->n_elems;
     info->frames = m->n_subs;
+    for (int s = 0; s < m->n_subs; s++)
+        if (m->subs[s].nfree > info->max_frame_nodes)
+            info->max_frame_nodes = m->subs[s].nfree;
+}
+
+/* Status of a failed construction into d (a message for SM_NOMEM). */
+static int model_fail(sm_diag *d, int rc)
+{
+    if (rc == SM_NOMEM && !d->message[0])
+        strcpy(d->message, "out of memory while building the model");
+    d->status = rc;
+    return rc;
+}
+
+int sm_model_new(sm_model **out, const sm_structure *st, const sm_options *opt, sm_diag *diag)
+{
+    sm_diag scratch;
+    sm_diag *d = diag ? diag : &scratch;
+    sm_model *m = NULL;
+    int rc = model_mesh(&m, st, opt, d);
+    *out = NULL;
+    if (rc < 0)
+        return model_fail(d, rc);
+    if ((rc = modes_build(m, d)) < 0) {
+        sm_model_free(m);
+        return model_fail(d, rc);
+    }
+    *out = m;
+    return SM_OK;
+}
+
+int sm_structure_check(const sm_structure *st, const sm_options *opt, sm_model_info *info, sm_diag *diag)
+{
+    sm_diag scratch;
+    sm_diag *d = diag ? diag : &scratch;
+    sm_model *m = NULL;
+    int rc = model_mesh(&m, st, opt, d);
+    if (rc < 0)
+        return model_fail(d, rc);
+    if (info) {
+        model_mesh_info(m, info);
+        for (int s = 0; s < m->n_subs; s++) {
+            int nm, na, k = modes_count(&m->opt, &m->subs[s], &nm, &na);
+            info->coordinates += k;
+            if (k > info->max_frame_coordinates)
+                info->max_frame_coordinates = k;
+        }
+    }
+    sm_model_free(m);
+    return SM_OK;
+}
+
+void sm_model_get_info(const sm_model *m, sm_model_info *info)
+{
+    model_mesh_info(m, info);
     info->coordinates = m->n;
+    for (int s = 0; s < m->n_subs; s++)
+        if (m->subs[s].m > info->max_frame_coordinates)
+            info->max_frame_coordinates = m->subs[s].m;
 }
 
 int sm_model_joint_node(const sm_model *m, int joint)

@@ -79,6 +79,29 @@ static void modes_assemble(const sm_model *m, const sm_sub *b, dmat *K, dmat *M)
         }
 }
 
+/**
+ * The number of modal coordinates substructure b gets under the options,
+ * from its topology alone (nfree, n_attach): *nm component modes plus *na
+ * attachment columns; returns *nm + *na.  Lumped mass: 2F condensed modes
+ * (F free nodes), truncated to modes_per_frame, plus the attachment nodes for
+ * the augmented basis.  Consistent mass: 3F modes, truncated, plus static
+ * attachment modes for the augmented basis only when truncated (the full
+ * basis already spans them).  modes_lumped/modes_consistent size N with it,
+ * and sm_structure_check predicts the model's sizes with it.
+ */
+int modes_count(const sm_options *o, const sm_sub *b, int *nm, int *na)
+{
+    int full = o->mass == SM_MASS_CONSISTENT ? 3 * b->nfree : 2 * b->nfree;
+    *nm = o->modes_per_frame > 0 && o->modes_per_frame < full ? o->modes_per_frame : full;
+    if (o->basis != SM_BASIS_AUGMENTED)
+        *na = 0;
+    else if (o->mass == SM_MASS_CONSISTENT)
+        *na = *nm < full ? b->n_attach : 0;
+    else
+        *na = b->n_attach;
+    return *nm + *na;
+}
+
 static int modes_is_attach(const sm_sub *b, int i)
 {
     for (int a = 0; a < b->n_attach; a++)
@@ -93,9 +116,8 @@ static int modes_is_attach(const sm_sub *b, int i)
  */
 static int modes_lumped(const sm_model *m, sm_sub *b, const dmat *K)
 {
-    int F = b->nfree, T = 2 * F, rc = SM_NOMEM;
-    int nm = m->opt.modes_per_frame > 0 && m->opt.modes_per_frame < T ? m->opt.modes_per_frame : T;
-    int na = m->opt.basis == SM_BASIS_AUGMENTED ? b->n_attach : 0;
+    int F = b->nfree, T = 2 * F, rc = SM_NOMEM, nm, na;
+    modes_count(&m->opt, b, &nm, &na);
     dmat Krr = {0}, X = {0}, Kc = {0}, Kcc = {0}, Y = {0};
     double *w = dm_vec((size_t)T), *sq = dm_vec((size_t)T);
     int *cidx = malloc((size_t)F * sizeof(int));
@@ -108,8 +130,8 @@ static int modes_lumped(const sm_model *m, sm_sub *b, const dmat *K)
     for (int i = 0; i < F; i++)
         for (int j = 0; j < T; j++)
             DM(&X, i, j) = -DM(K, 3 * i + 2, 3 * (j / 2) + j % 2);
-    rc = SM_SINGULAR;
-    if (LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', F, T, Krr.a, F, X.a, F) != 0)
+    rc = dm_lapack_status(LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', F, T, Krr.a, F, X.a, F), SM_SINGULAR);
+    if (rc < 0)
         goto done;
     /* Kc = Ktt + Ktr X, scaled: D^-1/2 Kc D^-1/2 with D the node masses */
     for (int i = 0; i < T; i++)
@@ -121,8 +143,8 @@ static int modes_lumped(const sm_model *m, sm_sub *b, const dmat *K)
                 s += DM(K, 3 * (i / 2) + i % 2, 3 * p + 2) * DM(&X, p, j);
             DM(&Kc, i, j) = s * sq[i] * sq[j];
         }
-    rc = SM_LAPACK_FAILED;
-    if (LAPACKE_dsyevd(LAPACK_COL_MAJOR, 'V', 'U', T, Kc.a, T, w) != 0)
+    rc = dm_lapack_status(LAPACKE_dsyevd(LAPACK_COL_MAJOR, 'V', 'U', T, Kc.a, T, w), SM_LAPACK_FAILED);
+    if (rc < 0)
         goto done;
     rc = SM_NOMEM;
     b->m = nm + na;
@@ -153,8 +175,9 @@ static int modes_lumped(const sm_model *m, sm_sub *b, const dmat *K)
             for (int a = 0; a < na; a++)
                 DM(&Y, i, a) = -DM(K, 3 * cidx[i] + 2, 3 * b->attach[a] + 2);
         }
-        rc = SM_SINGULAR;
-        if (nc > 0 && LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', nc, na, Kcc.a, nc, Y.a, nc) != 0)
+        if (nc > 0 &&
+            (rc = dm_lapack_status(LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', nc, na, Kcc.a, nc, Y.a, nc),
+                                   SM_SINGULAR)) < 0)
             goto done;
         for (int a = 0; a < na; a++) {
             DM(&b->N, 3 * b->attach[a] + 2, nm + a) = 1.0;
@@ -178,17 +201,18 @@ done:
 /* Consistent mass: modes of the full substructure (+ static attachment modes). */
 static int modes_consistent(const sm_model *m, sm_sub *b, const dmat *K, const dmat *M)
 {
-    int D = 3 * b->nfree, rc = SM_NOMEM;
-    int nm = m->opt.modes_per_frame > 0 && m->opt.modes_per_frame < D ? m->opt.modes_per_frame : D;
-    int na = (m->opt.basis == SM_BASIS_AUGMENTED && nm < D) ? b->n_attach : 0;
+    int D = 3 * b->nfree, rc = SM_NOMEM, nm, na;
+    modes_count(&m->opt, b, &nm, &na);
     dmat A = {0}, B = {0}, F = {0};
     double *w = dm_vec((size_t)D), *mx = dm_vec((size_t)D);
     if (!w || !mx || dm_alloc(&A, D, D) || dm_alloc(&B, D, D))
         goto done;
     memcpy(A.a, K->a, (size_t)D * D * sizeof(double));
     memcpy(B.a, M->a, (size_t)D * D * sizeof(double));
-    rc = SM_LAPACK_FAILED;
-    if (LAPACKE_dsygvd(LAPACK_COL_MAJOR, 1, 'V', 'U', D, A.a, D, B.a, D, w) != 0)
+    /* info > D: the mass matrix is not positive definite; 0 < info <= D: no convergence */
+    int info = LAPACKE_dsygvd(LAPACK_COL_MAJOR, 1, 'V', 'U', D, A.a, D, B.a, D, w);
+    rc = dm_lapack_status(info, info > D ? SM_SINGULAR : SM_LAPACK_FAILED);
+    if (rc < 0)
         goto done;
     rc = SM_NOMEM;
     b->m = nm + na;
@@ -202,8 +226,8 @@ static int modes_consistent(const sm_model *m, sm_sub *b, const dmat *K, const d
         double *rhs = b->N.a + (size_t)D * nm;
         for (int a = 0; a < na; a++)
             rhs[(size_t)D * a + 3 * b->attach[a] + 2] = 1.0;
-        rc = SM_SINGULAR;
-        if (LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', D, na, F.a, D, rhs, D) != 0)
+        rc = dm_lapack_status(LAPACKE_dposv(LAPACK_COL_MAJOR, 'U', D, na, F.a, D, rhs, D), SM_SINGULAR);
+        if (rc < 0)
             goto done;
         /* M-orthogonalise each static mode against the kept modes and earlier ones */
         for (int a = 0; a < nm + na; a++) {

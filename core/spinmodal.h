@@ -178,9 +178,24 @@ typedef struct sm_model_info {
     int elements;       /* FE elements */
     int frames;         /* substructures (reference frames) */
     int coordinates;    /* modal coordinates n */
+    int max_frame_coordinates; /* largest number of modal coordinates of one substructure */
+    int max_frame_nodes; /* largest number of FE nodes in one substructure (its component-mode
+                            problem has ~3x that many DOF); free nodes: the frame's root node,
+                            clamped in its basis, is not counted, so the DOF are exactly 3x */
 } sm_model_info;
 
+/** Sizes of the model m (borrowed) into *info. */
 void sm_model_get_info(const sm_model *m, sm_model_info *info);
+
+/** Check a structure and options the way sm_model_new does, without building the
+ *  component-mode bases (cost linear in the size): numbers, indices, topology (a tree rooted
+ *  at the clamp: cycles, disconnected members, joints on no member) and the sizes the model
+ *  would have.  Fills *info (may be NULL).  Returns SM_OK, SM_INVALID_INPUT (diag exactly as
+ *  sm_model_new would fill it for the same input) or SM_NOMEM. diag may be NULL.
+ *  opt NULL means the defaults, as for sm_model_new.  SM_OK does not promise that
+ *  sm_model_new succeeds: its component-mode solves may still fail (SM_SINGULAR,
+ *  SM_LAPACK_FAILED) or run out of memory. */
+int sm_structure_check(const sm_structure *st, const sm_options *opt, sm_model_info *info, sm_diag *diag);
 
 /** FE node index of joint j (joints are FE nodes), or -1 if out of range. */
 int sm_model_joint_node(const sm_model *m, int joint);
@@ -204,7 +219,10 @@ typedef int (*sm_progress_fn)(void *user, int done, int total);
 typedef enum sm_case_status {
     SM_CASE_SOLVED = 0,       /* equilibrium found, steady state stable */
     SM_CASE_UNSTABLE,         /* equilibrium found, K* has negative eigenvalues or Re(lambda) > 0 */
-    SM_CASE_NO_EQUILIBRIUM    /* continuation/Newton failed: see diagnostics */
+    SM_CASE_NO_EQUILIBRIUM,   /* continuation/Newton failed: see diagnostics */
+    SM_CASE_EIGEN_FAILED      /* equilibrium found (converged = 1, its fields filled), but the
+                                 eigen-analysis failed: message says why; no modes, and the
+                                 stability fields are 0 (unknown) */
 } sm_case_status;
 
 /* Inside a frame the kinematics are linear (small rotations).  An
@@ -255,7 +273,9 @@ typedef struct sm_result {
  * Solve at each speed of omegas (rad/s, finite, >= 0 in any order: they are
  * processed in ascending order with continuation, reported in input order).
  * A speed without equilibrium is a reported case (SM_CASE_NO_EQUILIBRIUM),
- * not an error; continuation restarts from rest for the next speed.
+ * not an error; continuation restarts from rest for the next speed.  An
+ * eigen-analysis that fails at a converged equilibrium is a reported case too
+ * (SM_CASE_EIGEN_FAILED); continuation goes on from that equilibrium.
  * Returns SM_OK (every case has a status), SM_CANCELED, SM_NOMEM,
  * SM_INVALID_INPUT (bad speeds) or SM_LAPACK_FAILED.  *out is set only on
  * SM_OK and is owned by the caller (sm_result_free).  cb and diag may be NULL.

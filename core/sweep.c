@@ -80,16 +80,9 @@ static void sweep_linearize(const sm_model *m, const double *q, double omega, sw
     int n = m->n;
     double s = omega * omega;
     frames_eval(m, q, &L->kin);
-    lin_mass(m, &L->kin, &L->M, &L->W);
+    lin_tangent(m, q, &L->kin, s, 1, &L->K, &L->M, &L->H, &L->W, L->work); /* K*, P frozen; M* */
     if (m->opt.coriolis)
         lin_gyro(m, &L->kin, omega, &L->C, &L->W, &L->X);
-    dm_zero(&L->H);
-    frames_hessian(m, q, &L->kin, &L->H, L->work);
-    for (size_t i = 0; i < (size_t)n * n; i++)
-        L->K.a[i] = -s * (L->M.a[i] + L->H.a[i]);
-    lin_elastic_add(m, &L->K);
-    if (m->opt.geometric_stiffening)
-        lin_geometric_tangent(m, q, 1, &L->K, L->work);
     for (int j = 0; j < n; j++) /* symmetric up to round-off: make it exact */
         for (int i = 0; i < j; i++)
             DM(&L->K, i, j) = DM(&L->K, j, i) = 0.5 * (DM(&L->K, i, j) + DM(&L->K, j, i));
@@ -220,7 +213,25 @@ static int sweep_equilibrium_out(const sm_model *m, const double *q, const sm_ki
     return SM_OK;
 }
 
-/* Modes of case c at the equilibrium q. */
+/*
+ * The eigen-analysis failed (status rc) at the converged equilibrium of case
+ * c: the case keeps its equilibrium fields and reports the cause.  finite: 0
+ * when the linearised matrices had non-finite entries.  Returns SM_OK, or rc
+ * when the failure is fatal to the whole solve (SM_NOMEM).
+ */
+static int sweep_eigen_failed(sm_case *c, int rc, int finite)
+{
+    if (rc == SM_NOMEM)
+        return rc;
+    c->status = SM_CASE_EIGEN_FAILED;
+    snprintf(c->message, sizeof c->message, "eigen-analysis failed at the converged equilibrium: %s%s",
+             sm_strerror(rc),
+             finite ? "" : " (K*, M* or C* has non-finite entries: the numbers overflow double precision)");
+    return SM_OK;
+}
+
+/* Modes of case c at the equilibrium q.  An eigen-analysis failure is
+ * reported on the case (sweep_eigen_failed); returns SM_OK or SM_NOMEM. */
 static int sweep_modes(const sm_model *m, const double *q, sweep_lin *L, sm_case *c)
 {
     sm_eig_out e;
@@ -232,7 +243,7 @@ static int sweep_modes(const sm_model *m, const double *q, sweep_lin *L, sm_case
     c->t_linearize = t1 - t0;
     c->t_eigen = t2 - t1;
     if (rc < 0)
-        return rc;
+        return sweep_eigen_failed(c, rc, dm_finite(&L->K) && dm_finite(&L->M) && dm_finite(&L->C));
     int k = e.n_modes, nn = m->n_nodes;
     c->n_modes = k;
     c->frequency = dm_vec((size_t)k);
@@ -334,8 +345,10 @@ int sm_solve(const sm_model *m, const double *omegas, int n_omegas, sm_progress_
             s_prev = 0;
         }
         rc = eq_solve(m, q, s_prev, s, from_rest, &pr, &eo);
-        if (rc < 0)
+        if (rc < 0) {
+            snprintf(d->message, sizeof d->message, "%s", eo.message);
             goto fail;
+        }
         rc = SM_CANCELED;
         if (eo.canceled)
             goto fail;
@@ -353,13 +366,10 @@ int sm_solve(const sm_model *m, const double *omegas, int n_omegas, sm_progress_
             from_rest = 1;
             prev = NULL;
         } else {
-            if ((rc = sweep_modes(m, q, &L, c)) < 0) {
-                if (rc == SM_NOMEM)
-                    goto fail;
-                /* an eigen failure is reported on the case, not fatal */
-                c->status = SM_CASE_NO_EQUILIBRIUM;
-                snprintf(c->message, sizeof c->message, "eigen-analysis failed: %s", sm_strerror(rc));
-                prev = NULL;
+            if ((rc = sweep_modes(m, q, &L, c)) < 0)
+                goto fail;
+            if (c->status == SM_CASE_EIGEN_FAILED) {
+                prev = NULL; /* nothing to track against */
             } else {
                 sweep_track(c, prev);
                 prev = c;
@@ -395,6 +405,7 @@ fail:
     free(q);
     sm_result_free(r);
     d->status = rc;
-    snprintf(d->message, sizeof d->message, "%s", sm_strerror(rc));
+    if (!d->message[0])
+        snprintf(d->message, sizeof d->message, "%s", sm_strerror(rc));
     return rc;
 }
