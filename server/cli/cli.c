@@ -8,10 +8,11 @@
  * stdout.  Errors in the request are reported as an RFC 9457 problem
  * document on stderr, exactly as the daemon would send them.
  *
- * Exit codes: 0 every speed has an equilibrium (solved or unstable),
+ * Exit codes: 0 every speed has its modes (solved or unstable),
  * 2 invalid input (problem JSON on stderr, nothing on stdout), 3 some speed
- * had no equilibrium (the result is still printed), 1 any other error
- * (I/O, out of memory, LAPACK), 64 usage error.
+ * has no modes: no equilibrium, or its eigen-analysis failed (the result is
+ * still printed), 1 any other error (I/O, out of memory, LAPACK), 64 usage
+ * error.
  */
 #include <errno.h>
 #include <stdio.h>
@@ -55,7 +56,8 @@ static void cli_help(void)
            "  -h, --help       show this help\n"
            "  -V, --version    show the version\n\n"
            "exit status: 0 solved, 2 invalid request (problem JSON on stderr),\n"
-           "3 some speed had no equilibrium, 1 other error, 64 usage error\n",
+           "3 some speed has no modes (no equilibrium, or its eigen-analysis failed),\n"
+           "1 other error, 64 usage error\n",
            SM_VERSION, cli_usage_text);
 }
 

@@ -1652,6 +1652,7 @@ const char *codec_case_status_name(sm_case_status s)
     case SM_CASE_SOLVED: return "solved";
     case SM_CASE_UNSTABLE: return "unstable";
     case SM_CASE_NO_EQUILIBRIUM: return "no_equilibrium";
+    case SM_CASE_EIGEN_FAILED: return "eigen_failed";
     }
     return "unknown";
 }
@@ -1799,7 +1800,7 @@ static json_t *enc_case(const codec_request *r, const sm_model *m, const sm_case
         json_object_set_new(o, "status", json_string(codec_case_status_name(c->status))) ||
         json_object_set_new(o, "equilibrium", enc_equilibrium(r, m, c)))
         goto fail;
-    if (c->status != SM_CASE_NO_EQUILIBRIUM &&
+    if (c->status != SM_CASE_NO_EQUILIBRIUM && c->status != SM_CASE_EIGEN_FAILED &&
         json_object_set_new(o, "stability",
                             json_pack("{s:b, s:i}", "stable", c->stable,
                                       "negative_eigenvalues", c->negative_eigenvalues)))

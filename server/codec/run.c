@@ -66,15 +66,17 @@ static json_t *run_errors(const codec_errors *errs)
 
 /*
  * A solved result: DONE, or PARTIAL with the error of the first speed
- * without equilibrium.  Returns SM_OK or SM_NOMEM.
+ * without modes (no equilibrium, or an eigen-analysis that failed after a
+ * converged equilibrium).  Returns SM_OK or SM_NOMEM.
  */
 static int run_outcome_of(const sm_result *res, codec_run_out *out)
 {
     const sm_case *bad = NULL;
-    int i, n_bad = 0;
+    int i, n_bad = 0, eigen;
 
     for (i = 0; i < res->n_cases; i++)
-        if (res->cases[i].status == SM_CASE_NO_EQUILIBRIUM) {
+        if (res->cases[i].status == SM_CASE_NO_EQUILIBRIUM ||
+            res->cases[i].status == SM_CASE_EIGEN_FAILED) {
             if (!bad)
                 bad = &res->cases[i];
             n_bad++;
@@ -83,12 +85,16 @@ static int run_outcome_of(const sm_result *res, codec_run_out *out)
     if (!bad)
         return SM_OK;
     out->outcome = CODEC_RUN_PARTIAL;
+    eigen = bad->status == SM_CASE_EIGEN_FAILED;
     snprintf(out->message, sizeof(out->message),
-             "no dynamic equilibrium at %d of %d speeds, first at omega = %.6g rad/s "
+             "%s at %d of %d speeds, first at omega = %.6g rad/s "
              "(last speed reached %.6g rad/s): %s; the other speeds are in the result",
+             eigen ? "no modes (the eigen-analysis failed at a converged equilibrium)"
+                   : "no dynamic equilibrium",
              n_bad, res->n_cases, bad->omega, bad->last_omega, bad->message);
-    out->error = codec_job_error_text("no_equilibrium", "No dynamic equilibrium", out->message,
-                                      NULL, run_case_diag(bad));
+    out->error = codec_job_error_text(eigen ? "eigen_failed" : "no_equilibrium",
+                                      eigen ? "Eigen-analysis failed" : "No dynamic equilibrium",
+                                      out->message, NULL, run_case_diag(bad));
     return out->error ? SM_OK : SM_NOMEM;
 }
 
