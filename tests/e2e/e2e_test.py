@@ -723,17 +723,28 @@ def t_errors(sc):
     d.signal(signal.SIGTERM)
     t0 = time.monotonic()
     check(d.wait_log(r"event=stopping\b", 5, start=n0) is not None, "errors: log has event=stopping after SIGTERM")
+    # spinmodald logs `stopping` just before its HTTP side begins to refuse (main.c:
+    # log_event, then main_stop): wait for /readyz to say so, then the POST must be
+    # refused.  (A POST at once after the log line raced with that and got 429.)
+    def not_ready():
+        """/readyz's answer (or connection error) once it is no longer 200; else None."""
+        try:
+            x = d.get("/readyz")
+        except (ConnectionError, OSError) as e:
+            return e
+        return None if x.status == 200 else x
+    r = ts.wait_until(not_ready, 5)
+    if isinstance(r, dm.Response):
+        problem_ok(r, 503, "errors: /readyz while stopping")
+    else:
+        check(isinstance(r, ConnectionRefusedError), "errors: /readyz while stopping: 503 or refused (%r)"
+              % (r if r is not None else "still 200 after %.1f s" % ts.budget(5)))
     try:
         r = submit(d, small(4))
         problem_ok(r, 503, "errors: POST while stopping")
         check(r.status != 503 or bool(r.headers.get("Retry-After")), "errors: 503 has Retry-After")
     except (ConnectionError, OSError, socket.error) as e:
         check(isinstance(e, ConnectionRefusedError), "errors: POST while stopping: 503 or connection refused (got %r)" % e)
-    try:
-        r = d.get("/readyz")
-        problem_ok(r, 503, "errors: /readyz while stopping")
-    except (ConnectionError, OSError) as e:
-        check(isinstance(e, ConnectionRefusedError), "errors: /readyz while stopping: 503 or refused (%r)" % e)
     rc = d.wait_exit(60)
     el = time.monotonic() - t0
     check(rc == 0, "errors: exit status 0 after SIGTERM (%s)" % rc)
