@@ -6,6 +6,8 @@ Usage: cli_test.py SPINMODAL SCENARIO   (meson registers one test per scenario)
 
 Scenarios build their requests here (no data files) and run the executable as a
 child process.  Each prints one line per check; the exit status is 1 on any failure.
+A run of the executable may take up to timescale.budget(300) seconds (tests/e2e/timescale.py:
+scaled to the machine, never past meson's timeout).
 """
 import json
 import math
@@ -14,6 +16,10 @@ import re
 import subprocess
 import sys
 import tempfile
+
+sys.dont_write_bytecode = True   # no __pycache__ in the source tree
+sys.path.append(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "e2e"))
+import timescale as ts  # noqa: E402
 
 EXE = None
 FAILURES = []
@@ -31,7 +37,8 @@ def check(cond, what):
 
 
 def run(args, stdin=None, timeout=300):
-    p = subprocess.run([EXE] + args, input=stdin, capture_output=True, timeout=timeout)
+    p = subprocess.run([EXE] + args, input=stdin, capture_output=True, timeout=ts.budget(timeout),
+                       env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
     return p.returncode, p.stdout.decode("utf-8", "replace"), p.stderr.decode("utf-8", "replace")
 
 
@@ -241,6 +248,7 @@ def main():
         print("usage: cli_test.py SPINMODAL {%s|all}" % "|".join(SCENARIOS), file=sys.stderr)
         return 2
     EXE = os.path.abspath(sys.argv[1])
+    ts.calibrate(cli=EXE)
     names = list(SCENARIOS) if sys.argv[2] == "all" else [sys.argv[2]]
     with tempfile.TemporaryDirectory(prefix="spinmodal-cli-") as tmp:
         for name in names:

@@ -7,6 +7,10 @@ Usage: clients_test.py SPINMODALD SPINMODAL SOURCE_ROOT SCENARIO   (meson: one t
 Each scenario starts its own spinmodald on a free loopback port with a temporary database
 (daemon.py), runs the clients against it and prints one line per check; the exit status is 1
 when a check failed, 77 (skip) when curl is missing for the curl scenario.
+
+Time: every wait polls for its condition and gives up after timescale.budget(base)
+(tests/e2e/timescale.py: scaled to the machine by a reference solve measured at the
+start and SPINMODAL_TEST_TIME_FACTOR, never past meson's timeout).
 """
 import sys
 sys.dont_write_bytecode = True          # no __pycache__ in the source tree
@@ -20,12 +24,15 @@ import traceback
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
+sys.path.append(os.path.join(os.path.dirname(HERE), "e2e"))   # timescale.py (after HERE: its daemon.py is not ours)
+import timescale as ts  # noqa: E402
 from daemon import Daemon, free_port  # noqa: E402
 
 SPINMODALD = SPINMODAL = SRC = None
 FAILURES = []
 os.environ["PYTHONDONTWRITEBYTECODE"] = "1"   # nor from the client processes
-MULT = max(1.0, float(os.environ.get("MESON_TEST_TIMEOUT_MULTIPLIER", "1") or 1))
+os.environ["OPENBLAS_NUM_THREADS"] = "1"      # the CLI: one BLAS thread (DESIGN.md section 2)
+B = ts.budget                                 # B(base): a wait's upper bound on this machine
 
 
 def check(cond, what):
@@ -52,7 +59,7 @@ def cli_solve(request, csv=False):
     """The one-shot CLI's answer for the same request (a dict), as JSON or CSV text."""
     args = [SPINMODAL, "solve"] + (["--csv"] if csv else []) + ["-"]
     p = subprocess.run(args, input=json.dumps(request).encode(), capture_output=True,
-                       timeout=120 * MULT)
+                       timeout=B(120))
     if p.returncode not in (0, 3):
         raise RuntimeError("spinmodal solve failed (%d): %s" % (p.returncode, p.stderr.decode()))
     return p.stdout.decode() if csv else json.loads(p.stdout)
@@ -90,8 +97,9 @@ def client_module():
 
 
 def wait_running(c, id, timeout):
-    """Poll until job id is running (or done/failed: then it is too late); the last status."""
-    end = time.monotonic() + timeout
+    """Poll until job id is running (or done/failed: then it is too late) or budget(timeout)
+    runs out; the last status."""
+    end = time.monotonic() + B(timeout)
     st = c.get(id)
     while st["state"] != "running" and st["state"] not in ("done", "failed") \
             and time.monotonic() < end:
@@ -125,14 +133,14 @@ def write_json(d, name, obj):
 def scenario_solve(d):
     """submit + wait + result of examples/angled-beam-90.json; omega1 as the CLI; cache hit; csv."""
     sm = client_module()
-    c = sm.Client(d.url, timeout=30 * MULT)
+    c = sm.Client(d.url, timeout=B(30))
     check(c.health().get("status") == "ready", "health(): /readyz status ready")
     check(c.live() == {"status": "ok"}, "live(): /livez {\"status\":\"ok\"}")
 
     st = c.submit(example("angled-beam-90.json"))
     check(re.fullmatch(r"[0-9a-f]{64}", st.get("id", "")) is not None, "submit(): id is 64 hex digits")
     check(st.get("state") in ("queued", "running", "done"), "submit(): state %r" % st.get("state"))
-    final = c.wait(st["id"], timeout=60 * MULT)
+    final = c.wait(st["id"], timeout=B(60))
     check(final["state"] == "done", "wait(): final state done (got %r, error %r)"
           % (final["state"], final.get("error")))
     check(final["progress"] == {"done": 1, "total": 1}, "wait(): progress 1/1 (%r)" % final["progress"])
@@ -168,7 +176,7 @@ def scenario_solve(d):
 
     # a failed job: no equilibrium -> failed with a result stored
     st = c.submit(no_equilibrium_request(), wait=60)
-    st = c.wait(st["id"], timeout=60 * MULT)
+    st = c.wait(st["id"], timeout=B(60))
     check(st["state"] == "failed" and (st.get("error") or {}).get("type") == "no_equilibrium",
           "no equilibrium: state failed, error.type no_equilibrium (%r, %r)" % (st["state"], st.get("error")))
     check("result" in st and c.result(st["id"])["cases"][0]["status"] == "no_equilibrium",
@@ -181,12 +189,12 @@ def scenario_solve(d):
 def scenario_cancel(d):
     """cancel of a running long sweep (202, then canceled), of a queued job (200), 409 after."""
     sm = client_module()
-    c = sm.Client(d.url, timeout=30 * MULT)
+    c = sm.Client(d.url, timeout=B(30))
     long_req = long_sweep()
     st = c.submit(long_req)
     check(st["state"] in ("queued", "running"), "long sweep queued or running (%s)" % st["state"])
     check(st["progress"]["total"] == 201, "progress.total 201 (%r)" % st["progress"])
-    st = wait_running(c, st["id"], 30 * MULT)
+    st = wait_running(c, st["id"], 30)
     check(st["state"] == "running", "long sweep running (%s)" % st["state"])
 
     # one worker: a second job stays queued behind the sweep
@@ -204,7 +212,7 @@ def scenario_cancel(d):
     check(got["state"] == "canceled" or got.get("cancel_requested") is True,
           "cancel() of the running sweep: cancel_requested true (%r)" % got.get("cancel_requested"))
     t0 = time.monotonic()
-    fin = c.wait(st["id"], timeout=30 * MULT)
+    fin = c.wait(st["id"], timeout=B(30))
     check(fin["state"] == "canceled", "wait(): the sweep ends canceled (%s)" % fin["state"])
     check(fin["progress"]["done"] < 201, "canceled before the end (%r)" % fin["progress"])
     print("     (canceled after %.2f s, %d/201 speeds)" % (time.monotonic() - t0, fin["progress"]["done"]))
@@ -213,14 +221,15 @@ def scenario_cancel(d):
     check(e is not None and e.status == 409 and e.title,
           "cancel() of a canceled job: SpinmodalError 409 with a title (%r)" % [e and (e.status, e.title)])
     t0 = time.monotonic()
-    check(c.wait(st["id"], timeout=5)["state"] == "canceled" and c.wait(other["id"], timeout=5)["state"]
-          == "canceled" and time.monotonic() - t0 < 2, "wait() of finished jobs returns at once")
+    check(c.wait(st["id"], timeout=B(5))["state"] == "canceled" and c.wait(other["id"], timeout=B(5))["state"]
+          == "canceled" and time.monotonic() - t0 < ts.scaled(2),
+          "wait() of finished jobs returns at once (%.2f s, at most %.1f)" % (time.monotonic() - t0, ts.scaled(2)))
 
     # a canceled job submitted again is queued again (new attempt)
     again = c.submit(angled_sweep([1.0, 2.0], elements=8), wait=30)
     check(again["id"] == other["id"] and again["state"] in ("queued", "running", "done"),
           "submit() of a canceled request queues it again (%s)" % again["state"])
-    fin = c.wait(again["id"], timeout=60 * MULT)
+    fin = c.wait(again["id"], timeout=B(60))
     check(fin["state"] == "done", "resubmitted job done (%s)" % fin["state"])
 
     # TimeoutError from wait(): a job that runs longer than the timeout
@@ -228,13 +237,13 @@ def scenario_cancel(d):
     e = raises(lambda: c.wait(st["id"], timeout=0.3), TimeoutError)
     check(e is not None, "wait(timeout=0.3) on a long sweep raises TimeoutError")
     c.cancel(st["id"])
-    c.wait(st["id"], timeout=30 * MULT)
+    c.wait(st["id"], timeout=B(30))
 
 
 def scenario_campbell(d):
     """campbell() rows (speeds x modes, omega ascending, CLI values), list() with paging."""
     sm = client_module()
-    c = sm.Client(d.url, timeout=30 * MULT)
+    c = sm.Client(d.url, timeout=B(30))
     speeds = sm.parse_speeds("0:20:6")
     check(speeds == [0.0, 4.0, 8.0, 12.0, 16.0, 20.0], "parse_speeds('0:20:6') (%r)" % speeds)
     check(sm.parse_speeds("0,5,10") == [0.0, 5.0, 10.0], "parse_speeds('0,5,10')")
@@ -261,7 +270,7 @@ def scenario_campbell(d):
     ids = set()
     for k in range(3):
         st = c.submit(angled_sweep([float(k)], elements=8), wait=30)
-        ids.add(c.wait(st["id"], timeout=60 * MULT)["id"])
+        ids.add(c.wait(st["id"], timeout=B(60))["id"])
     all_items = list(c.list(limit=100))
     check(len(all_items) == 5, "list(limit=100): 5 jobs (%d)" % len(all_items))
     paged = list(c.list(limit=1))
@@ -284,7 +293,7 @@ def scenario_campbell(d):
 def scenario_errors(d):
     """SpinmodalError fields on 422, 400, 404, 409; connection errors; retry on 429."""
     sm = client_module()
-    c = sm.Client(d.url, timeout=30 * MULT)
+    c = sm.Client(d.url, timeout=B(30))
     e = raises(lambda: c.submit(invalid_request()), sm.SpinmodalError)
     check(e is not None and e.status == 422, "422: SpinmodalError status 422 (%r)" % (e and e.status))
     if e is not None:
@@ -327,12 +336,12 @@ def scenario_errors(d):
     e = raises(lambda: c.cancel("f" * 64), sm.SpinmodalError)
     check(e is not None and e.status == 404, "404 cancel of an unknown id")
     st = c.submit(example("angled-beam-90.json"), wait=60)
-    st = c.wait(st["id"], timeout=60 * MULT)
+    st = c.wait(st["id"], timeout=B(60))
     e = raises(lambda: c.cancel(st["id"]), sm.SpinmodalError)
     check(e is not None and e.status == 409, "409 cancel of a done job")
     check(st["id"] == v["id"], "validate() id = the job id")
 
-    bad = sm.Client("http://127.0.0.1:%d" % free_port(), timeout=5)
+    bad = sm.Client("http://127.0.0.1:%d" % free_port(), timeout=B(5))
     e = raises(bad.health, sm.SpinmodalError)
     check(isinstance(e, sm.SpinmodalConnectionError) and e.status is None and "127.0.0.1" in str(e),
           "connection refused: SpinmodalConnectionError naming the URL (%s)" % e)
@@ -343,9 +352,9 @@ def scenario_errors(d):
 def scenario_queue_full(d):
     """429 + Retry-After with --queue-max 1 and one worker; submit(retry=True) waits it out."""
     sm = client_module()
-    c = sm.Client(d.url, timeout=30 * MULT)
+    c = sm.Client(d.url, timeout=B(30))
     first = c.submit(long_sweep())
-    check(wait_running(c, first["id"], 30 * MULT)["state"] == "running", "long sweep running")
+    check(wait_running(c, first["id"], 30)["state"] == "running", "long sweep running")
     c.submit(angled_sweep([1.0], elements=8))        # fills the queue (queue-max 1)
     e = raises(lambda: c.submit(angled_sweep([2.0], elements=8)), sm.SpinmodalError)
     check(e is not None and e.status == 429, "429 when the queue is full (%r)" % (e and e.status))
@@ -355,22 +364,22 @@ def scenario_queue_full(d):
     c.cancel(first["id"])      # the queued job runs, the queue empties, the retry gets through
     st = c.submit(angled_sweep([2.0], elements=8), retry=True, retries=30)
     check(st["state"] in ("queued", "running", "done"), "submit(retry=True) gets through (%s)" % st["state"])
-    c.wait(st["id"], timeout=60 * MULT)
+    c.wait(st["id"], timeout=B(60))
 
 
 def scenario_token(d):
     """--token-file: POST/DELETE need the bearer token, GET does not; python client and curl."""
     sm = client_module()
-    anon = sm.Client(d.url, timeout=30 * MULT)
-    auth = sm.Client(d.url, token="s3cret-token", timeout=30 * MULT)
-    wrong = sm.Client(d.url, token="wrong", timeout=30 * MULT)
+    anon = sm.Client(d.url, timeout=B(30))
+    auth = sm.Client(d.url, token="s3cret-token", timeout=B(30))
+    wrong = sm.Client(d.url, token="wrong", timeout=B(30))
     e = raises(lambda: anon.submit(example("angled-beam-90.json")), sm.SpinmodalError)
     check(e is not None and e.status == 401, "no token: submit() 401 (%r)" % (e and e.status))
     e = raises(lambda: wrong.submit(example("angled-beam-90.json")), sm.SpinmodalError)
     check(e is not None and e.status == 401, "wrong token: submit() 401 (%r)" % (e and e.status))
     st = auth.submit(example("angled-beam-90.json"), wait=60)
     check(st["state"] in ("queued", "running", "done"), "right token: submit() accepted (%s)" % st["state"])
-    st = anon.wait(st["id"], timeout=60 * MULT)
+    st = anon.wait(st["id"], timeout=B(60))
     check(st["state"] == "done", "no token: wait()/get() work (GET needs no token)")
     check(anon.result(st["id"])["cases"][0]["status"] == "solved", "no token: result() works")
     e = raises(lambda: anon.cancel(st["id"]), sm.SpinmodalError)
@@ -397,7 +406,7 @@ def run_py(args, env, cwd=None, timeout=None):
     if cwd is None:
         env = dict(env, PYTHONPATH=os.path.join(SRC, "clients", "python"))
     return subprocess.run([sys.executable, "-m", "spinmodal_client"] + args, env=env, cwd=cwd,
-                          capture_output=True, text=True, timeout=timeout or 120 * MULT)
+                          capture_output=True, text=True, timeout=timeout or B(120))
 
 
 def scenario_python_cli(d):
@@ -418,7 +427,7 @@ def scenario_python_cli(d):
           "PYTHONPATH=clients/python ... solve --csv --url: exit 0, header + 3 rows (%d)" % p.returncode)
     with open(example("angled-beam-90.json")) as f:
         p = subprocess.run([sys.executable, "-m", "spinmodal_client", "solve", "-"], stdin=f, env=dict(env, PYTHONPATH=pkg),
-                           capture_output=True, text=True, timeout=120 * MULT)
+                           capture_output=True, text=True, timeout=B(120))
     check(p.returncode == 0, "solve - (stdin): exit 0 (%d)" % p.returncode)
 
     tmp = os.path.join(d.tmp, "cli")
@@ -491,7 +500,7 @@ def have_curl():
 
 def run_sh(script, args, env, stdin=None, timeout=None):
     return subprocess.run(["bash", os.path.join(SRC, "clients", "curl", script)] + args, env=env,
-                          input=stdin, capture_output=True, text=True, timeout=timeout or 120 * MULT)
+                          input=stdin, capture_output=True, text=True, timeout=timeout or B(120))
 
 
 def scenario_curl(d):
@@ -576,23 +585,23 @@ def scenario_curl(d):
     p = run_sh("submit.sh", ["--no-wait", "--id", long_path], env)
     check(p.returncode == 0 and re.fullmatch(r"[0-9a-f]{64}\n", p.stdout) is not None,
           "submit.sh --no-wait --id: exit 0 at once, the id (%d)" % p.returncode)
-    st = wait_running(c, p.stdout.strip() or "0" * 64, 30 * MULT)
+    st = wait_running(c, p.stdout.strip() or "0" * 64, 30)
     p = run_sh("cancel.sh", [st["id"]], env)
     doc = json.loads(p.stdout) if p.returncode == 0 else {}
     check(p.returncode == 0 and (doc.get("cancel_requested") is True or doc.get("state") == "canceled"),
           "cancel.sh of a running sweep: exit 0, cancel_requested (%d) %s" % (p.returncode, p.stderr[-300:]))
-    fin = c.wait(st["id"], timeout=30 * MULT)
+    fin = c.wait(st["id"], timeout=B(30))
     check(fin["state"] == "canceled", "the sweep ends canceled (%s)" % fin["state"])
     p = run_sh("cancel.sh", [st["id"]], env)
     check(p.returncode == 3 and "409" in p.stderr, "cancel.sh of a canceled job: exit 3, 409 (%d)" % p.returncode)
     # submit.sh resubmits the canceled sweep and waits; canceled under it, it exits 1
     bg = subprocess.Popen(["bash", os.path.join(SRC, "clients", "curl", "submit.sh"), "--wait", "2", long_path],
                           env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    end = time.monotonic() + 30 * MULT
+    end = time.monotonic() + B(30)
     while c.get(st["id"])["state"] != "running" and time.monotonic() < end and bg.poll() is None:
         time.sleep(0.02)
     c.cancel(st["id"])
-    out, err = bg.communicate(timeout=60 * MULT)
+    out, err = bg.communicate(timeout=B(60))
     check(bg.returncode == 1 and "canceled" in err and out == "",
           "submit.sh of a job canceled while it waits: exit 1, 'canceled' on stderr (%d) %s" % (bg.returncode, err[-300:]))
 
@@ -659,6 +668,7 @@ def main(argv):
               file=sys.stderr)
         return 64
     SPINMODALD, SPINMODAL, SRC = os.path.abspath(argv[1]), os.path.abspath(argv[2]), os.path.abspath(argv[3])
+    ts.calibrate(cli=SPINMODAL)
     for name in (SCENARIOS if argv[4] == "all" else [argv[4]]):
         run_scenario(name)
     print("%d check(s) failed" % len(FAILURES) if FAILURES else "all checks passed")

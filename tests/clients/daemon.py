@@ -6,7 +6,8 @@
 
 The daemon listens on a free loopback port (--listen 127.0.0.1:0; the port is read from the
 `event=listening addr=...` log line), keeps its database in a temporary directory and is
-stopped with SIGTERM (SIGKILL after a grace period).
+stopped with SIGTERM (SIGKILL after a grace period).  Its waits are base budgets scaled to
+the machine by tests/e2e/timescale.py (the one module shared with tests/e2e).
 """
 import os
 import re
@@ -14,7 +15,11 @@ import shutil
 import signal
 import subprocess
 import tempfile
+import sys
 import threading
+
+sys.path.append(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "e2e"))
+import timescale as ts  # noqa: E402
 
 _LISTENING = re.compile(r"event=listening\b.*\baddr=(\S+)")
 
@@ -29,9 +34,7 @@ class Daemon:
         self.workers = workers
         self.token = token
         self.extra = list(extra)
-        # slow under sanitizers: MESON_TEST_TIMEOUT_MULTIPLIER (meson >= 0.57 sets it)
-        mult = float(os.environ.get("MESON_TEST_TIMEOUT_MULTIPLIER", "1") or 1)
-        self.start_timeout = start_timeout or 20.0 * max(1.0, mult)
+        self.start_timeout = start_timeout or ts.budget(20.0)
         self.tmp = None
         self.proc = None
         self.url = None
@@ -54,7 +57,7 @@ class Daemon:
             os.chmod(path, 0o600)
             args += ["--token-file", path]
         args += self.extra
-        env = dict(os.environ)
+        env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
         for k in list(env):   # no configuration leaking in from the environment
             if k.startswith("SPINMODAL_"):
                 del env[k]
@@ -83,18 +86,18 @@ class Daemon:
         return self
 
     def stop(self, grace=15.0):
-        """SIGTERM, wait, SIGKILL; returns the exit status (None if it never started)."""
+        """SIGTERM, wait (budget(grace)), SIGKILL; returns the exit status (None if it never started)."""
         if self.proc is not None and self.returncode is None:
             if self.proc.poll() is None:
                 self.proc.send_signal(signal.SIGTERM)
                 try:
-                    self.proc.wait(grace)
+                    self.proc.wait(ts.budget(grace))
                 except subprocess.TimeoutExpired:
                     self.proc.kill()
                     self.proc.wait()
             self.returncode = self.proc.returncode
             if self._reader is not None:
-                self._reader.join(5)
+                self._reader.join(ts.budget(5))
         if self.tmp is not None:
             shutil.rmtree(self.tmp, ignore_errors=True)
             self.tmp = None

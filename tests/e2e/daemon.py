@@ -12,6 +12,10 @@ memory for wait_log()/log_lines().
     status, headers, body = r       # ... or unpacked
     rc = d.stop()                   # SIGTERM, waits, returns the exit status
     d.kill()                        # SIGKILL
+
+Every `timeout` argument is a base budget in seconds (what an unloaded machine
+needs, with a margin): the wait polls for its condition and gives up after
+timescale.budget(timeout), i.e. scaled to this machine (tests/e2e/timescale.py).
 """
 import http.client
 import json
@@ -23,6 +27,8 @@ import socket
 import subprocess
 import threading
 import time
+
+import timescale as ts
 
 LISTEN_RE = re.compile(r"\bevent=listening\b.*?\baddr=(\S+):(\d+)")
 STOPPED_RE = re.compile(r"\bevent=stopped\b|\"event\"\s*:\s*\"stopped\"")
@@ -155,7 +161,7 @@ class Daemon:
         return [self.exe, "--listen", self.listen, "--db", self.db] + self.args
 
     def start(self, timeout=20.0):
-        """Start the daemon and wait for its `event=listening` line (timeout s).
+        """Start the daemon and wait for its `event=listening` line (budget(timeout) s).
         Raises DaemonError when it exits first or does not listen in time."""
         if self.proc is not None and self.proc.poll() is None:
             raise DaemonError("already running")
@@ -174,6 +180,7 @@ class Daemon:
                          threading.Thread(target=self._drain, args=(self.proc.stdout, "[stdout] "), daemon=True)]
         for t in self._threads:
             t.start()
+        timeout = ts.budget(timeout)
         deadline = time.monotonic() + timeout
         with self._cond:
             while True:
@@ -207,7 +214,7 @@ class Daemon:
 
     def _join(self):
         for t in self._threads:
-            t.join(10)
+            t.join(ts.budget(10))
         with self._lock:
             if self._logf:
                 self._logf.close()
@@ -227,7 +234,7 @@ class Daemon:
         if self.proc.poll() is None:
             self.proc.send_signal(signal.SIGTERM)
         try:
-            self.returncode = self.proc.wait(timeout)
+            self.returncode = self.proc.wait(ts.budget(timeout))
         except subprocess.TimeoutExpired:
             self.proc.kill()
             self.proc.wait()
@@ -237,7 +244,7 @@ class Daemon:
 
     def wait_exit(self, timeout=60.0):
         try:
-            self.returncode = self.proc.wait(timeout)
+            self.returncode = self.proc.wait(ts.budget(timeout))
         except subprocess.TimeoutExpired:
             return None
         self._join()
@@ -272,7 +279,7 @@ class Daemon:
     def wait_log(self, pattern, timeout=10.0, start=0):
         """Wait for a log line (index >= start) matching regex pattern; the line or None."""
         rx = re.compile(pattern)
-        deadline = time.monotonic() + timeout
+        deadline = time.monotonic() + ts.budget(timeout)
         with self._cond:
             while True:
                 for line in self._lines[start:]:
@@ -303,7 +310,7 @@ class Daemon:
                 hdrs["Content-Type"] = "application/json"
         if isinstance(body, str):
             body = body.encode("utf-8")
-        conn = http.client.HTTPConnection(self.host, self.port, timeout=timeout)
+        conn = http.client.HTTPConnection(self.host, self.port, timeout=ts.budget(timeout))
         try:
             conn.request(method, path, body=body, headers=hdrs)
             r = conn.getresponse()
@@ -329,7 +336,7 @@ class Daemon:
         """Send raw bytes (and optionally a body from an iterator of byte chunks,
         stopping early when the daemon answers) on a fresh connection and read one
         answer.  Returns a Response (status None when it closed without one)."""
-        return raw_exchange(self.host, self.port, data, body_iter, half_close, timeout, read_first)
+        return raw_exchange(self.host, self.port, data, body_iter, half_close, ts.budget(timeout), read_first)
 
 
 # ---------------------------------------------------------------- raw client
@@ -432,9 +439,9 @@ def raw_exchange(host, port, data, body_iter=None, half_close=False, timeout=20.
 
         ok = send_all(data)
         if ok and read_first:
-            # Expect: 100-continue: wait (up to 3 s, like curl's 1 s) for a final
-            # answer or a 100 before sending the body
-            wait_until = min(deadline, time.monotonic() + 3.0)
+            # Expect: 100-continue: wait (up to 3 s on an unloaded machine, like
+            # curl's 1 s) for a final answer or a 100 before sending the body
+            wait_until = min(deadline, time.monotonic() + ts.budget(3.0))
             while time.monotonic() < wait_until:
                 got = pump_read(0.2)
                 if got is None:

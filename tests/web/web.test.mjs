@@ -7,11 +7,17 @@
 //   SPINMODAL_NODE_MODULES  node_modules holding playwright-core (clients/web's npm dir)
 //   SPINMODAL_SCREENSHOTS   where screenshots are written
 //   CHROMIUM                browser executable (default /usr/bin/chromium)
+//   SPINMODAL_TEST_CLI, SPINMODAL_TEST_TIME_FACTOR, SPINMODAL_TEST_TIMEOUT
+//                           time budgets, as in tests/e2e/timescale.py: every wait
+//                           polls for its condition and gives up after a base budget
+//                           times a factor (a reference solve by the CLI measured at
+//                           the start, or the announced factor), never past meson's
+//                           timeout
 // Exit status: 0 all checks passed, 1 a check failed, 77 skipped (no browser
 // or no playwright-core).  Prints one "ok"/"not ok" line per check and a
 // closing "N passed, N failed" line.
 
-import {spawn} from 'node:child_process';
+import {spawn, spawnSync} from 'node:child_process';
 import fs from 'node:fs';
 import os from 'node:os';
 import path from 'node:path';
@@ -56,6 +62,53 @@ function ok(cond, what, detail = '') {
 
 const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
 
+// ------------------------------------------------------------------ time (tests/e2e/timescale.py)
+const T_START = Date.now();
+const TS = JSON.parse(fs.readFileSync(new URL('../e2e/timescale.json', import.meta.url), 'utf8'));
+const envFactor = Math.max(1, Number(process.env.SPINMODAL_TEST_TIME_FACTOR || 1) || 1);
+
+/** Median wall time (s) of 3 reference solves by the CLI, or null. */
+function referenceSolveSeconds(cli) {
+  const times = [];
+  for (let i = 0; i < 3; i++) {
+    const t0 = Date.now();
+    const p = spawnSync(cli, ['solve', '-'], {input: JSON.stringify(TS.reference_request),
+      env: {...process.env, OPENBLAS_NUM_THREADS: '1', OMP_NUM_THREADS: '1'}, stdio: ['pipe', 'ignore', 'ignore'],
+      timeout: 60000 * TS.max_factor});
+    if (p.status !== 0) return null;
+    times.push((Date.now() - t0) / 1000);
+  }
+  return times.sort((a, b) => a - b)[1];
+}
+
+const FACTOR = (() => {
+  const cli = process.env.SPINMODAL_TEST_CLI;
+  const t = cli && fs.existsSync(cli) ? referenceSolveSeconds(cli) : null;
+  const cal = t === null ? 1 : Math.max(1, t / TS.nominal_solve_s);
+  const f = Math.min(TS.max_factor, Math.max(envFactor, cal));
+  console.log(`# timescale: ${t === null ? 'no calibration (no CLI)' : `reference solve ${t.toFixed(3)} s ` +
+    `(nominal ${TS.nominal_solve_s} s) -> ${cal.toFixed(2)}`}; SPINMODAL_TEST_TIME_FACTOR ${envFactor}; ` +
+    `factor ${f.toFixed(2)}`);
+  return f;
+})();
+const HARD_MS = Number(process.env.SPINMODAL_TEST_TIMEOUT) > 0
+  ? Number(process.env.SPINMODAL_TEST_TIMEOUT) * envFactor * 1000 : null;
+
+/** ms on this machine's scale (for a fixed interval of a negative check). */
+const scaledMs = (ms) => ms * FACTOR;
+
+/** Upper bound (ms) of a wait that needs well under baseMs unloaded: scaled, and cut to
+ *  end before meson kills the test (minus a margin to report it). */
+function budgetMs(baseMs) {
+  let b = baseMs * FACTOR;
+  if (HARD_MS !== null) {
+    const margin = Math.min(30000, Math.max(3000, 0.1 * HARD_MS));
+    const left = HARD_MS - margin - (Date.now() - T_START);
+    if (left < b) b = Math.max(500, left);
+  }
+  return Math.round(b);
+}
+
 // ------------------------------------------------------------------ daemon
 const tmp = fs.mkdtempSync(path.join(os.tmpdir(), 'spinmodal-web-'));
 const daemons = [];
@@ -67,7 +120,8 @@ function startDaemon(name, extra = []) {
     const proc = spawn(DAEMON, ['--listen', '127.0.0.1:0', '--db', path.join(tmp, name + '.db'), '--workers', '2',
       ...extra], {stdio: ['ignore', 'ignore', 'pipe'], env: {...process.env, OPENBLAS_NUM_THREADS: '1'}});
     daemons.push(proc);
-    const timer = setTimeout(() => reject(new Error('no "event=listening" line within 30 s')), 30000);
+    const limit = budgetMs(30000);
+    const timer = setTimeout(() => reject(new Error(`no "event=listening" line within ${limit / 1000} s`)), limit);
     let buf = '';
     proc.stderr.setEncoding('utf8');
     proc.stderr.on('data', (d) => {
@@ -92,7 +146,7 @@ async function stopDaemons() {
     if (proc.exitCode !== null || proc.signalCode !== null) continue;
     const done = new Promise((r) => proc.once('exit', r));
     proc.kill('SIGTERM');
-    const t = setTimeout(() => proc.kill('SIGKILL'), 15000);
+    const t = setTimeout(() => proc.kill('SIGKILL'), budgetMs(15000));
     await done;
     clearTimeout(t);
   }
@@ -106,12 +160,14 @@ async function shot(page, name) {
   console.log(`# screenshot ${file}`);
 }
 
+/** Poll fn in the page until it is true; false after budgetMs(timeout). */
 async function waitFor(page, fn, arg, what, timeout = 15000) {
+  const limit = budgetMs(timeout);
   try {
-    await page.waitForFunction(fn, arg, {timeout, polling: 100});
+    await page.waitForFunction(fn, arg, {timeout: limit, polling: 100});
     return true;
   } catch (e) {
-    console.log(`# timed out waiting for ${what}`);
+    console.log(`# timed out waiting for ${what} (${limit / 1000} s)`);
     return false;
   }
 }
@@ -143,11 +199,15 @@ async function run() {
 
   const browser = await chromium.launch({
     executablePath: CHROMIUM,
+    timeout: budgetMs(180000),
     headless: true,
     args: ['--headless', '--no-sandbox', '--disable-background-networking',
            '--disable-dev-shm-usage', '--disable-gpu'],  // small /dev/shm in containers
   });
   const context = await browser.newContext({viewport: {width: 1440, height: 900}, acceptDownloads: true});
+  // playwright's own waits (actions, navigation, downloads; 30 s by default) on the same scale
+  context.setDefaultTimeout(budgetMs(30000));
+  context.setDefaultNavigationTimeout(budgetMs(30000));
   const page = await context.newPage();
   const consoleErrors = [];
   const foreign = [];
@@ -285,22 +345,22 @@ async function run() {
 
     // mode animation
     const a0 = await page.evaluate(() => window.__spinmodal.anim());
-    await sleep(600);
+    await waitFor(page, (f0) => window.__spinmodal.anim().frame > f0 + 5, a0.frame, 'animation frames');
     const a1 = await page.evaluate(() => window.__spinmodal.anim());
     ok(a1.frame > a0.frame + 5 && a1.path !== a0.path && a1.path.length > 0, 'mode animation runs (frames, path change)',
       `${a0.frame} -> ${a1.frame}`);
     ok(result.cases.find((c) => c.omega === 20).modes[0].shape.im !== undefined, 'complex (gyroscopic) shapes in the result');
     await page.selectOption('#mode-index', '1');
-    await sleep(100);
+    await waitFor(page, () => document.getElementById('mode-desc').textContent.includes('mode 2'), null, 'mode 2');
     ok((await page.textContent('#mode-desc')).includes('mode 2'), 'mode 2 selected');
     await shot(page, '02-sweep-results.png');
     await page.click('#mode-play');
     const p0 = await page.evaluate(() => window.__spinmodal.anim());
-    await sleep(300);
+    await sleep(scaledMs(300)); // paused: no frame may come in this time
     const p1 = await page.evaluate(() => window.__spinmodal.anim());
     ok(!p1.running && p1.frame === p0.frame, 'pause stops the animation');
     await page.keyboard.press('Enter'); // the focused Pause/Play button
-    await sleep(300);
+    await waitFor(page, () => window.__spinmodal.anim().running, null, 'the animation to run again');
     ok((await page.evaluate(() => window.__spinmodal.anim())).running, 'play again from the keyboard');
 
     // CSV download
@@ -369,7 +429,7 @@ async function run() {
       'the 404 of /v1/validate');
     const mass = page2.getByLabel('mass per length (kg/m) of section al');
     await mass.fill('heavy');
-    await sleep(400);
+    await sleep(scaledMs(400)); // no message may appear in this time
     ok(await messageOf(page2, mass) === '', 'no validation while typing without /v1/validate');
     await page2.click('#submit');
     ok(await waitFor(page2, () => {
