@@ -658,6 +658,7 @@ int main(int argc, char **argv)
         return rc;
     }
     sig = main_wait_signal(fds[0], &set);
+    http_begin_stop(d.h); /* refuse first, then say so: a client that reads the log sees 503 */
     log_event("info", "stopping", "signal", sig == SIGINT ? "SIGINT" : "SIGTERM",
               (const char *)NULL);
     main_stop(&d, o.shutdown_grace);

@@ -28,10 +28,10 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from daemon import Daemon  # noqa: E402
+import timescale  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 EXAMPLE = os.path.join(HERE, os.pardir, os.pardir, "examples", "angled-beam-90.json")
-SLOW = float(os.environ.get("SPINMODAL_TEST_SLOWNESS", "1") or "1")  # > 1 on a slow machine
 
 failures = []
 
@@ -42,9 +42,9 @@ def check(ok, what):
         failures.append(what)
 
 
-def wait_until(cond, limit):
-    """Poll cond() until it is true or limit seconds (times the slowness) pass; its last value."""
-    end = time.monotonic() + limit * SLOW
+def wait_until(cond, base):
+    """Poll cond() until it is true or timescale.budget(base) seconds pass; its last value."""
+    end = time.monotonic() + timescale.budget(base)
     while True:
         v = cond()
         if v or time.monotonic() > end:
@@ -63,7 +63,7 @@ def metric(d, name, headers=None):
 def connect_from(source, port):
     s = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
     s.bind((source, 0))
-    s.settimeout(5 * SLOW)
+    s.settimeout(timescale.budget(5))
     s.connect(("127.0.0.1", port))
     return s
 
@@ -103,7 +103,7 @@ def scenario_slow_clients(exe, tmp):
         check(len(held) <= per_client,
               "per-client limit: %d of %d connections from one address stay open (limit %d)"
               % (len(held), n, per_client))
-        r = d.get("/livez", timeout=10 * SLOW)
+        r = d.get("/livez", timeout=timescale.budget(10))
         check(r.status == 200, "/livez from another address answers while %d trickle (got %s)"
               % (len(held), r.status))
         # keep trickling one byte per second into the held connections until
@@ -203,6 +203,7 @@ def scenario_cors(exe, tmp):
 
 def main():
     exe, name = sys.argv[1], sys.argv[2]
+    timescale.calibrate(exe)
     with tempfile.TemporaryDirectory(prefix="spinmodal-hardening-") as tmp:
         globals()["scenario_" + name](exe, tmp)
     if failures:
