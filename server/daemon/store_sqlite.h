@@ -91,6 +91,12 @@ int store_sqlite_kind(int rc, int sys_errno);
  * ROLLBACK replaces the message). */
 int store_sqlite_fail(store_conn *c, int rc);
 
+/* Does path still name the file (dev, ino) the store opened?  STORE_OK,
+ * or the recorded failure of op: STORE_GONE when deleted or replaced, the
+ * errno's kind when stat fails otherwise.  what: "database file", … */
+int store_sqlite_same_file(store *s, const char *path, dev_t dev, ino_t ino, const char *what,
+                           const char *op);
+
 /* The cached statement k of c, prepared on first use; NULL on failure
  * (*rc receives the SQLite code). */
 sqlite3_stmt *store_sqlite_stmt(store_conn *c, int k, int *rc);

@@ -3,11 +3,12 @@
  * health (the file still there, still writable), size, and retention
  * (store.h: store_check_writable, store_health, store_size, store_prune).
  *
- * Health.  SQLite keeps writing to a database file that was deleted or
- * replaced under it, and every commit then goes to an inode nobody will
- * open again: jobs answered 202 vanish at the next start.  store_health
- * compares the device and inode the path names now with those of the file
- * opened (and likewise for the lock file), then commits one real write —
+ * Health.  SQLite (in WAL mode) keeps writing to a database file that was
+ * deleted or replaced under it, and every commit then goes to an inode
+ * nobody will open again: jobs answered 202 vanish at the next start.
+ * Every write transaction therefore refuses with STORE_GONE when the path
+ * no longer names the file opened (store_sqlite_writer_begin), and
+ * store_health compares the lock file likewise, then commits one real write —
  * user_version rewritten unchanged, one WAL frame, no fsync — so read-only
  * remounts, revoked permissions and a full device show as their kinds.
  *
@@ -26,10 +27,8 @@
  */
 #include "store_sqlite.h"
 
-#include <errno.h>
 #include <stdio.h>
 #include <string.h>
-#include <sys/stat.h>
 
 enum {
     PRUNE_BATCH = 256,     /* deletions per transaction */
@@ -48,32 +47,6 @@ int store_sqlite_check_writable(store *s)
     return store_sqlite_writer_end(s, STORE_OK, 0);
 }
 
-/* Does path still name the file (dev, ino)?  STORE_OK, or the recorded
- * kind: STORE_GONE when deleted or replaced.  what: "database file",
- * "lock file". */
-static int same_file(store *s, const char *path, dev_t dev, ino_t ino, const char *what)
-{
-    struct stat st;
-    char text[256];
-    int e;
-
-    if (stat(path, &st) != 0) {
-        e = errno;
-        if (e != ENOENT && e != ENOTDIR) {
-            snprintf(text, sizeof text, "cannot look at %s '%s': %s", what, path, strerror(e));
-            return store_note_error(s, store_errno_kind(e), 0, e, "health", text);
-        }
-        snprintf(text, sizeof text, "%s '%s' was deleted while the store had it open", what, path);
-        return store_note_error(s, STORE_GONE, 0, e, "health", text);
-    }
-    if (st.st_dev != dev || st.st_ino != ino) {
-        snprintf(text, sizeof text, "%s '%s' was replaced by another file while the store had "
-                 "it open", what, path);
-        return store_note_error(s, STORE_GONE, 0, 0, "health", text);
-    }
-    return STORE_OK;
-}
-
 int store_sqlite_health(store *s)
 {
     store_sqlite *q = s->impl;
@@ -81,9 +54,10 @@ int store_sqlite_health(store *s)
     char sql[48];
     int rc, status;
 
-    status = same_file(s, q->path, q->db_dev, q->db_ino, "database file");
+    status = store_sqlite_same_file(s, q->path, q->db_dev, q->db_ino, "database file", "health");
     if (status == STORE_OK)
-        status = same_file(s, q->lock.path, q->lock.dev, q->lock.ino, "lock file");
+        status = store_sqlite_same_file(s, q->lock.path, q->lock.dev, q->lock.ino, "lock file",
+                                        "health");
     if (status != STORE_OK)
         return status;
     /* a real write: the schema version, rewritten unchanged, is one page */

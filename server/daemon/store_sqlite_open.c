@@ -255,6 +255,8 @@ static int conn_open(store *s, store_conn *c, char *err, size_t errlen)
         kind = conn_kind(c, rc);
         if ((rc & 0xff) == SQLITE_NOTADB)
             seterr(err, errlen, "'%s' is not a SQLite database", q->path);
+        else if (kind == STORE_CORRUPT)
+            seterr(err, errlen, "database '%s' is corrupt: %s", q->path, sqlite3_errmsg(c->db));
         else
             seterr(err, errlen, "cannot configure database '%s': %s", q->path,
                    sqlite3_errmsg(c->db));
@@ -336,7 +338,9 @@ static int sq_quick_check(store_conn *c, const char *path, char *err, size_t err
     int rc = sqlite3_prepare_v2(c->db, "PRAGMA quick_check(4)", -1, &st, NULL), ok = 0, rows = 0;
     int kind = STORE_OK;
 
-    while (rc == SQLITE_OK && (rc = sqlite3_step(st)) == SQLITE_ROW) {
+    while (rc == SQLITE_OK || rc == SQLITE_ROW) {
+        if ((rc = sqlite3_step(st)) != SQLITE_ROW)
+            break;
         const char *t = (const char *)sqlite3_column_text(st, 0);
         if (rows++ == 0 && t != NULL && strcmp(t, "ok") == 0) {
             ok = 1;
@@ -348,6 +352,9 @@ static int sq_quick_check(store_conn *c, const char *path, char *err, size_t err
             used = w > 0 ? used + (size_t)w : used;
         }
     }
+    for (char *p = found; *p; p++)   /* one line for the log */
+        if (*p == '\n')
+            *p = ' ';
     if (rc != SQLITE_DONE && rc != SQLITE_OK) {
         kind = conn_kind(c, rc);
         if (kind == STORE_CORRUPT)
