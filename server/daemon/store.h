@@ -324,6 +324,9 @@ int store_health(store *s);
  * with PRAGMA incremental_vacuum, giving the freed pages back to the file
  * system (the file shrinks); a database created before keeps its size and
  * reuses the freed pages for new jobs (VACUUM it offline to shrink it).
+ * Shrinking moves pages, so its cost is about the data moved (the first
+ * prune of a large old database can take seconds; at most 4 MiB moved
+ * per transaction, so other writers wait at most that long).
  * Works in transactions of at most 256 deletions, so submissions wait at
  * most one batch.  When only queued and running jobs are left above the
  * bound it stops there (STORE_OK).  *removed (may be NULL) receives how

@@ -21,6 +21,11 @@
  * database with auto_vacuum = INCREMENTAL then gets its free pages back to
  * the file system (PRAGMA incremental_vacuum, VACUUM_PAGES per
  * transaction) and a passive checkpoint lets the file itself shrink.
+ * Shrinking moves the pages at the end of the file into the freed ones,
+ * so it costs about the data moved: measured here (2 loaded cores), 10 000
+ * of 20 000 jobs with 20 KB results deleted by age in 0.3 s without and
+ * 6 s with the vacuum (200 MB freed at the start of a 412 MB file).  A
+ * periodic prune that deletes a few jobs moves a few pages.
  * Neither query has an index on finished_at: each batch scans the table's
  * small columns (the large texts are not read), which is fine at the
  * intended scale (a scan of 100 000 jobs is milliseconds).
@@ -32,7 +37,7 @@
 
 enum {
     PRUNE_BATCH = 256,     /* deletions per transaction */
-    VACUUM_PAGES = 4096    /* pages given back per transaction (16 MiB at 4 KiB) */
+    VACUUM_PAGES = 1024    /* pages given back per transaction (4 MiB at 4 KiB) */
 };
 
 /* ---- probes --------------------------------------------------------------- */
