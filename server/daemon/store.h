@@ -5,12 +5,16 @@
  * The store is the queue's durable half: workers claim the oldest queued
  * job with store_claim_next, and at start store_open puts jobs left
  * `running` by a crash back to `queued`.  Results are stored as the exact
- * bytes served.  DESIGN.md §6: this small interface is what a PostgreSQL
- * backend will implement later (claim = SELECT … FOR UPDATE SKIP LOCKED).
+ * bytes served.  One process owns a database file at a time (a lock file,
+ * store_open_with).  DESIGN.md §6: this interface is what a PostgreSQL
+ * backend will implement later (claim = SELECT … FOR UPDATE SKIP LOCKED);
+ * store_backend.h is where it plugs in.
  *
  * Thread safety: every function may be called from any thread at once; the
  * store keeps a small pool of connections (WAL: readers never block the
- * writer).  Return values are store_rc codes (0 = STORE_OK).
+ * writer).  Return values are store_rc codes (0 = STORE_OK, failures < 0);
+ * a failure of the database also leaves SQLite's own words in
+ * store_last_error and the settings' on_error callback.
  */
 #ifndef SPINMODAL_STORE_H
 #define SPINMODAL_STORE_H
@@ -21,14 +25,72 @@
 extern "C" {
 #endif
 
-/** Return codes of the store. */
+/*
+ * Return codes of the store: one X-macro table generates the enum,
+ * store_strerror and store_rc_name.  0 is success; every failure is
+ * negative.  The database kinds (ERROR … GONE) keep apart problems an
+ * operator solves differently: free disk space (FULL), find the other
+ * writer (BUSY), restore a backup (CORRUPT), fix permissions or the mount
+ * (READONLY), look at the disk (IOERR), stop the other daemon (IN_USE),
+ * find who deleted the file (GONE).  STORE_NOMEM stays apart from them.
+ * X(name, value, token for logs and metric labels, sentence)
+ */
+#define STORE_RC_MAP(X)                                                                        \
+    X(OK, 0, "ok", "success")                                                                  \
+    X(NOT_FOUND, -1, "not_found", "no such job, or no queued job to claim")                    \
+    X(CONFLICT, -2, "conflict", "the job is not in a state that allows the change")            \
+    X(NOMEM, -3, "nomem", "out of memory")                                                     \
+    X(ERROR, -4, "error", "database error")                                                    \
+    X(FULL, -5, "full", "the database or its disk is full")                                    \
+    X(BUSY, -6, "busy", "the database stayed locked by another connection past the timeout")   \
+    X(CORRUPT, -7, "corrupt", "the database file is corrupt or not a database")                \
+    X(READONLY, -8, "readonly",                                                                \
+      "the database cannot be written (read-only file, directory, mount or permissions)")      \
+    X(IOERR, -9, "ioerr", "input/output error on the database file")                           \
+    X(IN_USE, -10, "in_use", "the database is in use by another process")                      \
+    X(GONE, -11, "gone", "the database file was deleted or replaced while the store had it open") \
+    X(INVALID, -12, "invalid", "invalid argument (a caller's mistake)")
+
+/** Return codes of the store (STORE_RC_MAP). */
 typedef enum store_rc {
-    STORE_OK = 0,
-    STORE_NOT_FOUND = -1,   /* no such job, or no queued job to claim */
-    STORE_CONFLICT = -2,    /* the job is not in a state that allows the change */
-    STORE_NOMEM = -3,
-    STORE_ERROR = -4        /* SQLite failed (disk full, locked past the timeout, corrupt …) */
+#define STORE_RC_ENUM(name, value, token, text) STORE_##name = value,
+    STORE_RC_MAP(STORE_RC_ENUM)
+#undef STORE_RC_ENUM
+    STORE_RC_MIN = -12      /* the lowest code, for tables indexed by -rc */
 } store_rc;
+
+/** A sentence for rc ("the database or its disk is full"); never NULL. */
+const char *store_strerror(int rc);
+
+/**
+ * A short token for rc, for log fields and metric labels: "ok",
+ * "not_found", "conflict", "nomem", "error", "full", "busy", "corrupt",
+ * "readonly", "ioerr", "in_use", "gone", "invalid"; "unknown" otherwise.
+ */
+const char *store_rc_name(int rc);
+
+/**
+ * 1 when rc is a database failure (STORE_ERROR, FULL, BUSY, CORRUPT,
+ * READONLY, IOERR, IN_USE, GONE): the kinds a caller that only needs
+ * "the database failed" (a 503, readiness) treats alike.  0 for
+ * STORE_OK, NOT_FOUND, CONFLICT, NOMEM and INVALID.
+ */
+int store_is_db_error(int rc);
+
+/**
+ * One failure, as recorded by the store: the kind, the backend's own code
+ * and text (for SQLite: the extended result code and sqlite3_errmsg), the
+ * errno of the failing system call when the backend knows it, and which
+ * store operation failed.  Plain data, no pointers.
+ */
+typedef struct store_error {
+    int rc;                    /* store_rc kind; STORE_OK when nothing failed yet */
+    int backend_rc;            /* SQLite extended result code, 0 when not SQLite's */
+    int sys_errno;             /* errno of the failing system call, 0 when unknown */
+    unsigned long long seq;    /* failures recorded by this store so far, this one included */
+    char op[24];               /* "submit", "claim", "finish", "health", "prune", … */
+    char text[256];            /* the backend's message ("database or disk is full") */
+} store_error;
 
 /** Job states, in this order (used as array indices). */
 typedef enum store_state {
@@ -84,20 +146,75 @@ void store_job_clear(store_job *j);
 typedef struct store store;  /* opaque */
 
 /**
- * Open (creating if needed) the database at path, switch it to WAL, apply
- * the migrations up to the current schema version, and put every `running`
- * job back to `queued` (a crash or kill -9 left them so).  *requeued
- * receives how many (may be NULL).  On failure *out is NULL and err
- * (errlen bytes, may be NULL) holds a sentence naming the cause.
- * Returns STORE_OK, STORE_NOMEM or STORE_ERROR.
+ * Called by the store on every failure of a database operation after
+ * store_open returned (not for STORE_NOT_FOUND, CONFLICT or INVALID: those
+ * are answers, not failures).  Runs on the thread that saw the failure,
+ * possibly while the store holds its write lock: it must be quick and
+ * must not call the store.  e is valid only during the call.
+ */
+typedef void (*store_error_cb)(void *ctx, const store_error *e);
+
+/** How to open a store; fill with store_default_settings, then change fields. */
+typedef struct store_settings {
+    const char *path;          /* SQLite database file (required; not ":memory:") */
+    int busy_timeout_ms;       /* wait this long for another process's SQLite lock; 5000 */
+    int quick_check;           /* 1: PRAGMA quick_check at open, refuse a corrupt file
+                                * (reads the whole file once: ~0.3 s per GB cached); 0: skip */
+    store_error_cb on_error;   /* may be NULL */
+    void *on_error_ctx;        /* passed to on_error */
+} store_settings;
+
+/** Defaults: no path, busy_timeout_ms 5000, quick_check 1, no callback. */
+void store_default_settings(store_settings *set);
+
+/**
+ * Open (creating if needed) the database at set->path for this process
+ * alone, check it, switch it to WAL, apply the migrations up to the
+ * current schema version, and put every `running` job back to `queued` (a
+ * crash or kill -9 left them so).  *requeued receives how many (may be
+ * NULL).  On failure *out is NULL and err (errlen bytes, may be NULL)
+ * holds a sentence naming the file and the cause.
+ *
+ * Exclusive: the store holds an exclusive lock on `<path>.lock` (created
+ * next to the database, holding the owner's pid; never deleted) for its
+ * whole life.  The kernel drops the lock when the process ends in any way
+ * (kill -9 included), so a crashed daemon never blocks its restart.  A
+ * second store on the same file, in this process or another, fails with
+ * STORE_IN_USE and a sentence naming the file and the holder's pid.
+ *
+ * Returns STORE_OK; STORE_IN_USE (another store holds the file);
+ * STORE_CORRUPT (not a SQLite database, or PRAGMA quick_check found
+ * damage: err carries SQLite's first finding); STORE_READONLY (the file,
+ * its directory or the lock file cannot be written); STORE_FULL,
+ * STORE_IOERR, STORE_BUSY (another process kept a write lock past the
+ * timeout); STORE_NOMEM; STORE_INVALID (set or its path NULL or empty);
+ * STORE_ERROR (a newer schema, a database of another application, a
+ * missing directory, ":memory:" or a file system without WAL, anything
+ * else).
+ */
+int store_open_with(store **out, const store_settings *set, int *requeued, char *err,
+                    size_t errlen);
+
+/**
+ * store_open_with with the default settings and this path (no error
+ * callback).  Same returns.
  */
 int store_open(store **out, const char *path, int *requeued, char *err, size_t errlen);
 
-/** Close every connection (checkpointing the WAL); NULL is a no-op. */
+/** Close every connection (checkpointing the WAL) and drop the lock; NULL is a no-op. */
 void store_close(store *s);
 
 /** The schema version of the open database (PRAGMA user_version). */
 int store_schema_version(store *s);
+
+/**
+ * The most recent failure recorded by s, from any thread, into *out (a
+ * copy taken under a lock; out->seq tells a new failure from an old one).
+ * For the text of one particular call, use the on_error callback, which
+ * sees each failure on its own thread.  Returns out->rc: STORE_OK (and a
+ * zeroed *out) when nothing failed since store_open.
+ */
+int store_last_error(store *s, store_error *out);
 
 /**
  * Record a submission in one transaction, committed before it returns.
@@ -107,14 +224,15 @@ int store_schema_version(store *s);
  *   cleared, created_at kept, seq renewed so it queues last), *outcome = 2;
  * - a `queued`, `running` or `done` row: nothing changes, *outcome = 0.
  * In every case *job (may be NULL) receives the row as it now is, without
- * the large texts.  Returns STORE_OK, STORE_NOMEM or STORE_ERROR.
+ * the large texts.  Returns STORE_OK, STORE_INVALID (id not 64 characters,
+ * request NULL), STORE_NOMEM or a database kind (store_is_db_error).
  */
 int store_submit(store *s, const char *id, const char *request, size_t request_len,
                  int speeds_total, double now, int *outcome, store_job *job);
 
 /**
  * Read one job; flags (STORE_WITH_*) choose the large texts to load.
- * Returns STORE_OK, STORE_NOT_FOUND, STORE_NOMEM or STORE_ERROR.
+ * Returns STORE_OK, STORE_NOT_FOUND, STORE_NOMEM or a database kind.
  */
 int store_get(store *s, const char *id, unsigned flags, store_job *out);
 
@@ -122,7 +240,7 @@ int store_get(store *s, const char *id, unsigned flags, store_job *out);
  * Claim the oldest `queued` job (lowest seq): in one transaction set it
  * `running`, started_at = now, attempts + 1.  *out receives it with its
  * request text.  Returns STORE_OK, STORE_NOT_FOUND (queue empty),
- * STORE_NOMEM or STORE_ERROR.
+ * STORE_NOMEM or a database kind.
  */
 int store_claim_next(store *s, double now, store_job *out);
 
@@ -130,7 +248,8 @@ int store_claim_next(store *s, double now, store_job *out);
  * Record the end of a `running` job: state is STORE_DONE, STORE_FAILED or
  * STORE_CANCELED; error (JSON text), result (JSON text) and csv may be NULL.
  * speeds_done is stored too.  Returns STORE_OK, STORE_CONFLICT (the job is
- * not running), STORE_NOT_FOUND, STORE_NOMEM or STORE_ERROR.
+ * not running, or state is not an end state), STORE_NOT_FOUND, STORE_NOMEM
+ * or a database kind.
  */
 int store_finish(store *s, const char *id, store_state state, double now, int speeds_done,
                  const char *error, const char *result, size_t result_len,
@@ -140,7 +259,7 @@ int store_finish(store *s, const char *id, store_state state, double now, int sp
  * Put a `running` job back to `queued` (graceful shutdown while it ran):
  * started_at cleared, attempts - 1 (the interruption was not its fault),
  * seq kept so it runs first again.  Returns STORE_OK, STORE_CONFLICT,
- * STORE_NOT_FOUND or STORE_ERROR.
+ * STORE_NOT_FOUND, STORE_NOMEM or a database kind.
  */
 int store_requeue(store *s, const char *id);
 
@@ -149,7 +268,7 @@ int store_requeue(store *s, const char *id);
  * job gets cancel_requested = 1 and stays running (its worker stops it);
  * *state (may be NULL) receives the state after the call.  Returns
  * STORE_OK, STORE_CONFLICT (done/failed/canceled: *state says which),
- * STORE_NOT_FOUND or STORE_ERROR.
+ * STORE_NOT_FOUND, STORE_NOMEM or a database kind.
  */
 int store_cancel(store *s, const char *id, double now, store_state *state);
 
@@ -158,19 +277,70 @@ int store_cancel(store *s, const char *id, double now, store_state *state);
  * seq < before (before <= 0: from the newest), only state `filter` when
  * filter >= 0, at most max of them into out[] (caller's array of max
  * zeroed store_job).  *n receives the count; *more is 1 when older
- * matching jobs exist.  Returns STORE_OK, STORE_NOMEM or STORE_ERROR.
+ * matching jobs exist.  Returns STORE_OK, STORE_INVALID (filter >=
+ * STORE_N_STATES), STORE_NOMEM or a database kind.
  */
 int store_list(store *s, long long before, int filter, int max, store_job *out, int *n,
                int *more);
 
-/** Number of jobs per state into counts[STORE_N_STATES].  STORE_OK or STORE_ERROR. */
+/**
+ * Number of jobs per state into counts[STORE_N_STATES] (all 0 on failure).
+ * Returns STORE_OK, STORE_NOMEM or a database kind.
+ */
 int store_count(store *s, long long counts[STORE_N_STATES]);
 
 /**
- * Readiness probe: 0 (STORE_OK) when the database accepts a write
- * transaction (BEGIN IMMEDIATE; ROLLBACK), STORE_ERROR otherwise.
+ * Light readiness probe: STORE_OK when the database grants a write
+ * transaction (BEGIN IMMEDIATE; ROLLBACK), else the kind of the failure
+ * (STORE_BUSY, STORE_READONLY, STORE_GONE, … or STORE_NOMEM).  Writes
+ * nothing; store_health is the deeper check.
  */
 int store_check_writable(store *s);
+
+/**
+ * Health of the open database, for /readyz and a periodic check:
+ * 1. the path still names the file the store opened (same device and
+ *    inode) and `<path>.lock` is still the file the store locked, else
+ *    STORE_GONE (deleted, renamed or replaced: every later write would go
+ *    to a file nobody will open again);
+ * 2. a real write commits: the schema version is rewritten unchanged in
+ *    a transaction committed without fsync (one 4 KiB WAL frame), so a
+ *    read-only remount, revoked permissions or a full WAL device show.
+ * Returns STORE_OK, STORE_GONE, STORE_READONLY, STORE_FULL, STORE_IOERR,
+ * STORE_BUSY, STORE_CORRUPT, STORE_NOMEM or STORE_ERROR.
+ */
+int store_health(store *s);
+
+/**
+ * Retention.  Delete finished jobs (done, failed, canceled; never queued
+ * or running ones), oldest end first (finished_at, then seq):
+ * - every one that finished before now - max_age_s (max_age_s > 0;
+ *   <= 0: no age limit);
+ * - then, while the live data of the database exceeds max_bytes
+ *   (max_bytes > 0; <= 0: no size limit), the oldest remaining ones.
+ * Live data is (page_count - freelist_count) * page_size: the pages that
+ * hold rows, not the file size and not the WAL.  Space: a database created
+ * by this version uses auto_vacuum = INCREMENTAL, and store_prune ends
+ * with PRAGMA incremental_vacuum, giving the freed pages back to the file
+ * system (the file shrinks); a database created before keeps its size and
+ * reuses the freed pages for new jobs (VACUUM it offline to shrink it).
+ * Shrinking moves pages, so its cost is about the data moved (the first
+ * prune of a large old database can take seconds; at most 4 MiB moved
+ * per transaction, so other writers wait at most that long).
+ * Works in transactions of at most 256 deletions, so submissions wait at
+ * most one batch.  When only queued and running jobs are left above the
+ * bound it stops there (STORE_OK).  *removed (may be NULL) receives how
+ * many jobs were deleted, also on failure (the batches committed before).
+ * Returns STORE_OK, STORE_NOMEM or a database kind.
+ */
+int store_prune(store *s, double now, double max_age_s, long long max_bytes,
+                long long *removed);
+
+/**
+ * Live data and file size in bytes (see store_prune), for a gauge.
+ * Returns STORE_OK, STORE_NOMEM or a database kind (*live, *file 0).
+ */
+int store_size(store *s, long long *live_bytes, long long *file_bytes);
 
 #ifdef __cplusplus
 }

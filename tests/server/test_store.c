@@ -86,6 +86,8 @@ static void remove_db(const char *path)
     unlink(p);
     snprintf(p, sizeof p, "%s-shm", path);
     unlink(p);
+    snprintf(p, sizeof p, "%s.lock", path);
+    unlink(p);
 }
 
 static void test_names(void)
@@ -403,8 +405,8 @@ static void test_refused(const char *dir)
         fclose(f);
     }
     s = (store *)&s;
-    CHECK(store_open(&s, path, NULL, err, sizeof err) == STORE_ERROR && s == NULL,
-          "text file refused");
+    CHECK(store_open(&s, path, NULL, err, sizeof err) == STORE_CORRUPT && s == NULL,
+          "text file refused as corrupt (SQLITE_NOTADB)");
     CHECK(strstr(err, "is not a SQLite database") != NULL, "not-a-database sentence: '%s'", err);
     remove_db(path);
 
@@ -414,8 +416,8 @@ static void test_refused(const char *dir)
         fputs("hello", f);
         fclose(f);
     }
-    CHECK(store_open(&s, path, NULL, err, sizeof err) == STORE_ERROR && s == NULL,
-          "5-byte file refused");
+    CHECK(store_open(&s, path, NULL, err, sizeof err) == STORE_CORRUPT && s == NULL,
+          "5-byte file refused as corrupt (SQLITE_NOTADB)");
     CHECK(strstr(err, "is not a SQLite database") != NULL, "short file sentence: '%s'", err);
     remove_db(path);
 

@@ -1,0 +1,73 @@
+/*
+ * store_backend.h — private to the store: the line where a backend plugs in.
+ *
+ * store.c owns what every backend shares: argument checks, the public
+ * entry points, the error record and callback, state names.  A backend
+ * (store_sqlite*.c today; PostgreSQL later, DESIGN.md §6) fills one
+ * store_backend table; store.c calls it after checking arguments and
+ * zeroing out-parameters, so a backend sees only valid ids, states and
+ * filters.  A backend reports every failure through store_note_error.
+ * Not installed, not included by the daemon: only store*.c and the store
+ * test include it.
+ */
+#ifndef SPINMODAL_STORE_BACKEND_H
+#define SPINMODAL_STORE_BACKEND_H
+
+#include "store.h"
+
+#include <pthread.h>
+
+/* The operations of one backend; the meanings and return codes are those
+ * of the public functions of the same name in store.h.  open sets s->impl
+ * (NULL on failure, after freeing what it made); close frees it. */
+typedef struct store_backend {
+    const char *name;   /* "sqlite" */
+    int (*open)(store *s, const store_settings *set, int *requeued, char *err, size_t errlen);
+    void (*close)(store *s);
+    int (*schema_version)(store *s);
+    int (*submit)(store *s, const char *id, const char *request, size_t request_len,
+                  int speeds_total, double now, int *outcome, store_job *job);
+    int (*get)(store *s, const char *id, unsigned flags, store_job *out);
+    int (*claim_next)(store *s, double now, store_job *out);
+    int (*finish)(store *s, const char *id, store_state state, double now, int speeds_done,
+                  const char *error, const char *result, size_t result_len, const char *csv,
+                  size_t csv_len);
+    int (*requeue)(store *s, const char *id);
+    int (*cancel)(store *s, const char *id, double now, store_state *state);
+    int (*list)(store *s, long long before, int filter, int max, store_job *out, int *n,
+                int *more);
+    int (*count)(store *s, long long counts[STORE_N_STATES]);
+    int (*check_writable)(store *s);
+    int (*health)(store *s);
+    /* store_prune with the age bound as a time: by_age = 1 deletes the
+     * finished jobs that ended before cutoff; max_bytes <= 0: no size bound */
+    int (*prune)(store *s, int by_age, double cutoff, long long max_bytes, long long *removed);
+    int (*size)(store *s, long long *live_bytes, long long *file_bytes);
+} store_backend;
+
+/* The SQLite backend (store_sqlite.c, store_sqlite_open.c). */
+extern const store_backend store_sqlite_backend;
+
+struct store {
+    const store_backend *be;
+    void *impl;                 /* the backend's state */
+    store_error_cb on_error;    /* may be NULL */
+    void *on_error_ctx;
+    pthread_mutex_t err_lock;   /* guards last */
+    store_error last;           /* the most recent failure */
+};
+
+/*
+ * Record a failure of operation op (a static string) with the backend's
+ * code, errno and message (text may be NULL), then call the on_error
+ * callback outside err_lock.  Returns kind, so a backend can write
+ * `return store_note_error(s, …)`.  Not for NOT_FOUND, CONFLICT, INVALID.
+ */
+int store_note_error(store *s, int kind, int backend_rc, int sys_errno, const char *op,
+                     const char *text);
+
+/* errno of a failed system call → store_rc kind (EACCES → STORE_READONLY,
+ * ENOSPC → STORE_FULL, EIO → STORE_IOERR, …; STORE_ERROR otherwise). */
+int store_errno_kind(int e);
+
+#endif /* SPINMODAL_STORE_BACKEND_H */

@@ -1,0 +1,818 @@
+/*
+ * store_sqlite.c — the SQLite backend of the store: statements,
+ * connections, the job operations, health and retention (store.h).
+ * Opening, the lock file, checks and migrations are in store_sqlite_open.c;
+ * the probes and retention in store_sqlite_file.c.
+ *
+ * Durability.  A submission and a cancel are committed with synchronous=FULL
+ * (WAL: the commit is on disk) before store_submit / store_cancel return,
+ * so a 202 is never sent for a job a power cut or kill -9 could lose.
+ * Claims, finishes, requeues, pruning and the health probe commit with
+ * synchronous=NORMAL (no fsync): they survive a kill -9 of the process, and
+ * a power cut can at worst roll them back, which puts the job back to
+ * `queued` and runs it again (one fsync less per commit: ~1.4 ms each here).
+ *
+ * Connections.  One writer connection, guarded by a mutex, runs every write
+ * transaction (BEGIN IMMEDIATE … COMMIT); SQLite allows one writer at a time
+ * anyway, and serialising writers in-process hands the lock over on a mutex
+ * instead of sleeping in SQLite's busy handler.  The busy timeout (5 s by
+ * default) is still there for writers of other processes (a sqlite3 shell,
+ * a backup).  STORE_SQLITE_READERS reader connections, handed out under a
+ * mutex + condition variable, serve reads; in WAL mode they never wait for
+ * the writer.  Every connection is opened SQLITE_OPEN_NOMUTEX: it is only
+ * ever used by the one thread that holds it.  Each connection caches its
+ * prepared statements (prepared on first use), so a GET is one bind + step
+ * on a warm statement.
+ *
+ * Queue order.  seq (INTEGER PRIMARY KEY, the rowid) is both the submission
+ * order and the list cursor.  A resubmitted failed/canceled job gets a new
+ * seq (max + 1), so it queues last and lists as the newest; a job put back
+ * by store_requeue keeps its seq and runs first again.  Claiming is "lowest
+ * seq among queued" on the index jobs(state, seq).
+ *
+ * Every write transaction first checks that the path still names the file
+ * opened (store_sqlite_same_file): SQLite in WAL mode goes on committing to
+ * a deleted or replaced file, and those commits would be lost.
+ *
+ * Errors.  Every failing SQLite call goes through store_sqlite_fail while
+ * the connection is still held and before a ROLLBACK can replace its
+ * message: SQLite's extended code, errno and sqlite3_errmsg text are
+ * recorded (store_note_error) with the operation's name, and the code is
+ * mapped to a kind (store_sqlite_kind).
+ */
+#include "store_sqlite.h"
+
+#include <errno.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+/* Columns every job read selects, in the order job_from_row expects
+ * (0 … 11); the three large texts follow as columns 12, 13, 14.
+ * typeof() tells whether a result is stored without loading its text. */
+#define JOB_COLS                                                                        \
+    "seq, id, state, speeds_total, speeds_done, attempts, cancel_requested, created_at," \
+    " started_at, finished_at, typeof(result) <> 'null', error"
+#define JOB_GET(req, res, csv) "SELECT " JOB_COLS ", " req ", " res ", " csv " FROM jobs WHERE id = ?1"
+#define JOB_FINISHED "state IN ('done', 'failed', 'canceled')"
+
+const char *const store_sqlite_sql[STMT_N] = {
+    JOB_GET("NULL", "NULL", "NULL"),
+    JOB_GET("request", "NULL", "NULL"),
+    JOB_GET("NULL", "result", "NULL"),
+    JOB_GET("request", "result", "NULL"),
+    JOB_GET("NULL", "NULL", "result_csv"),
+    JOB_GET("request", "NULL", "result_csv"),
+    JOB_GET("NULL", "result", "result_csv"),
+    JOB_GET("request", "result", "result_csv"),
+    /* STMT_BEGIN */ "BEGIN IMMEDIATE",
+    /* STMT_COMMIT */ "COMMIT",
+    /* STMT_ROLLBACK */ "ROLLBACK",
+    /* STMT_INSERT */
+    "INSERT INTO jobs (id, state, speeds_total, created_at, request)"
+    " VALUES (?1, 'queued', ?2, ?3, ?4)",
+    /* STMT_RESUBMIT: a new seq (max + 1) so the job queues last */
+    "UPDATE jobs SET seq = (SELECT max(seq) FROM jobs) + 1, state = 'queued', speeds_total = ?2,"
+    " speeds_done = 0, attempts = 0, cancel_requested = 0, started_at = NULL,"
+    " finished_at = NULL, error = NULL, request = ?3, result = NULL, result_csv = NULL"
+    " WHERE id = ?1 AND state IN ('failed', 'canceled')",
+    /* STMT_CLAIM */
+    "UPDATE jobs SET state = 'running', started_at = ?1, attempts = attempts + 1"
+    " WHERE seq = (SELECT seq FROM jobs WHERE state = 'queued' ORDER BY seq LIMIT 1)"
+    " RETURNING " JOB_COLS ", request, NULL, NULL",
+    /* STMT_FINISH */
+    "UPDATE jobs SET state = ?2, finished_at = ?3, speeds_done = ?4, error = ?5, result = ?6,"
+    " result_csv = ?7 WHERE id = ?1 AND state = 'running'",
+    /* STMT_REQUEUE: the interruption was not the job's fault; a cancel
+     * request is kept, so the next worker stops the job at once */
+    "UPDATE jobs SET state = 'queued', started_at = NULL, speeds_done = 0,"
+    " attempts = max(attempts - 1, 0) WHERE id = ?1 AND state = 'running'",
+    /* STMT_STATE */ "SELECT state FROM jobs WHERE id = ?1",
+    /* STMT_CANCEL_QUEUED */
+    "UPDATE jobs SET state = 'canceled', finished_at = ?2 WHERE id = ?1 AND state = 'queued'",
+    /* STMT_CANCEL_RUNNING */
+    "UPDATE jobs SET cancel_requested = 1 WHERE id = ?1 AND state = 'running'",
+    /* STMT_LIST_ALL */
+    "SELECT " JOB_COLS " FROM jobs WHERE seq < ?1 ORDER BY seq DESC LIMIT ?2",
+    /* STMT_LIST_STATE */
+    "SELECT " JOB_COLS " FROM jobs WHERE state = ?3 AND seq < ?1 ORDER BY seq DESC LIMIT ?2",
+    /* STMT_COUNT */ "SELECT state, count(*) FROM jobs GROUP BY state",
+    /* STMT_PAGES */
+    "SELECT p.page_count, f.freelist_count, s.page_size"
+    " FROM pragma_page_count AS p, pragma_freelist_count AS f, pragma_page_size AS s",
+    /* STMT_PRUNE_AGE: one batch of the jobs that ended before ?1 */
+    "DELETE FROM jobs WHERE seq IN (SELECT seq FROM jobs WHERE " JOB_FINISHED
+    " AND finished_at < ?1 ORDER BY finished_at, seq LIMIT ?2)",
+    /* STMT_PRUNE_OLDEST: the next batch of candidates for the size bound */
+    "SELECT seq FROM jobs WHERE " JOB_FINISHED " ORDER BY finished_at, seq LIMIT ?1",
+    /* STMT_PRUNE_ONE: the state test again, in case the job was resubmitted */
+    "DELETE FROM jobs WHERE seq = ?1 AND " JOB_FINISHED,
+};
+
+/* ---- errors --------------------------------------------------------------- */
+
+int store_sqlite_kind(int rc, int sys_errno)
+{
+    int errno_kind = store_errno_kind(sys_errno);
+
+    switch (rc & 0xff) {
+    case SQLITE_OK:
+    case SQLITE_ROW:
+    case SQLITE_DONE:
+        return STORE_OK;
+    case SQLITE_NOMEM:
+        return STORE_NOMEM;
+    case SQLITE_FULL:
+        return STORE_FULL;
+    case SQLITE_BUSY:
+    case SQLITE_LOCKED:
+        return STORE_BUSY;
+    case SQLITE_CORRUPT:
+    case SQLITE_NOTADB:
+        return STORE_CORRUPT;
+    case SQLITE_READONLY:
+        /* DBMOVED: the file was unlinked or replaced under the connection */
+        return rc == SQLITE_READONLY_DBMOVED ? STORE_GONE : STORE_READONLY;
+    case SQLITE_PERM:
+        return STORE_READONLY;
+    case SQLITE_CANTOPEN:
+        /* the file or a -wal/-shm/temp file beside it: the errno says why */
+        return errno_kind == STORE_OK ? STORE_ERROR : errno_kind;
+    case SQLITE_IOERR:
+        if (rc == SQLITE_IOERR_NOMEM)
+            return STORE_NOMEM;
+        return errno_kind == STORE_FULL || errno_kind == STORE_READONLY ? errno_kind : STORE_IOERR;
+    default:
+        return STORE_ERROR;
+    }
+}
+
+int store_sqlite_fail(store_conn *c, int rc)
+{
+    int e = c->db ? sqlite3_system_errno(c->db) : 0;
+    int kind = store_sqlite_kind(rc, e);
+    const char *text = c->db ? sqlite3_errmsg(c->db) : sqlite3_errstr(rc);
+
+    if (kind == STORE_OK)
+        kind = STORE_ERROR;   /* a caller's "failure" SQLite did not see */
+    return store_note_error(c->owner, kind, rc, e, c->op, text);
+}
+
+/* A failure that is not SQLite's (a malformed row, an allocation). */
+static int conn_fail_kind(store_conn *c, int kind, const char *text)
+{
+    return store_note_error(c->owner, kind, 0, 0, c->op, text);
+}
+
+int store_sqlite_same_file(store *s, const char *path, dev_t dev, ino_t ino, const char *what,
+                           const char *op)
+{
+    struct stat st;
+    char text[256];
+    int e;
+
+    if (stat(path, &st) != 0) {
+        e = errno;
+        if (e != ENOENT && e != ENOTDIR) {
+            snprintf(text, sizeof text, "cannot look at %s '%s': %s", what, path, strerror(e));
+            return store_note_error(s, store_errno_kind(e), 0, e, op, text);
+        }
+        snprintf(text, sizeof text, "%s '%s' was deleted while the store had it open", what, path);
+        return store_note_error(s, STORE_GONE, 0, e, op, text);
+    }
+    if (st.st_dev != dev || st.st_ino != ino) {
+        snprintf(text, sizeof text, "%s '%s' was replaced by another file while the store had "
+                 "it open", what, path);
+        return store_note_error(s, STORE_GONE, 0, 0, op, text);
+    }
+    return STORE_OK;
+}
+
+/* ---- statements ----------------------------------------------------------- */
+
+sqlite3_stmt *store_sqlite_stmt(store_conn *c, int k, int *rc)
+{
+    if (c->stmt[k] == NULL) {
+        *rc = sqlite3_prepare_v3(c->db, store_sqlite_sql[k], -1, SQLITE_PREPARE_PERSISTENT,
+                                 &c->stmt[k], NULL);
+        if (*rc != SQLITE_OK) {
+            c->stmt[k] = NULL;
+            return NULL;
+        }
+    }
+    *rc = SQLITE_OK;
+    return c->stmt[k];
+}
+
+void store_sqlite_stmt_done(sqlite3_stmt *st)
+{
+    if (st == NULL)
+        return;
+    (void)sqlite3_reset(st);
+    (void)sqlite3_clear_bindings(st);
+}
+
+int store_sqlite_exec(store_conn *c, int k)
+{
+    int rc;
+    sqlite3_stmt *st = store_sqlite_stmt(c, k, &rc);
+
+    if (st == NULL)
+        return rc;
+    rc = sqlite3_step(st);
+    store_sqlite_stmt_done(st);
+    return rc == SQLITE_DONE || rc == SQLITE_ROW ? SQLITE_OK : rc;
+}
+
+void store_sqlite_rollback(store_conn *c)
+{
+    if (!sqlite3_get_autocommit(c->db))
+        (void)store_sqlite_exec(c, STMT_ROLLBACK);
+}
+
+void store_sqlite_conn_close(store_conn *c)
+{
+    for (int k = 0; k < STMT_N; k++) {
+        if (c->stmt[k] != NULL)
+            (void)sqlite3_finalize(c->stmt[k]);
+        c->stmt[k] = NULL;
+    }
+    if (c->db != NULL)
+        (void)sqlite3_close(c->db);
+    c->db = NULL;
+}
+
+/* Bind text (NULL → SQL NULL); the text must live until the step. */
+static int bind_text(sqlite3_stmt *st, int i, const char *s, size_t len)
+{
+    if (s == NULL)
+        return sqlite3_bind_null(st, i);
+    return sqlite3_bind_text64(st, i, s, (sqlite3_uint64)len, SQLITE_STATIC, SQLITE_UTF8);
+}
+
+/* Copy text column i into a malloc'd NUL-terminated string (NULL when the
+ * column is NULL).  Returns SQLITE_OK or SQLITE_NOMEM. */
+static int column_dup(sqlite3_stmt *st, int i, char **out, size_t *len)
+{
+    const unsigned char *t;
+    int n;
+
+    *out = NULL;
+    if (len)
+        *len = 0;
+    if (sqlite3_column_type(st, i) == SQLITE_NULL)
+        return SQLITE_OK;
+    t = sqlite3_column_text(st, i);
+    n = sqlite3_column_bytes(st, i);
+    if (t == NULL || n < 0)
+        return SQLITE_NOMEM;   /* a non-NULL value that could not be converted */
+    *out = malloc((size_t)n + 1);
+    if (*out == NULL)
+        return SQLITE_NOMEM;
+    memcpy(*out, t, (size_t)n);
+    (*out)[n] = '\0';
+    if (len)
+        *len = (size_t)n;
+    return SQLITE_OK;
+}
+
+/* Read the state text of column i: STORE_OK, or STORE_CORRUPT (recorded)
+ * for a state the schema's CHECK forbids. */
+static int column_state(store_conn *c, sqlite3_stmt *st, int i, store_state *out)
+{
+    const char *t = (const char *)sqlite3_column_text(st, i);
+
+    if (store_state_parse(t, out) == STORE_OK)
+        return STORE_OK;
+    return conn_fail_kind(c, STORE_CORRUPT, "a job row holds an unknown state");
+}
+
+/* Fill *j (overwritten, not freed) from the current row of st, laid out as
+ * JOB_COLS; with_large: columns 12 … 14 hold request, result, CSV (or NULL).
+ * On failure *j holds no allocation.  Returns a store_rc. */
+static int job_from_row(store_conn *c, sqlite3_stmt *st, int with_large, store_job *j)
+{
+    const unsigned char *id;
+    int rc;
+
+    memset(j, 0, sizeof *j);
+    id = sqlite3_column_text(st, 1);
+    if (id == NULL || sqlite3_column_bytes(st, 1) != 64)   /* the schema's CHECK forbids it */
+        return conn_fail_kind(c, STORE_CORRUPT, "a job row holds an id that is not 64 characters");
+    memcpy(j->id, id, 64);
+    j->id[64] = '\0';
+    j->seq = sqlite3_column_int64(st, 0);
+    if (column_state(c, st, 2, &j->state) != STORE_OK)
+        return STORE_CORRUPT;
+    j->speeds_total = sqlite3_column_int(st, 3);
+    j->speeds_done = sqlite3_column_int(st, 4);
+    j->attempts = sqlite3_column_int(st, 5);
+    j->cancel_requested = sqlite3_column_int(st, 6) != 0;
+    j->created_at = sqlite3_column_double(st, 7);   /* NULL reads as 0.0 */
+    j->started_at = sqlite3_column_double(st, 8);
+    j->finished_at = sqlite3_column_double(st, 9);
+    j->has_result = sqlite3_column_int(st, 10) != 0;
+    rc = column_dup(st, 11, &j->error, NULL);
+    if (rc == SQLITE_OK && with_large)
+        rc = column_dup(st, 12, &j->request, &j->request_len);
+    if (rc == SQLITE_OK && with_large)
+        rc = column_dup(st, 13, &j->result, &j->result_len);
+    if (rc == SQLITE_OK && with_large)
+        rc = column_dup(st, 14, &j->result_csv, &j->csv_len);
+    if (rc != SQLITE_OK) {
+        store_job_clear(j);
+        return conn_fail_kind(c, STORE_NOMEM, "out of memory copying a job's texts");
+    }
+    return STORE_OK;
+}
+
+/* ---- the pool ------------------------------------------------------------- */
+
+/* Take a reader connection for operation op, waiting while all are in use;
+ * NULL (recorded as STORE_ERROR) when the pool's lock fails. */
+static store_conn *reader_acquire(store *s, const char *op)
+{
+    store_sqlite *q = s->impl;
+    store_conn *c;
+
+    if (pthread_mutex_lock(&q->pool_lock) != 0)
+        goto fail;
+    while (q->free_readers == NULL) {
+        if (pthread_cond_wait(&q->pool_cond, &q->pool_lock) != 0) {
+            (void)pthread_mutex_unlock(&q->pool_lock);
+            goto fail;
+        }
+    }
+    c = q->free_readers;
+    q->free_readers = c->next;
+    (void)pthread_mutex_unlock(&q->pool_lock);
+    c->op = op;
+    return c;
+fail:
+    (void)store_note_error(s, STORE_ERROR, 0, 0, op, "cannot take a reader connection");
+    return NULL;
+}
+
+static void reader_release(store *s, store_conn *c)
+{
+    store_sqlite *q = s->impl;
+
+    (void)pthread_mutex_lock(&q->pool_lock);
+    c->next = q->free_readers;
+    q->free_readers = c;
+    (void)pthread_cond_signal(&q->pool_cond);
+    (void)pthread_mutex_unlock(&q->pool_lock);
+}
+
+/* Back to synchronous=FULL after a relaxed transaction (caller holds write_lock). */
+static void writer_restore(store_sqlite *q)
+{
+    if (q->writer_relaxed &&
+        sqlite3_exec(q->writer.db, "PRAGMA synchronous = FULL", NULL, NULL, NULL) == SQLITE_OK)
+        q->writer_relaxed = 0;
+}
+
+/* BEGIN IMMEDIATE takes the write lock now, so no later statement of the
+ * transaction can fail with BUSY.  durable = 0 commits with
+ * synchronous=NORMAL: in WAL mode it survives a crash or kill -9 of the
+ * process but may roll back on power loss.  Used for claim, finish,
+ * requeue, pruning and the health probe, whose loss only means a job runs
+ * again (results are deterministic) or a probe is repeated; a submission
+ * and a cancel are always durable (on disk before the HTTP answer). */
+int store_sqlite_writer_begin(store *s, store_conn **out, int durable, const char *op)
+{
+    store_sqlite *q = s->impl;
+    int rc;
+
+    *out = NULL;
+    if (pthread_mutex_lock(&q->write_lock) != 0)
+        return store_note_error(s, STORE_ERROR, 0, 0, op, "cannot take the writer's lock");
+    q->writer.op = op;
+    /* a commit to a deleted or replaced file would be lost at the next
+     * start (SQLite in WAL mode does not notice): one stat(2), ~1 µs */
+    rc = store_sqlite_same_file(s, q->path, q->db_dev, q->db_ino, "database file", op);
+    if (rc != STORE_OK) {
+        (void)pthread_mutex_unlock(&q->write_lock);
+        return rc;
+    }
+    if (!durable && sqlite3_exec(q->writer.db, "PRAGMA synchronous = NORMAL", NULL, NULL,
+                                 NULL) == SQLITE_OK)
+        q->writer_relaxed = 1;
+    rc = store_sqlite_exec(&q->writer, STMT_BEGIN);   /* waits busy_ms for other processes */
+    if (rc != SQLITE_OK) {
+        int kind = store_sqlite_fail(&q->writer, rc);
+        writer_restore(q);
+        (void)pthread_mutex_unlock(&q->write_lock);
+        return kind;
+    }
+    *out = &q->writer;
+    return STORE_OK;
+}
+
+int store_sqlite_writer_end(store *s, int status, int commit)
+{
+    store_sqlite *q = s->impl;
+    int rc;
+
+    if (commit) {
+        rc = store_sqlite_exec(&q->writer, STMT_COMMIT);
+        if (rc != SQLITE_OK) {
+            status = store_sqlite_fail(&q->writer, rc);
+            store_sqlite_rollback(&q->writer);
+        }
+    } else {
+        store_sqlite_rollback(&q->writer);
+    }
+    writer_restore(q);
+    (void)pthread_mutex_unlock(&q->write_lock);
+    return status;
+}
+
+/* ---- writes --------------------------------------------------------------- */
+
+/* Read job id on connection c (inside the caller's transaction or not)
+ * with the large texts of flags.  Returns a store_rc. */
+static int conn_get(store_conn *c, const char *id, unsigned flags, store_job *out)
+{
+    int rc, status;
+    sqlite3_stmt *st = store_sqlite_stmt(c, STMT_GET + (int)(flags & 7u), &rc);
+
+    memset(out, 0, sizeof *out);
+    if (st == NULL)
+        return store_sqlite_fail(c, rc);
+    rc = bind_text(st, 1, id, strlen(id));
+    if (rc == SQLITE_OK)
+        rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW)
+        status = job_from_row(c, st, 1, out);
+    else if (rc == SQLITE_DONE)
+        status = STORE_NOT_FOUND;
+    else
+        status = store_sqlite_fail(c, rc);
+    store_sqlite_stmt_done(st);
+    return status;
+}
+
+/* The state of job id on c: STORE_OK, STORE_NOT_FOUND or a failure kind. */
+static int conn_state(store_conn *c, const char *id, store_state *out)
+{
+    int rc, status;
+    sqlite3_stmt *st = store_sqlite_stmt(c, STMT_STATE, &rc);
+
+    if (st == NULL)
+        return store_sqlite_fail(c, rc);
+    rc = bind_text(st, 1, id, strlen(id));
+    if (rc == SQLITE_OK)
+        rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW)
+        status = column_state(c, st, 0, out);
+    else if (rc == SQLITE_DONE)
+        status = STORE_NOT_FOUND;
+    else
+        status = store_sqlite_fail(c, rc);
+    store_sqlite_stmt_done(st);
+    return status;
+}
+
+/* Step the bound update statement st of c once, reset it; *changes
+ * receives the rows it changed.  Returns a store_rc. */
+static int conn_update(store_conn *c, sqlite3_stmt *st, int *changes)
+{
+    int rc = sqlite3_step(st), status = STORE_OK;
+
+    if (rc != SQLITE_DONE)
+        status = store_sqlite_fail(c, rc);
+    store_sqlite_stmt_done(st);
+    if (status == STORE_OK)
+        *changes = sqlite3_changes(c->db);
+    return status;
+}
+
+/* A statement of c that failed to prepare or bind: record, reset, return the kind. */
+static int stmt_fail(store_conn *c, sqlite3_stmt *st, int rc)
+{
+    int kind = store_sqlite_fail(c, rc);
+
+    store_sqlite_stmt_done(st);
+    return kind;
+}
+
+static int sq_submit(store *s, const char *id, const char *request, size_t request_len,
+                     int speeds_total, double now, int *outcome, store_job *job)
+{
+    store_conn *c = NULL;
+    sqlite3_stmt *st;
+    store_state state;
+    int rc, status, changes = 0, result = 0;
+
+    status = store_sqlite_writer_begin(s, &c, 1, "submit");
+    if (status != STORE_OK)
+        return status;
+    status = conn_state(c, id, &state);
+    if (status == STORE_NOT_FOUND) {
+        st = store_sqlite_stmt(c, STMT_INSERT, &rc);
+        if (st == NULL || (rc = bind_text(st, 1, id, 64)) != SQLITE_OK ||
+            (rc = sqlite3_bind_int(st, 2, speeds_total)) != SQLITE_OK ||
+            (rc = sqlite3_bind_double(st, 3, now)) != SQLITE_OK ||
+            (rc = bind_text(st, 4, request, request_len)) != SQLITE_OK) {
+            status = stmt_fail(c, st, rc);
+            goto fail;
+        }
+        status = conn_update(c, st, &changes);
+        result = 1;
+    } else if (status == STORE_OK && (state == STORE_FAILED || state == STORE_CANCELED)) {
+        st = store_sqlite_stmt(c, STMT_RESUBMIT, &rc);
+        if (st == NULL || (rc = bind_text(st, 1, id, 64)) != SQLITE_OK ||
+            (rc = sqlite3_bind_int(st, 2, speeds_total)) != SQLITE_OK ||
+            (rc = bind_text(st, 3, request, request_len)) != SQLITE_OK) {
+            status = stmt_fail(c, st, rc);
+            goto fail;
+        }
+        status = conn_update(c, st, &changes);
+        result = 2;
+    }
+    if (status != STORE_OK)
+        goto fail;
+    if (job) {
+        status = conn_get(c, id, 0, job);
+        if (status != STORE_OK)
+            goto fail;
+    }
+    status = store_sqlite_writer_end(s, STORE_OK, 1);
+    if (status != STORE_OK) {
+        store_job_clear(job);
+        return status;
+    }
+    if (outcome)
+        *outcome = result;
+    return STORE_OK;
+fail:
+    store_job_clear(job);
+    return store_sqlite_writer_end(s, status, 0);
+}
+
+static int sq_claim_next(store *s, double now, store_job *out)
+{
+    store_conn *c = NULL;
+    sqlite3_stmt *st;
+    int rc, status, got = 0;
+
+    status = store_sqlite_writer_begin(s, &c, 0, "claim");
+    if (status != STORE_OK)
+        return status;
+    st = store_sqlite_stmt(c, STMT_CLAIM, &rc);
+    if (st == NULL || (rc = sqlite3_bind_double(st, 1, now)) != SQLITE_OK) {
+        status = stmt_fail(c, st, rc);
+        goto fail;
+    }
+    /* RETURNING: every row is computed at the first step; step to DONE
+     * before committing */
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        if (!got) {
+            status = job_from_row(c, st, 1, out);
+            if (status != STORE_OK) {
+                store_sqlite_stmt_done(st);
+                goto fail;
+            }
+            got = 1;
+        }
+    }
+    if (rc != SQLITE_DONE) {
+        status = stmt_fail(c, st, rc);
+        goto fail;
+    }
+    store_sqlite_stmt_done(st);
+    if (!got)
+        return store_sqlite_writer_end(s, STORE_NOT_FOUND, 0);
+    status = store_sqlite_writer_end(s, STORE_OK, 1);
+    if (status != STORE_OK)
+        store_job_clear(out);
+    return status;
+fail:
+    store_job_clear(out);
+    return store_sqlite_writer_end(s, status, 0);
+}
+
+/* After an update touched no row: STORE_NOT_FOUND (no such job) or
+ * STORE_CONFLICT (it exists in another state). */
+static int no_change_status(store_conn *c, const char *id)
+{
+    store_state st = STORE_QUEUED;
+    int status = conn_state(c, id, &st);
+
+    return status == STORE_OK ? STORE_CONFLICT : status;
+}
+
+/* Run the bound update st of the writer's open transaction on job id and end
+ * the transaction: committed when a row changed; else rolled back with
+ * STORE_NOT_FOUND or STORE_CONFLICT (no_change_status). */
+static int writer_update_one(store *s, store_conn *c, sqlite3_stmt *st, const char *id)
+{
+    int changes = 0, status = conn_update(c, st, &changes);
+
+    if (status != STORE_OK)
+        return store_sqlite_writer_end(s, status, 0);
+    if (changes == 0)
+        return store_sqlite_writer_end(s, no_change_status(c, id), 0);
+    return store_sqlite_writer_end(s, STORE_OK, 1);
+}
+
+static int sq_finish(store *s, const char *id, store_state state, double now, int speeds_done,
+                     const char *error, const char *result, size_t result_len, const char *csv,
+                     size_t csv_len)
+{
+    const char *name = store_state_name(state);
+    store_conn *c = NULL;
+    sqlite3_stmt *st;
+    int rc, status;
+
+    status = store_sqlite_writer_begin(s, &c, 0, "finish");
+    if (status != STORE_OK)
+        return status;
+    st = store_sqlite_stmt(c, STMT_FINISH, &rc);
+    if (st == NULL || (rc = bind_text(st, 1, id, strlen(id))) != SQLITE_OK ||
+        (rc = bind_text(st, 2, name, strlen(name))) != SQLITE_OK ||
+        (rc = sqlite3_bind_double(st, 3, now)) != SQLITE_OK ||
+        (rc = sqlite3_bind_int(st, 4, speeds_done)) != SQLITE_OK ||
+        (rc = bind_text(st, 5, error, error ? strlen(error) : 0)) != SQLITE_OK ||
+        (rc = bind_text(st, 6, result, result_len)) != SQLITE_OK ||
+        (rc = bind_text(st, 7, csv, csv_len)) != SQLITE_OK)
+        return store_sqlite_writer_end(s, stmt_fail(c, st, rc), 0);
+    return writer_update_one(s, c, st, id);
+}
+
+static int sq_requeue(store *s, const char *id)
+{
+    store_conn *c = NULL;
+    sqlite3_stmt *st;
+    int rc, status;
+
+    status = store_sqlite_writer_begin(s, &c, 0, "requeue");
+    if (status != STORE_OK)
+        return status;
+    st = store_sqlite_stmt(c, STMT_REQUEUE, &rc);
+    if (st == NULL || (rc = bind_text(st, 1, id, strlen(id))) != SQLITE_OK)
+        return store_sqlite_writer_end(s, stmt_fail(c, st, rc), 0);
+    return writer_update_one(s, c, st, id);
+}
+
+static int sq_cancel(store *s, const char *id, double now, store_state *state)
+{
+    store_conn *c = NULL;
+    sqlite3_stmt *st;
+    store_state cur = STORE_QUEUED;
+    int rc, status, changes = 0;
+
+    status = store_sqlite_writer_begin(s, &c, 1, "cancel");
+    if (status != STORE_OK)
+        return status;
+    status = conn_state(c, id, &cur);
+    if (status != STORE_OK)
+        return store_sqlite_writer_end(s, status, 0);
+    if (state)
+        *state = cur;
+    if (cur != STORE_QUEUED && cur != STORE_RUNNING)
+        return store_sqlite_writer_end(s, STORE_CONFLICT, 0);
+
+    st = store_sqlite_stmt(c, cur == STORE_QUEUED ? STMT_CANCEL_QUEUED : STMT_CANCEL_RUNNING, &rc);
+    if (st != NULL)
+        rc = bind_text(st, 1, id, strlen(id));
+    if (st != NULL && rc == SQLITE_OK && cur == STORE_QUEUED)
+        rc = sqlite3_bind_double(st, 2, now);
+    if (st == NULL || rc != SQLITE_OK)
+        return store_sqlite_writer_end(s, stmt_fail(c, st, rc), 0);
+    status = conn_update(c, st, &changes);
+    if (status != STORE_OK)
+        return store_sqlite_writer_end(s, status, 0);
+    status = store_sqlite_writer_end(s, STORE_OK, 1);
+    if (status == STORE_OK && state && cur == STORE_QUEUED)
+        *state = STORE_CANCELED;
+    return status;
+}
+
+/* ---- reads ---------------------------------------------------------------- */
+
+static int sq_get(store *s, const char *id, unsigned flags, store_job *out)
+{
+    store_conn *c = reader_acquire(s, "get");
+    int status;
+
+    if (c == NULL)
+        return STORE_ERROR;
+    status = conn_get(c, id, flags, out);
+    reader_release(s, c);
+    return status;
+}
+
+/* The rows of a list statement into out[0 … max-1]; *more when a row
+ * beyond max exists. */
+static int list_rows(store_conn *c, sqlite3_stmt *st, int max, store_job *out, int *n, int *more)
+{
+    int rc, status;
+
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        if (*n >= max) {
+            *more = 1;
+            break;
+        }
+        status = job_from_row(c, st, 0, &out[*n]);
+        if (status != STORE_OK)
+            return status;
+        (*n)++;
+    }
+    if (rc != SQLITE_ROW && rc != SQLITE_DONE)
+        return store_sqlite_fail(c, rc);
+    return STORE_OK;
+}
+
+static int sq_list(store *s, long long before, int filter, int max, store_job *out, int *n,
+                   int *more)
+{
+    store_conn *c = reader_acquire(s, "list");
+    sqlite3_stmt *st;
+    int rc, status;
+
+    if (c == NULL)
+        return STORE_ERROR;
+    st = store_sqlite_stmt(c, filter >= 0 ? STMT_LIST_STATE : STMT_LIST_ALL, &rc);
+    if (st == NULL) {
+        status = store_sqlite_fail(c, rc);
+        goto done;
+    }
+    rc = sqlite3_bind_int64(st, 1, before > 0 ? (sqlite3_int64)before : INT64_MAX);
+    if (rc == SQLITE_OK)
+        rc = sqlite3_bind_int64(st, 2, (sqlite3_int64)max + 1);   /* one more: is there more? */
+    if (rc == SQLITE_OK && filter >= 0) {
+        const char *name = store_state_name((store_state)filter);
+        rc = bind_text(st, 3, name, strlen(name));
+    }
+    if (rc != SQLITE_OK)
+        status = store_sqlite_fail(c, rc);
+    else
+        status = list_rows(c, st, max, out, n, more);
+    store_sqlite_stmt_done(st);
+done:
+    reader_release(s, c);
+    if (status != STORE_OK) {
+        for (int i = 0; i < *n; i++)
+            store_job_clear(&out[i]);
+        *n = 0;
+        *more = 0;
+    }
+    return status;
+}
+
+static int sq_count(store *s, long long counts[STORE_N_STATES])
+{
+    store_conn *c = reader_acquire(s, "count");
+    sqlite3_stmt *st;
+    store_state state;
+    int rc, status = STORE_OK;
+
+    if (c == NULL)
+        return STORE_ERROR;
+    st = store_sqlite_stmt(c, STMT_COUNT, &rc);
+    if (st == NULL) {
+        status = store_sqlite_fail(c, rc);
+        reader_release(s, c);
+        return status;
+    }
+    while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
+        status = column_state(c, st, 0, &state);
+        if (status != STORE_OK)
+            break;
+        counts[state] = sqlite3_column_int64(st, 1);
+    }
+    if (status == STORE_OK && rc != SQLITE_DONE)
+        status = store_sqlite_fail(c, rc);
+    store_sqlite_stmt_done(st);
+    reader_release(s, c);
+    if (status != STORE_OK) {
+        for (int i = 0; i < STORE_N_STATES; i++)
+            counts[i] = 0;
+    }
+    return status;
+}
+
+/* ---- the backend table --------------------------------------------------- */
+
+const store_backend store_sqlite_backend = {
+    .name = "sqlite",
+    .open = store_sqlite_open,
+    .close = store_sqlite_close,
+    .schema_version = store_sqlite_schema_version,
+    .submit = sq_submit,
+    .get = sq_get,
+    .claim_next = sq_claim_next,
+    .finish = sq_finish,
+    .requeue = sq_requeue,
+    .cancel = sq_cancel,
+    .list = sq_list,
+    .count = sq_count,
+    .check_writable = store_sqlite_check_writable,
+    .health = store_sqlite_health,
+    .prune = store_sqlite_prune,
+    .size = store_sqlite_size,
+};
