@@ -21,7 +21,7 @@
  * The codec pre-checks only the cheap local cases (zero-length member, a
  * clamp that is no member's end) so those appear with the other errors.
  */
-#include "codec.h"
+#include "codec_internal.h"
 
 #include <limits.h>
 #include <math.h>
@@ -34,9 +34,6 @@
 
 /* Flags for dumping canonical text and results. */
 #define CODEC_DUMP_CANON (JSON_SORT_KEYS | JSON_COMPACT | JSON_REAL_PRECISION(17))
-
-/* 2*pi, for hertz (M_PI is not C11). */
-#define CODEC_TWO_PI 6.283185307179586476925
 
 /* ================================================================ limits */
 
@@ -71,7 +68,7 @@ struct codec_errors {
 };
 
 /* malloc'd printf; NULL when out of memory. */
-static char *str_vfmt(const char *fmt, va_list ap)
+char *err_vfmt(const char *fmt, va_list ap)
 {
     va_list aq;
     int n;
@@ -89,16 +86,13 @@ static char *str_vfmt(const char *fmt, va_list ap)
     return s;
 }
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 1, 2)))
-#endif
-static char *str_fmt(const char *fmt, ...)
+char *err_fmt(const char *fmt, ...)
 {
     va_list ap;
     char *s;
 
     va_start(ap, fmt);
-    s = str_vfmt(fmt, ap);
+    s = err_vfmt(fmt, ap);
     va_end(ap);
     return s;
 }
@@ -135,7 +129,7 @@ void codec_errors_free(codec_errors *e)
 }
 
 /* Store one error; takes ownership of message (may be NULL = NOMEM). */
-static int errors_push(codec_errors *e, const char *pointer, char *message)
+static int err_push(codec_errors *e, const char *pointer, char *message)
 {
     char *p = NULL;
 
@@ -170,9 +164,9 @@ fail:
     return SM_NOMEM;
 }
 
-static int errors_vadd(codec_errors *e, const char *pointer, const char *fmt, va_list ap)
+int err_vadd(codec_errors *e, const char *pointer, const char *fmt, va_list ap)
 {
-    return errors_push(e, pointer, str_vfmt(fmt, ap));
+    return err_push(e, pointer, err_vfmt(fmt, ap));
 }
 
 int codec_errors_add(codec_errors *e, const char *pointer, const char *fmt, ...)
@@ -181,7 +175,7 @@ int codec_errors_add(codec_errors *e, const char *pointer, const char *fmt, ...)
     int rc;
 
     va_start(ap, fmt);
-    rc = errors_vadd(e, pointer, fmt, ap);
+    rc = err_vadd(e, pointer, fmt, ap);
     va_end(ap);
     return rc;
 }
@@ -215,6 +209,21 @@ int codec_errors_too_large(const codec_errors *e)
     return e ? e->too_large : 0;
 }
 
+void err_mark_malformed(codec_errors *e)
+{
+    e->malformed = 1;
+}
+
+void err_mark_too_large(codec_errors *e)
+{
+    e->too_large = 1;
+}
+
+void err_mark_nomem(codec_errors *e)
+{
+    e->nomem = 1;
+}
+
 json_t *codec_errors_to_json(const codec_errors *e)
 {
     json_t *arr = json_array();
@@ -234,10 +243,10 @@ fail:
     return NULL;
 }
 
-/* ======================================================= pointers, names */
+/* ------------------------------------------------ RFC 6901 pointers */
 
 /* base + "/" + key with RFC 6901 escaping (~ -> ~0, / -> ~1); NULL = NOMEM. */
-static char *ptr_key(const char *base, const char *key)
+char *err_ptr_key(const char *base, const char *key)
 {
     size_t nb = strlen(base), nk = strlen(key), extra = 0, i, j;
     char *s;
@@ -263,19 +272,17 @@ static char *ptr_key(const char *base, const char *key)
 }
 
 /* base + "/" + index; NULL = NOMEM. */
-static char *ptr_idx(const char *base, size_t i)
+char *err_ptr_idx(const char *base, size_t i)
 {
-    return str_fmt("%s/%zu", base, i);
+    return err_fmt("%s/%zu", base, i);
 }
 
-/* A user-supplied name shortened for messages (cut on a UTF-8 boundary). */
-typedef struct short_name {
-    char s[72];
-} short_name;
+/* ================================================================= field */
 
-static short_name name_short(const char *name)
+/* A user-supplied name shortened for messages (cut on a UTF-8 boundary). */
+field_short field_short_name(const char *name)
 {
-    short_name out;
+    field_short out;
     size_t n = strlen(name), cut = 60;
 
     if (n <= cut) {
@@ -290,7 +297,7 @@ static short_name name_short(const char *name)
 }
 
 /* "an object", "a string", ... for "must be X, not Y" messages. */
-static const char *type_name(const json_t *x)
+const char *field_type_name(const json_t *x)
 {
     switch (json_typeof(x)) {
     case JSON_OBJECT: return "an object";
@@ -306,7 +313,7 @@ static const char *type_name(const json_t *x)
 }
 
 /* Levenshtein distance, capped: returns > 2 for anything far or long. */
-static int edit_distance(const char *a, const char *b)
+static int field_edit_distance(const char *a, const char *b)
 {
     size_t na = strlen(a), nb = strlen(b), i, j;
     int row[65];
@@ -332,20 +339,7 @@ static int edit_distance(const char *a, const char *b)
     return row[nb];
 }
 
-/* ============================================================ validation */
-
-/* Validation state: the error list and limits of one request. */
-typedef struct vctx {
-    codec_errors *errs;         /* where errors go (borrowed) */
-    const codec_limits *lim;    /* limits (borrowed) */
-    long total_elements;        /* FE elements over all valid members */
-    int nomem;                  /* an allocation failed */
-} vctx;
-
-#if defined(__GNUC__)
-__attribute__((format(printf, 3, 4)))
-#endif
-static void verr(vctx *v, const char *ptr, const char *fmt, ...)
+void field_error(val_ctx *v, const char *ptr, const char *fmt, ...)
 {
     va_list ap;
 
@@ -354,33 +348,30 @@ static void verr(vctx *v, const char *ptr, const char *fmt, ...)
         return;
     }
     va_start(ap, fmt);
-    if (errors_vadd(v->errs, ptr, fmt, ap))
+    if (err_vadd(v->errs, ptr, fmt, ap))
         v->nomem = 1;
     va_end(ap);
 }
 
 /* Error at base/key. */
-#if defined(__GNUC__)
-__attribute__((format(printf, 4, 5)))
-#endif
-static void verr_key(vctx *v, const char *base, const char *key, const char *fmt, ...)
+void field_error_key(val_ctx *v, const char *base, const char *key, const char *fmt, ...)
 {
     va_list ap;
-    char *p = ptr_key(base, key);
+    char *p = err_ptr_key(base, key);
 
     if (!p) {
         v->nomem = 1;
         return;
     }
     va_start(ap, fmt);
-    if (errors_vadd(v->errs, p, fmt, ap))
+    if (err_vadd(v->errs, p, fmt, ap))
         v->nomem = 1;
     va_end(ap);
     free(p);
 }
 
 /* Set canon[key] = value (stolen); records NOMEM. */
-static void cset(vctx *v, json_t *canon, const char *key, json_t *value)
+void field_set(val_ctx *v, json_t *canon, const char *key, json_t *value)
 {
     if (!canon) {
         json_decref(value);
@@ -391,8 +382,8 @@ static void cset(vctx *v, json_t *canon, const char *key, json_t *value)
 }
 
 /* Every key of obj must be one of allowed (NULL-terminated). */
-static void check_keys(vctx *v, const json_t *obj, const char *base,
-                       const char *const *allowed, const char *what)
+void field_check_keys(val_ctx *v, const json_t *obj, const char *base,
+                      const char *const *allowed, const char *what)
 {
     const char *key;
     json_t *val;
@@ -407,7 +398,7 @@ static void check_keys(vctx *v, const json_t *obj, const char *base,
                 found = 1;
                 break;
             }
-            d = edit_distance(key, allowed[i]);
+            d = field_edit_distance(key, allowed[i]);
             if (d < bestd) {
                 bestd = d;
                 best = allowed[i];
@@ -416,15 +407,16 @@ static void check_keys(vctx *v, const json_t *obj, const char *base,
         if (found)
             continue;
         if (best)
-            verr_key(v, base, key, "unknown %s key '%s' (did you mean '%s'?)", what,
-                     name_short(key).s, best);
+            field_error_key(v, base, key, "unknown %s key '%s' (did you mean '%s'?)", what,
+                            field_short_name(key).s, best);
         else
-            verr_key(v, base, key, "unknown %s key '%s'", what, name_short(key).s);
+            field_error_key(v, base, key, "unknown %s key '%s'", what,
+                            field_short_name(key).s);
     }
 }
 
 /* Numeric value of an integer or real; 0 if x is not a number. */
-static int num_value(const json_t *x, double *d)
+int field_number(const json_t *x, double *d)
 {
     if (json_is_integer(x)) {
         *d = (double)json_integer_value(x);
@@ -438,7 +430,7 @@ static int num_value(const json_t *x, double *d)
 }
 
 /* Integer value of an integer or an integral real in [lo, hi]; 0 otherwise. */
-static int int_value(const json_t *x, long lo, long hi, long *out)
+static int field_integer(const json_t *x, long lo, long hi, long *out)
 {
     double d;
 
@@ -459,29 +451,26 @@ static int int_value(const json_t *x, long lo, long hi, long *out)
     return 1;
 }
 
-/* Range classes for real fields. */
-enum real_kind { REAL_FINITE, REAL_NONNEG, REAL_POSITIVE };
-
 /* Check a real value x at ptr; 1 and *out when valid. */
-static int check_real(vctx *v, const json_t *x, const char *ptr, enum real_kind kind,
-                      const char *unit, double *out)
+int field_check_real(val_ctx *v, const json_t *x, const char *ptr,
+                     enum field_real_kind kind, const char *unit, double *out)
 {
     double d;
 
-    if (!num_value(x, &d)) {
-        verr(v, ptr, "must be a number%s, not %s", unit, type_name(x));
+    if (!field_number(x, &d)) {
+        field_error(v, ptr, "must be a number%s, not %s", unit, field_type_name(x));
         return 0;
     }
     if (!isfinite(d)) {
-        verr(v, ptr, "must be a finite number");
+        field_error(v, ptr, "must be a finite number");
         return 0;
     }
-    if (kind == REAL_POSITIVE && !(d > 0)) {
-        verr(v, ptr, "must be a positive number%s, got %g", unit, d);
+    if (kind == FIELD_POSITIVE && !(d > 0)) {
+        field_error(v, ptr, "must be a positive number%s, got %g", unit, d);
         return 0;
     }
-    if (kind == REAL_NONNEG && !(d >= 0)) {
-        verr(v, ptr, "must be a number >= 0%s, got %g", unit, d);
+    if (kind == FIELD_NONNEG && !(d >= 0)) {
+        field_error(v, ptr, "must be a number >= 0%s, got %g", unit, d);
         return 0;
     }
     if (d == 0)
@@ -491,8 +480,8 @@ static int check_real(vctx *v, const json_t *x, const char *ptr, enum real_kind 
 }
 
 /* Real field obj[key]: required, checked, written to canon as a real. */
-static int rd_real(vctx *v, const json_t *obj, const char *key, const char *base,
-                   json_t *canon, enum real_kind kind, const char *unit, double *out)
+int field_real(val_ctx *v, const json_t *obj, const char *key, const char *base,
+               json_t *canon, enum field_real_kind kind, const char *unit, double *out)
 {
     const json_t *x = json_object_get(obj, key);
     char *ptr;
@@ -500,19 +489,19 @@ static int rd_real(vctx *v, const json_t *obj, const char *key, const char *base
     int ok;
 
     if (!x) {
-        verr_key(v, base, key, "required field '%s' is missing", key);
+        field_error_key(v, base, key, "required field '%s' is missing", key);
         return 0;
     }
-    ptr = ptr_key(base, key);
+    ptr = err_ptr_key(base, key);
     if (!ptr) {
         v->nomem = 1;
         return 0;
     }
-    ok = check_real(v, x, ptr, kind, unit, &d);
+    ok = field_check_real(v, x, ptr, kind, unit, &d);
     free(ptr);
     if (!ok)
         return 0;
-    cset(v, canon, key, json_real(d));
+    field_set(v, canon, key, json_real(d));
     if (out)
         *out = d;
     return 1;
@@ -522,113 +511,141 @@ static int rd_real(vctx *v, const json_t *obj, const char *key, const char *base
  * Integer field obj[key] in [lo, hi] (hi from a limit when limit_name is set).
  * Absent: error when required, else canon gets def.
  */
-static int rd_int(vctx *v, const json_t *obj, const char *key, const char *base,
-                  json_t *canon, int required, long def, long lo, long hi,
-                  const char *limit_name, long *out)
+int field_int(val_ctx *v, const json_t *obj, const char *key, const char *base,
+              json_t *canon, int required, long def, long lo, long hi,
+              const char *limit_name, long *out)
 {
     const json_t *x = json_object_get(obj, key);
     long i;
 
     if (!x) {
         if (required) {
-            verr_key(v, base, key, "required field '%s' is missing", key);
+            field_error_key(v, base, key, "required field '%s' is missing", key);
             return 0;
         }
-        cset(v, canon, key, json_integer(def));
+        field_set(v, canon, key, json_integer(def));
         if (out)
             *out = def;
         return 1;
     }
-    if (!int_value(x, lo, LONG_MAX, &i)) {
+    if (!field_integer(x, lo, LONG_MAX, &i)) {
         double d;
-        if (num_value(x, &d) && d >= (double)lo && isfinite(d) && d == floor(d))
+        if (field_number(x, &d) && d >= (double)lo && isfinite(d) && d == floor(d))
             i = LONG_MAX; /* integral but huge: report as over the limit */
         else {
-            verr_key(v, base, key, "must be an integer >= %ld", lo);
+            field_error_key(v, base, key, "must be an integer >= %ld", lo);
             return 0;
         }
     }
     if (i > hi) {
         if (limit_name)
-            verr_key(v, base, key, "%s is too large: the limit is %ld", limit_name, hi);
+            field_error_key(v, base, key, "%s is too large: the limit is %ld", limit_name, hi);
         else
-            verr_key(v, base, key, "must be an integer between %ld and %ld", lo, hi);
+            field_error_key(v, base, key, "must be an integer between %ld and %ld", lo, hi);
         return 0;
     }
-    cset(v, canon, key, json_integer(i));
+    field_set(v, canon, key, json_integer(i));
     if (out)
         *out = i;
     return 1;
 }
 
 /* Boolean field with a default. */
-static void rd_bool(vctx *v, const json_t *obj, const char *key, const char *base,
-                    json_t *canon, int def)
+void field_bool(val_ctx *v, const json_t *obj, const char *key, const char *base,
+                json_t *canon, int def)
 {
     const json_t *x = json_object_get(obj, key);
 
     if (!x) {
-        cset(v, canon, key, json_boolean(def));
+        field_set(v, canon, key, json_boolean(def));
         return;
     }
     if (!json_is_boolean(x)) {
-        verr_key(v, base, key, "must be true or false, not %s", type_name(x));
+        field_error_key(v, base, key, "must be true or false, not %s", field_type_name(x));
         return;
     }
-    cset(v, canon, key, json_boolean(json_is_true(x)));
+    field_set(v, canon, key, json_boolean(json_is_true(x)));
 }
 
 /* String field with one of choices (NULL-terminated) and a default. */
-static void rd_enum(vctx *v, const json_t *obj, const char *key, const char *base,
-                    json_t *canon, const char *const *choices, const char *def)
+void field_enum(val_ctx *v, const json_t *obj, const char *key, const char *base,
+                json_t *canon, const char *const *choices, const char *def)
 {
     const json_t *x = json_object_get(obj, key);
     const char *s;
     int i;
 
     if (!x) {
-        cset(v, canon, key, json_string(def));
+        field_set(v, canon, key, json_string(def));
         return;
     }
     if (!json_is_string(x)) {
-        verr_key(v, base, key, "must be a string, not %s", type_name(x));
+        field_error_key(v, base, key, "must be a string, not %s", field_type_name(x));
         return;
     }
     s = json_string_value(x);
     for (i = 0; choices[i]; i++) {
         if (!strcmp(s, choices[i])) {
-            cset(v, canon, key, json_string(s));
+            field_set(v, canon, key, json_string(s));
             return;
         }
     }
-    verr_key(v, base, key, "unknown value '%s'; expected '%s' or '%s'", name_short(s).s,
-             choices[0], choices[1]);
+    field_error_key(v, base, key, "unknown value '%s'; expected '%s' or '%s'",
+                    field_short_name(s).s, choices[0], choices[1]);
 }
 
 /* Required object field; NULL (with an error) when absent or not an object. */
-static const json_t *rd_object(vctx *v, const json_t *obj, const char *key, const char *base)
+const json_t *field_object(val_ctx *v, const json_t *obj, const char *key, const char *base)
 {
     const json_t *x = json_object_get(obj, key);
 
     if (!x) {
-        verr_key(v, base, key, "required field '%s' is missing", key);
+        field_error_key(v, base, key, "required field '%s' is missing", key);
         return NULL;
     }
     if (!json_is_object(x)) {
-        verr_key(v, base, key, "must be an object, not %s", type_name(x));
+        field_error_key(v, base, key, "must be an object, not %s", field_type_name(x));
         return NULL;
     }
     return x;
 }
 
+/* Reference obj[key] (string naming a key of names, if known). */
+const char *field_ref(val_ctx *v, const json_t *obj, const char *key, const char *base,
+                      json_t *canon, const json_t *names, const char *what)
+{
+    const json_t *x = json_object_get(obj, key);
+    const char *s;
+
+    if (!x) {
+        field_error_key(v, base, key, "required field '%s' is missing", key);
+        return NULL;
+    }
+    if (!json_is_string(x)) {
+        field_error_key(v, base, key, "must be the name of a %s (a string), not %s", what,
+                        field_type_name(x));
+        return NULL;
+    }
+    s = json_string_value(x);
+    if (names && !json_object_get(names, s)) {
+        field_error_key(v, base, key, "unknown %s '%s'", what, field_short_name(s).s);
+        return NULL;
+    }
+    field_set(v, canon, key, json_string(s));
+    return names ? s : NULL;
+}
+
+/* ============================================================== validate */
+
 /* Coordinates of joint `name` in the input joints object, if valid. */
-static int joint_xy(const json_t *joints, const char *name, double xy[2])
+static int val_joint_xy(const json_t *joints, const char *name, double xy[2])
 {
     const json_t *j = joints ? json_object_get(joints, name) : NULL;
 
     if (!json_is_array(j) || json_array_size(j) != 2)
         return 0;
-    if (!num_value(json_array_get(j, 0), &xy[0]) || !num_value(json_array_get(j, 1), &xy[1]))
+    if (!field_number(json_array_get(j, 0), &xy[0]) ||
+        !field_number(json_array_get(j, 1), &xy[1]))
         return 0;
     return isfinite(xy[0]) && isfinite(xy[1]);
 }
@@ -636,29 +653,29 @@ static int joint_xy(const json_t *joints, const char *name, double xy[2])
 /* ---------------------------------------------------------- structure */
 
 /* structure.joints: {"name": [x, y], ...}; returns the input object if usable. */
-static const json_t *v_joints(vctx *v, const json_t *st, json_t *cst)
+static const json_t *val_joints(val_ctx *v, const json_t *st, json_t *cst)
 {
     static const char *base = "/structure/joints";
-    const json_t *joints = rd_object(v, st, "joints", "/structure");
+    const json_t *joints = field_object(v, st, "joints", "/structure");
     json_t *cj, *xy;
     const char *name;
 
     if (!joints)
         return NULL;
     if (json_object_size(joints) == 0) {
-        verr(v, base, "must name at least one joint");
+        field_error(v, base, "must name at least one joint");
         return NULL;
     }
     if (json_object_size(joints) > (size_t)v->lim->max_joints) {
-        verr(v, base, "too many joints (%zu): the limit is %d", json_object_size(joints),
-             v->lim->max_joints);
+        field_error(v, base, "too many joints (%zu): the limit is %d", json_object_size(joints),
+                    v->lim->max_joints);
         return NULL;
     }
     cj = json_object();
     if (!cj)
         v->nomem = 1;
     json_object_foreach((json_t *)joints, name, xy) {
-        char *p = ptr_key(base, name);
+        char *p = err_ptr_key(base, name);
         double c[2];
         size_t k;
         json_t *arr;
@@ -667,19 +684,20 @@ static const json_t *v_joints(vctx *v, const json_t *st, json_t *cst)
             break;
         }
         if (name[0] == '\0')
-            verr(v, p, "a joint name must not be empty");
+            field_error(v, p, "a joint name must not be empty");
         if (!json_is_array(xy) || json_array_size(xy) != 2) {
             if (json_is_array(xy))
-                verr(v, p, "must be [x, y] (2 numbers), got %zu value%s", json_array_size(xy),
-                     json_array_size(xy) == 1 ? "" : "s");
+                field_error(v, p, "must be [x, y] (2 numbers), got %zu value%s",
+                            json_array_size(xy), json_array_size(xy) == 1 ? "" : "s");
             else
-                verr(v, p, "must be [x, y] (2 numbers), not %s", type_name(xy));
+                field_error(v, p, "must be [x, y] (2 numbers), not %s", field_type_name(xy));
             free(p);
             continue;
         }
         for (k = 0; k < 2; k++) {
-            char *pk = ptr_idx(p, k);
-            if (!check_real(v, json_array_get(xy, k), pk ? pk : p, REAL_FINITE, " (m)", &c[k]))
+            char *pk = err_ptr_idx(p, k);
+            if (!field_check_real(v, json_array_get(xy, k), pk ? pk : p, FIELD_FINITE, " (m)",
+                                  &c[k]))
                 c[k] = NAN;
             free(pk);
         }
@@ -692,36 +710,36 @@ static const json_t *v_joints(vctx *v, const json_t *st, json_t *cst)
                 json_decref(arr);
         }
     }
-    cset(v, cst, "joints", cj);
+    field_set(v, cst, "joints", cj);
     return joints;
 }
 
 /* structure.sections: {"name": {E, A, I, mass_per_length}, ...}. */
-static const json_t *v_sections(vctx *v, const json_t *st, json_t *cst)
+static const json_t *val_sections(val_ctx *v, const json_t *st, json_t *cst)
 {
     static const char *const keys[] = {"E", "A", "I", "mass_per_length", NULL};
     static const char *const units[] = {" (Pa)", " (m^2)", " (m^4)", " (kg/m)"};
     static const char *base = "/structure/sections";
-    const json_t *secs = rd_object(v, st, "sections", "/structure");
+    const json_t *secs = field_object(v, st, "sections", "/structure");
     json_t *cs, *sec;
     const char *name;
 
     if (!secs)
         return NULL;
     if (json_object_size(secs) == 0) {
-        verr(v, base, "must define at least one section");
+        field_error(v, base, "must define at least one section");
         return NULL;
     }
     if (json_object_size(secs) > (size_t)v->lim->max_sections) {
-        verr(v, base, "too many sections (%zu): the limit is %d", json_object_size(secs),
-             v->lim->max_sections);
+        field_error(v, base, "too many sections (%zu): the limit is %d", json_object_size(secs),
+                    v->lim->max_sections);
         return NULL;
     }
     cs = json_object();
     if (!cs)
         v->nomem = 1;
     json_object_foreach((json_t *)secs, name, sec) {
-        char *p = ptr_key(base, name);
+        char *p = err_ptr_key(base, name);
         json_t *c;
         int k;
         if (!p) {
@@ -729,60 +747,36 @@ static const json_t *v_sections(vctx *v, const json_t *st, json_t *cst)
             break;
         }
         if (name[0] == '\0')
-            verr(v, p, "a section name must not be empty");
+            field_error(v, p, "a section name must not be empty");
         if (!json_is_object(sec)) {
-            verr(v, p, "must be an object {E, A, I, mass_per_length}, not %s", type_name(sec));
+            field_error(v, p, "must be an object {E, A, I, mass_per_length}, not %s",
+                        field_type_name(sec));
             free(p);
             continue;
         }
-        check_keys(v, sec, p, keys, "section");
+        field_check_keys(v, sec, p, keys, "section");
         c = json_object();
         if (!c)
             v->nomem = 1;
         for (k = 0; keys[k]; k++)
-            rd_real(v, sec, keys[k], p, c, REAL_POSITIVE, units[k], NULL);
+            field_real(v, sec, keys[k], p, c, FIELD_POSITIVE, units[k], NULL);
         free(p);
         if (cs && c && json_object_set_new(cs, name, c))
             v->nomem = 1;
         else if (!cs)
             json_decref(c);
     }
-    cset(v, cst, "sections", cs);
+    field_set(v, cst, "sections", cs);
     return secs;
 }
 
-/* Joint reference member[key] (string naming a joint of joints, if known). */
-static const char *rd_ref(vctx *v, const json_t *obj, const char *key, const char *base,
-                          json_t *canon, const json_t *names, const char *what)
-{
-    const json_t *x = json_object_get(obj, key);
-    const char *s;
-
-    if (!x) {
-        verr_key(v, base, key, "required field '%s' is missing", key);
-        return NULL;
-    }
-    if (!json_is_string(x)) {
-        verr_key(v, base, key, "must be the name of a %s (a string), not %s", what,
-                 type_name(x));
-        return NULL;
-    }
-    s = json_string_value(x);
-    if (names && !json_object_get(names, s)) {
-        verr_key(v, base, key, "unknown %s '%s'", what, name_short(s).s);
-        return NULL;
-    }
-    cset(v, canon, key, json_string(s));
-    return names ? s : NULL;
-}
-
 /* Member i: {id, from, to, section, elements}; adds its elements to *total. */
-static void v_member(vctx *v, const json_t *mem, size_t i, const json_t *joints,
-                     const json_t *secs, json_t *cm, json_t *ids, json_t *ends,
-                     int *ends_ok, long *total)
+static void val_member(val_ctx *v, const json_t *mem, size_t i, const json_t *joints,
+                       const json_t *secs, json_t *cm, json_t *ids, json_t *ends,
+                       int *ends_ok, long *total)
 {
     static const char *const keys[] = {"id", "from", "to", "section", "elements", NULL};
-    char *p = ptr_idx("/structure/members", i);
+    char *p = err_ptr_idx("/structure/members", i);
     const json_t *id;
     const char *from, *to;
     double a[2], b[2];
@@ -794,34 +788,35 @@ static void v_member(vctx *v, const json_t *mem, size_t i, const json_t *joints,
         return;
     }
     if (!json_is_object(mem)) {
-        verr(v, p, "must be an object {id, from, to, section, elements}, not %s",
-             type_name(mem));
+        field_error(v, p, "must be an object {id, from, to, section, elements}, not %s",
+                    field_type_name(mem));
         *ends_ok = 0;
         goto done;
     }
-    check_keys(v, mem, p, keys, "member");
+    field_check_keys(v, mem, p, keys, "member");
     c = json_object();
     if (!c)
         v->nomem = 1;
     id = json_object_get(mem, "id");
     if (id && (!json_is_string(id) || json_string_length(id) == 0)) {
-        verr_key(v, p, "id", "must be a non-empty string, not %s",
-                 json_is_string(id) ? "an empty string" : type_name(id));
+        field_error_key(v, p, "id", "must be a non-empty string, not %s",
+                        json_is_string(id) ? "an empty string" : field_type_name(id));
     } else if (id) {
         const char *s = json_string_value(id);
         const json_t *seen = json_object_get(ids, s);
         if (seen)
-            verr_key(v, p, "id", "duplicate member id '%s' (also /structure/members/%"
-                     JSON_INTEGER_FORMAT ")", name_short(s).s, json_integer_value(seen));
+            field_error_key(v, p, "id", "duplicate member id '%s' (also /structure/members/%"
+                            JSON_INTEGER_FORMAT ")", field_short_name(s).s,
+                            json_integer_value(seen));
         else if (json_object_set_new(ids, s, json_integer((json_int_t)i)))
             v->nomem = 1;
-        cset(v, c, "id", json_string(s));
+        field_set(v, c, "id", json_string(s));
     }
-    from = rd_ref(v, mem, "from", p, c, joints, "joint");
-    to = rd_ref(v, mem, "to", p, c, joints, "joint");
-    rd_ref(v, mem, "section", p, c, secs, "section");
-    if (rd_int(v, mem, "elements", p, c, 1, 0, 1, v->lim->max_elements,
-               "the number of elements", &el))
+    from = field_ref(v, mem, "from", p, c, joints, "joint");
+    to = field_ref(v, mem, "to", p, c, joints, "joint");
+    field_ref(v, mem, "section", p, c, secs, "section");
+    if (field_int(v, mem, "elements", p, c, 1, 0, 1, v->lim->max_elements,
+                  "the number of elements", &el))
         *total += el;
     if (!from || !to) {
         *ends_ok = 0;
@@ -830,12 +825,12 @@ static void v_member(vctx *v, const json_t *mem, size_t i, const json_t *joints,
             json_object_set_new(ends, to, json_true()))
             v->nomem = 1;
         if (!strcmp(from, to))
-            verr_key(v, p, "to", "zero-length member: it starts and ends at joint '%s'",
-                     name_short(to).s);
-        else if (joint_xy(joints, from, a) && joint_xy(joints, to, b) && a[0] == b[0] &&
+            field_error_key(v, p, "to", "zero-length member: it starts and ends at joint '%s'",
+                            field_short_name(to).s);
+        else if (val_joint_xy(joints, from, a) && val_joint_xy(joints, to, b) && a[0] == b[0] &&
                  a[1] == b[1])
-            verr(v, p, "zero-length member: joints '%s' and '%s' are at the same position",
-                 name_short(from).s, name_short(to).s);
+            field_error(v, p, "zero-length member: joints '%s' and '%s' are at the same position",
+                        field_short_name(from).s, field_short_name(to).s);
     }
 done:
     free(p);
@@ -846,8 +841,8 @@ done:
 }
 
 /* structure.members: non-empty array; returns the set of joints that are member ends. */
-static void v_members(vctx *v, const json_t *st, const json_t *joints, const json_t *secs,
-                      json_t *cst, json_t *ends, int *ends_ok)
+static void val_members(val_ctx *v, const json_t *st, const json_t *joints, const json_t *secs,
+                        json_t *cst, json_t *ends, int *ends_ok)
 {
     static const char *base = "/structure/members";
     const json_t *mems = json_object_get(st, "members");
@@ -857,20 +852,20 @@ static void v_members(vctx *v, const json_t *st, const json_t *joints, const jso
 
     *ends_ok = 0;
     if (!mems) {
-        verr(v, base, "required field 'members' is missing");
+        field_error(v, base, "required field 'members' is missing");
         return;
     }
     if (!json_is_array(mems)) {
-        verr(v, base, "must be an array of members, not %s", type_name(mems));
+        field_error(v, base, "must be an array of members, not %s", field_type_name(mems));
         return;
     }
     if (json_array_size(mems) == 0) {
-        verr(v, base, "must list at least one member");
+        field_error(v, base, "must list at least one member");
         return;
     }
     if (json_array_size(mems) > (size_t)v->lim->max_members) {
-        verr(v, base, "too many members (%zu): the limit is %d", json_array_size(mems),
-             v->lim->max_members);
+        field_error(v, base, "too many members (%zu): the limit is %d", json_array_size(mems),
+                    v->lim->max_members);
         return;
     }
     *ends_ok = joints != NULL;
@@ -880,17 +875,17 @@ static void v_members(vctx *v, const json_t *st, const json_t *joints, const jso
         v->nomem = 1;
     else
         json_array_foreach(mems, i, mem)
-            v_member(v, mem, i, joints, secs, cm, ids, ends, ends_ok, &total);
+            val_member(v, mem, i, joints, secs, cm, ids, ends, ends_ok, &total);
     json_decref(ids);
     v->total_elements = total;
     if (total > v->lim->max_elements)
-        verr(v, base, "the members have %ld elements in total: the limit is %d", total,
-             v->lim->max_elements);
-    cset(v, cst, "members", cm);
+        field_error(v, base, "the members have %ld elements in total: the limit is %d", total,
+                    v->lim->max_elements);
+    field_set(v, cst, "members", cm);
 }
 
 /* structure.point_masses: optional array of {joint, mass}. */
-static void v_point_masses(vctx *v, const json_t *st, const json_t *joints, json_t *cst)
+static void val_point_masses(val_ctx *v, const json_t *st, const json_t *joints, json_t *cst)
 {
     static const char *const keys[] = {"joint", "mass", NULL};
     static const char *base = "/structure/point_masses";
@@ -899,16 +894,16 @@ static void v_point_masses(vctx *v, const json_t *st, const json_t *joints, json
     size_t i;
 
     if (!pms) {
-        cset(v, cst, "point_masses", json_array());
+        field_set(v, cst, "point_masses", json_array());
         return;
     }
     if (!json_is_array(pms)) {
-        verr(v, base, "must be an array of {joint, mass}, not %s", type_name(pms));
+        field_error(v, base, "must be an array of {joint, mass}, not %s", field_type_name(pms));
         return;
     }
     if (json_array_size(pms) > (size_t)v->lim->max_point_masses) {
-        verr(v, base, "too many point masses (%zu): the limit is %d", json_array_size(pms),
-             v->lim->max_point_masses);
+        field_error(v, base, "too many point masses (%zu): the limit is %d", json_array_size(pms),
+                    v->lim->max_point_masses);
         return;
     }
     cp = json_array();
@@ -917,32 +912,32 @@ static void v_point_masses(vctx *v, const json_t *st, const json_t *joints, json
         return;
     }
     json_array_foreach(pms, i, pm) {
-        char *p = ptr_idx(base, i);
+        char *p = err_ptr_idx(base, i);
         json_t *c;
         if (!p) {
             v->nomem = 1;
             break;
         }
         if (!json_is_object(pm)) {
-            verr(v, p, "must be an object {joint, mass}, not %s", type_name(pm));
+            field_error(v, p, "must be an object {joint, mass}, not %s", field_type_name(pm));
             free(p);
             continue;
         }
-        check_keys(v, pm, p, keys, "point mass");
+        field_check_keys(v, pm, p, keys, "point mass");
         c = json_object();
         if (!c)
             v->nomem = 1;
-        rd_ref(v, pm, "joint", p, c, joints, "joint");
-        rd_real(v, pm, "mass", p, c, REAL_NONNEG, " (kg)", NULL);
+        field_ref(v, pm, "joint", p, c, joints, "joint");
+        field_real(v, pm, "mass", p, c, FIELD_NONNEG, " (kg)", NULL);
         free(p);
         if (c && json_array_append_new(cp, c))
             v->nomem = 1;
     }
-    cset(v, cst, "point_masses", cp);
+    field_set(v, cst, "point_masses", cp);
 }
 
 /* Every joint must be an end of some member (the core rejects it too). */
-static void v_unused_joints(vctx *v, const json_t *joints, const json_t *ends)
+static void val_unused_joints(val_ctx *v, const json_t *joints, const json_t *ends)
 {
     const char *name;
     json_t *xy;
@@ -950,49 +945,49 @@ static void v_unused_joints(vctx *v, const json_t *joints, const json_t *ends)
     json_object_foreach((json_t *)joints, name, xy) {
         (void)xy;
         if (!json_object_get(ends, name))
-            verr_key(v, "/structure/joints", name, "joint '%s' is not an end of any member",
-                     name_short(name).s);
+            field_error_key(v, "/structure/joints", name,
+                            "joint '%s' is not an end of any member", field_short_name(name).s);
     }
 }
 
 /* The structure object. */
-static void v_structure(vctx *v, const json_t *root, json_t *canon)
+static void val_structure(val_ctx *v, const json_t *root, json_t *canon)
 {
     static const char *const keys[] = {"joints", "sections", "members", "point_masses",
                                        "clamp", NULL};
-    const json_t *st = rd_object(v, root, "structure", "");
+    const json_t *st = field_object(v, root, "structure", "");
     const json_t *joints, *secs, *clamp;
     json_t *cst, *ends;
     int ends_ok = 0;
 
     if (!st)
         return;
-    check_keys(v, st, "/structure", keys, "structure");
+    field_check_keys(v, st, "/structure", keys, "structure");
     cst = json_object();
     ends = json_object();
     if (!cst || !ends)
         v->nomem = 1;
-    joints = v_joints(v, st, cst);
-    secs = v_sections(v, st, cst);
+    joints = val_joints(v, st, cst);
+    secs = val_sections(v, st, cst);
     if (ends)
-        v_members(v, st, joints, secs, cst, ends, &ends_ok);
-    v_point_masses(v, st, joints, cst);
+        val_members(v, st, joints, secs, cst, ends, &ends_ok);
+    val_point_masses(v, st, joints, cst);
     if (ends_ok)
-        v_unused_joints(v, joints, ends);
+        val_unused_joints(v, joints, ends);
     clamp = json_object_get(st, "clamp");
     if (clamp && json_is_string(clamp) && joints &&
         json_object_get(joints, json_string_value(clamp)) && ends_ok &&
         !json_object_get(ends, json_string_value(clamp)))
-        verr(v, "/structure/clamp", "joint '%s' is not an end of any member",
-             name_short(json_string_value(clamp)).s);
-    rd_ref(v, st, "clamp", "/structure", cst, joints, "joint");
+        field_error(v, "/structure/clamp", "joint '%s' is not an end of any member",
+                    field_short_name(json_string_value(clamp)).s);
+    field_ref(v, st, "clamp", "/structure", cst, joints, "joint");
     json_decref(ends);
-    cset(v, canon, "structure", cst);
+    field_set(v, canon, "structure", cst);
 }
 
 /* ----------------------------------------------------- frames, analysis */
 
-static void v_frames(vctx *v, const json_t *root, json_t *canon)
+static void val_frames(val_ctx *v, const json_t *root, json_t *canon)
 {
     static const char *const keys[] = {"per_member", "elements_per_frame", NULL};
     const json_t *f = json_object_get(root, "frames");
@@ -1000,29 +995,30 @@ static void v_frames(vctx *v, const json_t *root, json_t *canon)
     int nk;
 
     if (!f) {
-        cset(v, canon, "frames", json_string("per_element"));
+        field_set(v, canon, "frames", json_string("per_element"));
         return;
     }
     if (json_is_string(f)) {
         const char *s = json_string_value(f);
         if (!strcmp(s, "single") || !strcmp(s, "per_element"))
-            cset(v, canon, "frames", json_string(s));
+            field_set(v, canon, "frames", json_string(s));
         else
-            verr(v, "/frames", "unknown frame scheme '%s'; expected \"single\", "
-                 "\"per_element\", {\"per_member\": k} or {\"elements_per_frame\": n}",
-                 name_short(s).s);
+            field_error(v, "/frames", "unknown frame scheme '%s'; expected \"single\", "
+                        "\"per_element\", {\"per_member\": k} or {\"elements_per_frame\": n}",
+                        field_short_name(s).s);
         return;
     }
     if (!json_is_object(f)) {
-        verr(v, "/frames", "must be \"single\", \"per_element\", {\"per_member\": k} or "
-             "{\"elements_per_frame\": n}, not %s", type_name(f));
+        field_error(v, "/frames", "must be \"single\", \"per_element\", {\"per_member\": k} or "
+                    "{\"elements_per_frame\": n}, not %s", field_type_name(f));
         return;
     }
-    check_keys(v, f, "/frames", keys, "frames");
+    field_check_keys(v, f, "/frames", keys, "frames");
     nk = (json_object_get(f, "per_member") != NULL) +
          (json_object_get(f, "elements_per_frame") != NULL);
     if (nk != 1) {
-        verr(v, "/frames", "must have exactly one of 'per_member' and 'elements_per_frame'");
+        field_error(v, "/frames",
+                    "must have exactly one of 'per_member' and 'elements_per_frame'");
         return;
     }
     c = json_object();
@@ -1030,13 +1026,13 @@ static void v_frames(vctx *v, const json_t *root, json_t *canon)
         v->nomem = 1;
         return;
     }
-    rd_int(v, f, json_object_get(f, "per_member") ? "per_member" : "elements_per_frame",
-           "/frames", c, 1, 0, 1, v->lim->max_elements, NULL, NULL);
-    cset(v, canon, "frames", c);
+    field_int(v, f, json_object_get(f, "per_member") ? "per_member" : "elements_per_frame",
+              "/frames", c, 1, 0, 1, v->lim->max_elements, NULL, NULL);
+    field_set(v, canon, "frames", c);
 }
 
 /* analysis.omega: a number or a non-empty array of numbers, finite, >= 0. */
-static void v_omega(vctx *v, const json_t *an, json_t *can)
+static void val_omega(val_ctx *v, const json_t *an, json_t *can)
 {
     static const char *base = "/analysis/omega";
     const json_t *om = json_object_get(an, "omega");
@@ -1045,27 +1041,27 @@ static void v_omega(vctx *v, const json_t *an, json_t *can)
     double d;
 
     if (!om) {
-        verr(v, base, "required field 'omega' (the speed in rad/s, or an array of speeds) "
-             "is missing");
+        field_error(v, base, "required field 'omega' (the speed in rad/s, or an array of speeds) "
+                    "is missing");
         return;
     }
     if (json_is_number(om)) {
-        if (check_real(v, om, base, REAL_NONNEG, " (rad/s)", &d))
-            cset(v, can, "omega", json_real(d));
+        if (field_check_real(v, om, base, FIELD_NONNEG, " (rad/s)", &d))
+            field_set(v, can, "omega", json_real(d));
         return;
     }
     if (!json_is_array(om)) {
-        verr(v, base, "must be a number (rad/s) or an array of numbers, not %s",
-             type_name(om));
+        field_error(v, base, "must be a number (rad/s) or an array of numbers, not %s",
+                    field_type_name(om));
         return;
     }
     if (json_array_size(om) == 0) {
-        verr(v, base, "must list at least one speed");
+        field_error(v, base, "must list at least one speed");
         return;
     }
     if (json_array_size(om) > (size_t)v->lim->max_speeds) {
-        verr(v, base, "too many speeds (%zu): the limit is %d", json_array_size(om),
-             v->lim->max_speeds);
+        field_error(v, base, "too many speeds (%zu): the limit is %d", json_array_size(om),
+                    v->lim->max_speeds);
         return;
     }
     arr = json_array();
@@ -1074,20 +1070,20 @@ static void v_omega(vctx *v, const json_t *an, json_t *can)
         return;
     }
     json_array_foreach(om, i, x) {
-        char *p = ptr_idx(base, i);
+        char *p = err_ptr_idx(base, i);
         if (!p) {
             v->nomem = 1;
             break;
         }
-        if (check_real(v, x, p, REAL_NONNEG, " (rad/s)", &d) &&
+        if (field_check_real(v, x, p, FIELD_NONNEG, " (rad/s)", &d) &&
             json_array_append_new(arr, json_real(d)))
             v->nomem = 1;
         free(p);
     }
-    cset(v, can, "omega", arr);
+    field_set(v, can, "omega", arr);
 }
 
-static void v_analysis(vctx *v, const json_t *root, json_t *canon)
+static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
 {
     static const char *const keys[] = {"omega", "modes", "geometric_stiffening", "coriolis",
                                        "mass", "substructure_modes", "modes_per_frame",
@@ -1095,40 +1091,41 @@ static void v_analysis(vctx *v, const json_t *root, json_t *canon)
     static const char *const mass[] = {"lumped", "consistent", NULL};
     static const char *const basis[] = {"augmented", "paper", NULL};
     static const char *base = "/analysis";
-    const json_t *an = rd_object(v, root, "analysis", "");
+    const json_t *an = field_object(v, root, "analysis", "");
     const json_t *mpf;
     json_t *can;
 
     if (!an)
         return;
-    check_keys(v, an, base, keys, "analysis");
+    field_check_keys(v, an, base, keys, "analysis");
     can = json_object();
     if (!can)
         v->nomem = 1;
-    v_omega(v, an, can);
-    rd_int(v, an, "modes", base, can, 0, 3, 1, v->lim->max_modes, "the number of modes",
-           NULL);
-    rd_bool(v, an, "geometric_stiffening", base, can, 1);
-    rd_bool(v, an, "coriolis", base, can, 1);
-    rd_enum(v, an, "mass", base, can, mass, "lumped");
-    rd_enum(v, an, "substructure_modes", base, can, basis, "augmented");
+    val_omega(v, an, can);
+    field_int(v, an, "modes", base, can, 0, 3, 1, v->lim->max_modes, "the number of modes",
+              NULL);
+    field_bool(v, an, "geometric_stiffening", base, can, 1);
+    field_bool(v, an, "coriolis", base, can, 1);
+    field_enum(v, an, "mass", base, can, mass, "lumped");
+    field_enum(v, an, "substructure_modes", base, can, basis, "augmented");
     mpf = json_object_get(an, "modes_per_frame");
     if (!mpf || (json_is_string(mpf) && !strcmp(json_string_value(mpf), "all")))
-        cset(v, can, "modes_per_frame", json_string("all"));
+        field_set(v, can, "modes_per_frame", json_string("all"));
     else if (json_is_number(mpf))
-        rd_int(v, an, "modes_per_frame", base, can, 1, 0, 1, 100000, NULL, NULL);
+        field_int(v, an, "modes_per_frame", base, can, 1, 0, 1, 100000, NULL, NULL);
     else
-        verr(v, "/analysis/modes_per_frame", "must be \"all\" or a positive integer, not %s",
-             json_is_string(mpf) ? "another string" : type_name(mpf));
-    rd_bool(v, an, "mode_shapes", base, can, 1);
-    cset(v, canon, "analysis", can);
+        field_error(v, "/analysis/modes_per_frame",
+                    "must be \"all\" or a positive integer, not %s",
+                    json_is_string(mpf) ? "another string" : field_type_name(mpf));
+    field_bool(v, an, "mode_shapes", base, can, 1);
+    field_set(v, canon, "analysis", can);
 }
 
 /*
  * Size of the mode shapes in the result: speeds x modes x nodes x 3
  * (x 2 with Coriolis: complex shapes) against max_shape_values.
  */
-static void v_output_size(vctx *v, const json_t *canon)
+static void val_output_size(val_ctx *v, const json_t *canon)
 {
     const json_t *an = json_object_get(canon, "analysis");
     const json_t *om = json_object_get(an, "omega");
@@ -1140,36 +1137,52 @@ static void v_output_size(vctx *v, const json_t *canon)
 
     if (!json_is_true(json_object_get(an, "mode_shapes")) || !(values > v->lim->max_shape_values))
         return;
-    verr(v, "/analysis/mode_shapes", "mode shapes for %.0f speeds x %.0f modes x %.0f nodes "
-         "would be %.0f numbers: the limit is %ld; set mode_shapes to false or ask for fewer "
-         "speeds or modes", speeds, modes, nodes, values, v->lim->max_shape_values);
+    field_error(v, "/analysis/mode_shapes",
+                "mode shapes for %.0f speeds x %.0f modes x %.0f nodes "
+                "would be %.0f numbers: the limit is %ld; set mode_shapes to false or ask for "
+                "fewer speeds or modes", speeds, modes, nodes, values, v->lim->max_shape_values);
 }
 
 /* Validate root; returns the canonical request (new) or NULL. */
-static json_t *v_request(vctx *v, const json_t *root)
+static json_t *val_document(val_ctx *v, const json_t *root)
 {
     static const char *const keys[] = {"structure", "frames", "analysis", NULL};
     json_t *canon;
 
     if (!json_is_object(root)) {
-        verr(v, "", "the request must be a JSON object, not %s", type_name(root));
+        field_error(v, "", "the request must be a JSON object, not %s", field_type_name(root));
         return NULL;
     }
-    check_keys(v, root, "", keys, "top-level");
+    field_check_keys(v, root, "", keys, "top-level");
     canon = json_object();
     if (!canon) {
         v->nomem = 1;
         return NULL;
     }
-    v_structure(v, root, canon);
-    v_frames(v, root, canon);
-    v_analysis(v, root, canon);
+    val_structure(v, root, canon);
+    val_frames(v, root, canon);
+    val_analysis(v, root, canon);
     if (json_object_get(canon, "analysis") && json_object_get(canon, "structure"))
-        v_output_size(v, canon);
+        val_output_size(v, canon);
     return canon;
 }
 
-/* ============================================== request from canonical */
+json_t *val_request(const json_t *root, const codec_limits *lim, codec_errors *errs,
+                    int *nomem)
+{
+    val_ctx v;
+    json_t *canon;
+
+    v.errs = errs;
+    v.lim = lim;
+    v.total_elements = 0;
+    v.nomem = 0;
+    canon = val_document(&v, root);
+    *nomem = v.nomem;
+    return canon;
+}
+
+/* =============================================================== request */
 
 struct codec_request {
     json_t *canon;              /* canonical request, defaults applied */
@@ -1187,13 +1200,13 @@ struct codec_request {
     sm_options opt;             /* from the analysis and frames fields */
 };
 
-static int cmp_str(const void *a, const void *b)
+static int req_cmp_str(const void *a, const void *b)
 {
     return strcmp(*(const char *const *)a, *(const char *const *)b);
 }
 
 /* Sorted key list of obj (borrowed keys); NULL = NOMEM. */
-static const char **sorted_keys(const json_t *obj, int *n)
+static const char **req_sorted_keys(const json_t *obj, int *n)
 {
     size_t k = 0, cnt = json_object_size(obj);
     const char **names = calloc(cnt ? cnt : 1, sizeof(*names));
@@ -1206,34 +1219,34 @@ static const char **sorted_keys(const json_t *obj, int *n)
         (void)val;
         names[k++] = key;
     }
-    qsort(names, cnt, sizeof(*names), cmp_str);
+    qsort(names, cnt, sizeof(*names), req_cmp_str);
     *n = (int)cnt;
     return names;
 }
 
-static int name_index(const char **names, int n, const char *name)
+static int req_name_index(const char **names, int n, const char *name)
 {
-    const char **hit = bsearch(&name, names, (size_t)n, sizeof(*names), cmp_str);
+    const char **hit = bsearch(&name, names, (size_t)n, sizeof(*names), req_cmp_str);
     return hit ? (int)(hit - names) : -1;
 }
 
-static double num_of(const json_t *x)
+static double req_number(const json_t *x)
 {
     double d = 0;
-    num_value(x, &d);
+    field_number(x, &d);
     return d;
 }
 
 /* Joints and sections arrays, sorted by name. */
-static int build_tables(codec_request *r)
+static int req_build_tables(codec_request *r)
 {
     const json_t *st = json_object_get(r->canon, "structure");
     const json_t *joints = json_object_get(st, "joints");
     const json_t *secs = json_object_get(st, "sections");
     int i, nj = 0, ns = 0;
 
-    r->joint_names = sorted_keys(joints, &nj);
-    r->section_names = sorted_keys(secs, &ns);
+    r->joint_names = req_sorted_keys(joints, &nj);
+    r->section_names = req_sorted_keys(secs, &ns);
     if (!r->joint_names || !r->section_names)
         return SM_NOMEM;
     r->joint_xy = malloc(2 * (size_t)nj * sizeof(double));
@@ -1242,15 +1255,15 @@ static int build_tables(codec_request *r)
         return SM_NOMEM;
     for (i = 0; i < nj; i++) {
         const json_t *xy = json_object_get(joints, r->joint_names[i]);
-        r->joint_xy[2 * i] = num_of(json_array_get(xy, 0));
-        r->joint_xy[2 * i + 1] = num_of(json_array_get(xy, 1));
+        r->joint_xy[2 * i] = req_number(json_array_get(xy, 0));
+        r->joint_xy[2 * i + 1] = req_number(json_array_get(xy, 1));
     }
     for (i = 0; i < ns; i++) {
         const json_t *s = json_object_get(secs, r->section_names[i]);
-        r->sections[i].E = num_of(json_object_get(s, "E"));
-        r->sections[i].A = num_of(json_object_get(s, "A"));
-        r->sections[i].I = num_of(json_object_get(s, "I"));
-        r->sections[i].mu = num_of(json_object_get(s, "mass_per_length"));
+        r->sections[i].E = req_number(json_object_get(s, "E"));
+        r->sections[i].A = req_number(json_object_get(s, "A"));
+        r->sections[i].I = req_number(json_object_get(s, "I"));
+        r->sections[i].mu = req_number(json_object_get(s, "mass_per_length"));
     }
     r->st.n_joints = nj;
     r->st.joint_xy = r->joint_xy;
@@ -1260,7 +1273,7 @@ static int build_tables(codec_request *r)
 }
 
 /* Members, point masses and clamp as indices. */
-static int build_structure(codec_request *r)
+static int req_build_structure(codec_request *r)
 {
     const json_t *st = json_object_get(r->canon, "structure");
     const json_t *mems = json_object_get(st, "members");
@@ -1274,30 +1287,30 @@ static int build_structure(codec_request *r)
     if (!r->members || (np && !r->point_masses))
         return SM_NOMEM;
     json_array_foreach(mems, i, x) {
-        r->members[i].from = name_index(r->joint_names, nj,
-                                        json_string_value(json_object_get(x, "from")));
-        r->members[i].to = name_index(r->joint_names, nj,
-                                      json_string_value(json_object_get(x, "to")));
-        r->members[i].section = name_index(r->section_names, ns,
-                                           json_string_value(json_object_get(x, "section")));
+        r->members[i].from = req_name_index(r->joint_names, nj,
+                                            json_string_value(json_object_get(x, "from")));
+        r->members[i].to = req_name_index(r->joint_names, nj,
+                                          json_string_value(json_object_get(x, "to")));
+        r->members[i].section = req_name_index(r->section_names, ns,
+                                               json_string_value(json_object_get(x, "section")));
         r->members[i].elements = (int)json_integer_value(json_object_get(x, "elements"));
     }
     json_array_foreach(pms, i, x) {
-        r->point_masses[i].joint = name_index(r->joint_names, nj,
-                                              json_string_value(json_object_get(x, "joint")));
-        r->point_masses[i].mass = num_of(json_object_get(x, "mass"));
+        r->point_masses[i].joint = req_name_index(r->joint_names, nj,
+                                                  json_string_value(json_object_get(x, "joint")));
+        r->point_masses[i].mass = req_number(json_object_get(x, "mass"));
     }
     r->st.n_members = (int)nm;
     r->st.members = r->members;
     r->st.n_point_masses = (int)np;
     r->st.point_masses = r->point_masses;
-    r->st.clamp = name_index(r->joint_names, nj,
-                             json_string_value(json_object_get(st, "clamp")));
+    r->st.clamp = req_name_index(r->joint_names, nj,
+                                 json_string_value(json_object_get(st, "clamp")));
     return SM_OK;
 }
 
 /* sm_options and speeds from frames and analysis. */
-static int build_options(codec_request *r)
+static int req_build_options(codec_request *r)
 {
     const json_t *an = json_object_get(r->canon, "analysis");
     const json_t *fr = json_object_get(r->canon, "frames");
@@ -1331,7 +1344,7 @@ static int build_options(codec_request *r)
     if (!r->speeds)
         return SM_NOMEM;
     for (i = 0; i < n; i++)
-        r->speeds[i] = num_of(json_is_array(om) ? json_array_get(om, i) : om);
+        r->speeds[i] = req_number(json_is_array(om) ? json_array_get(om, i) : om);
     r->n_speeds = (int)n;
     return SM_OK;
 }
@@ -1357,22 +1370,17 @@ int codec_request_from_json(codec_request **out, const json_t *root,
                             const codec_limits *lim, codec_errors *errs)
 {
     codec_limits deflim;
-    vctx v;
     codec_request *r = NULL;
     json_t *canon;
-    int rc = SM_NOMEM, before = codec_errors_count(errs);
+    int rc = SM_NOMEM, before = codec_errors_count(errs), nomem;
 
     *out = NULL;
     if (!lim) {
         codec_default_limits(&deflim);
         lim = &deflim;
     }
-    v.errs = errs;
-    v.lim = lim;
-    v.total_elements = 0;
-    v.nomem = 0;
-    canon = v_request(&v, root);
-    if (v.nomem)
+    canon = val_request(root, lim, errs, &nomem);
+    if (nomem)
         goto fail;
     if (codec_errors_count(errs) > before || !canon) {
         rc = SM_INVALID_INPUT;
@@ -1387,7 +1395,8 @@ int codec_request_from_json(codec_request **out, const json_t *root,
     if (!r->canon_text)
         goto fail;
     if ((rc = codec_sha256_hex(r->canon_text, strlen(r->canon_text), r->sha)) ||
-        (rc = build_tables(r)) || (rc = build_structure(r)) || (rc = build_options(r)))
+        (rc = req_build_tables(r)) || (rc = req_build_structure(r)) ||
+        (rc = req_build_options(r)))
         goto fail;
     *out = r;
     return SM_OK;
@@ -1411,7 +1420,7 @@ int codec_request_parse(codec_request **out, const char *text, size_t len,
         lim = &deflim;
     }
     if (len > lim->max_request_bytes) {
-        errs->too_large = 1;
+        err_mark_too_large(errs);
         if (codec_errors_add(errs, "", "the request is %zu bytes: the limit is %zu bytes",
                              len, lim->max_request_bytes))
             return SM_NOMEM;
@@ -1419,7 +1428,7 @@ int codec_request_parse(codec_request **out, const char *text, size_t len,
     }
     root = json_loadb(text, len, JSON_REJECT_DUPLICATES, &jerr);
     if (!root) {
-        errs->malformed = 1;
+        err_mark_malformed(errs);
         for (size_t k = 0; jerr.text[k]; k++) /* jansson's "near '...'" may cut a UTF-8 char */
             if ((unsigned char)jerr.text[k] >= 0x80)
                 jerr.text[k] = '?';
@@ -1474,6 +1483,13 @@ const char *codec_request_joint_name(const codec_request *r, int j)
     return r->joint_names[j];
 }
 
+const char *req_section_name(const codec_request *r, int s)
+{
+    if (s < 0 || s >= r->st.n_sections)
+        return NULL;
+    return r->section_names[s];
+}
+
 const json_t *codec_request_canonical(const codec_request *r)
 {
     return r->canon;
@@ -1489,10 +1505,10 @@ const char *codec_request_sha256(const codec_request *r)
     return r->sha;
 }
 
-/* ======================================================= core diagnostics */
+/* ================================================================== diag */
 
 /* Request field name of a core field name (mu -> mass_per_length ...). */
-static const char *field_name(const char *f)
+static const char *diag_field_name(const char *f)
 {
     if (!strcmp(f, "mu"))
         return "mass_per_length";
@@ -1504,7 +1520,7 @@ static const char *field_name(const char *f)
 }
 
 /* 1 when f is one of the NULL-terminated names. */
-static int among(const char *f, const char *const *names)
+static int diag_among(const char *f, const char *const *names)
 {
     int i;
 
@@ -1514,40 +1530,41 @@ static int among(const char *f, const char *const *names)
     return 0;
 }
 
-static int is_section_field(const char *f)
+static int diag_is_section_field(const char *f)
 {
     return !strcmp(f, "E") || !strcmp(f, "A") || !strcmp(f, "I") || !strcmp(f, "mu") ||
            !strcmp(f, "mass_per_length");
 }
 
 /* Pointer of an option field reported by the core. */
-static char *options_pointer(const codec_request *r, const char *f, int index)
+static char *diag_options_pointer(const codec_request *r, const char *f, int index)
 {
-    const json_t *fr = json_object_get(r->canon, "frames");
-    const json_t *om = json_object_get(json_object_get(r->canon, "analysis"), "omega");
+    const json_t *canon = codec_request_canonical(r);
+    const json_t *fr = json_object_get(canon, "frames");
+    const json_t *om = json_object_get(json_object_get(canon, "analysis"), "omega");
 
     if ((!strcmp(f, "omega") || !strcmp(f, "omegas")) && json_is_array(om) && index >= 0 &&
         (size_t)index < json_array_size(om))
-        return str_fmt("/analysis/omega/%d", index);
+        return err_fmt("/analysis/omega/%d", index);
 
     if (!strcmp(f, "frames") || !strcmp(f, "frames_param") || !strcmp(f, "per_member") ||
         !strcmp(f, "elements_per_frame")) {
         if (json_is_object(fr) && strcmp(f, "frames")) {
             const char *key = json_object_get(fr, "per_member") ? "per_member"
                                                                 : "elements_per_frame";
-            return str_fmt("/frames/%s", key);
+            return err_fmt("/frames/%s", key);
         }
         return strdup("/frames");
     }
     if (f[0] == '\0')
         return strdup("/analysis");
-    return ptr_key("/analysis", field_name(f));
+    return err_ptr_key("/analysis", diag_field_name(f));
 }
 
-/* Pointer of the item a diagnostic names; NULL = NOMEM. */
+/* Pointer of the item a diagnostic names; malloc'd, NULL = NOMEM. */
 static char *diag_pointer(const codec_request *r, const sm_diag *d)
 {
-    const sm_structure *st = &r->st;
+    const sm_structure *st = codec_request_structure(r);
     const char *f = d->field;
     int i = d->item_index;
     char *base, *p;
@@ -1562,21 +1579,22 @@ static char *diag_pointer(const codec_request *r, const sm_diag *d)
     case SM_ITEM_MEMBER:
         if (i < 0 || i >= st->n_members)
             return strdup("/structure/members");
-        if (is_section_field(f) && st->members[i].section >= 0 &&
+        if (diag_is_section_field(f) && st->members[i].section >= 0 &&
             st->members[i].section < st->n_sections) {
-            base = ptr_key("/structure/sections", r->section_names[st->members[i].section]);
+            base = err_ptr_key("/structure/sections",
+                               req_section_name(r, st->members[i].section));
             known = NULL;
             break;
         }
-        base = ptr_idx("/structure/members", (size_t)i);
+        base = err_ptr_idx("/structure/members", (size_t)i);
         known = member_fields;
         break;
     case SM_ITEM_JOINT:
         if (i < 0 || i >= st->n_joints)
             return strdup("/structure/joints");
-        base = ptr_key("/structure/joints", r->joint_names[i]);
+        base = err_ptr_key("/structure/joints", codec_request_joint_name(r, i));
         if (base && (!strcmp(f, "x") || !strcmp(f, "y"))) {
-            p = str_fmt("%s/%d", base, f[0] == 'y');
+            p = err_fmt("%s/%d", base, f[0] == 'y');
             free(base);
             return p;
         }
@@ -1584,27 +1602,27 @@ static char *diag_pointer(const codec_request *r, const sm_diag *d)
     case SM_ITEM_SECTION:
         if (i < 0 || i >= st->n_sections)
             return strdup("/structure/sections");
-        base = ptr_key("/structure/sections", r->section_names[i]);
+        base = err_ptr_key("/structure/sections", req_section_name(r, i));
         known = NULL;
         break;
     case SM_ITEM_POINT_MASS:
         if (i < 0 || i >= st->n_point_masses)
             return strdup("/structure/point_masses");
-        base = ptr_idx("/structure/point_masses", (size_t)i);
+        base = err_ptr_idx("/structure/point_masses", (size_t)i);
         known = pm_fields;
         break;
     case SM_ITEM_CLAMP:
         return strdup("/structure/clamp");
     case SM_ITEM_OPTIONS:
-        return options_pointer(r, f, i);
+        return diag_options_pointer(r, f, i);
     case SM_ITEM_NONE:
     default:
         return strdup("/structure");
     }
     /* a field the request does not have: point at the item itself */
-    if (!base || f[0] == '\0' || (known ? !among(f, known) : !is_section_field(f)))
+    if (!base || f[0] == '\0' || (known ? !diag_among(f, known) : !diag_is_section_field(f)))
         return base;
-    p = ptr_key(base, field_name(f));
+    p = err_ptr_key(base, diag_field_name(f));
     free(base);
     return p;
 }
@@ -1615,7 +1633,7 @@ int codec_diag_error(const codec_request *r, const sm_diag *d, codec_errors *err
     int rc;
 
     if (!p) {
-        errs->nomem = 1;
+        err_mark_nomem(errs);
         return SM_NOMEM;
     }
     rc = codec_errors_add(errs, p, "%s", d->message[0] ? d->message : sm_strerror(d->status));
@@ -1633,7 +1651,7 @@ int codec_model_new(sm_model **out, const codec_request *r, codec_errors *errs,
     memset(d, 0, sizeof(*d));
     d->item_index = -1;
     *out = NULL;
-    rc = sm_model_new(out, &r->st, &r->opt, d);
+    rc = sm_model_new(out, codec_request_structure(r), codec_request_options(r), d);
     if (rc == SM_OK)
         return SM_OK;
     *out = NULL;
@@ -1657,20 +1675,20 @@ const char *codec_case_status_name(sm_case_status s)
 }
 
 /* A real, or null when not finite (JSON has no NaN or infinity). */
-static json_t *jreal(double x)
+static json_t *res_real(double x)
 {
     return isfinite(x) ? json_real(x) : json_null();
 }
 
 /* [a, b, c] from three reals. */
-static json_t *jtriple(const double *v)
+static json_t *res_triple(const double *v)
 {
     json_t *a = json_array();
 
     if (!a)
         return NULL;
-    if (json_array_append_new(a, jreal(v[0])) || json_array_append_new(a, jreal(v[1])) ||
-        json_array_append_new(a, jreal(v[2]))) {
+    if (json_array_append_new(a, res_real(v[0])) || json_array_append_new(a, res_real(v[1])) ||
+        json_array_append_new(a, res_real(v[2]))) {
         json_decref(a);
         return NULL;
     }
@@ -1678,7 +1696,7 @@ static json_t *jtriple(const double *v)
 }
 
 /* [[x, y, z], ...] from n triples. */
-static json_t *jtriples(const double *v, int n)
+static json_t *res_triples(const double *v, int n)
 {
     json_t *a = json_array();
     int k;
@@ -1686,7 +1704,7 @@ static json_t *jtriples(const double *v, int n)
     if (!a)
         return NULL;
     for (k = 0; k < n; k++)
-        if (json_array_append_new(a, jtriple(v + 3 * (size_t)k)))
+        if (json_array_append_new(a, res_triple(v + 3 * (size_t)k)))
             goto fail;
     return a;
 fail:
@@ -1694,7 +1712,7 @@ fail:
     return NULL;
 }
 
-static json_t *jreals(const double *v, int n)
+static json_t *res_reals(const double *v, int n)
 {
     json_t *a = json_array();
     int k;
@@ -1702,7 +1720,7 @@ static json_t *jreals(const double *v, int n)
     if (!a)
         return NULL;
     for (k = 0; k < n; k++)
-        if (json_array_append_new(a, jreal(v[k])))
+        if (json_array_append_new(a, res_real(v[k])))
             goto fail;
     return a;
 fail:
@@ -1711,40 +1729,40 @@ fail:
 }
 
 /* case.equilibrium */
-static json_t *enc_equilibrium(const codec_request *r, const sm_model *m, const sm_case *c)
+static json_t *res_equilibrium(const codec_request *r, const sm_model *m, const sm_case *c)
 {
     json_t *e = json_object(), *joints = NULL;
-    int j;
+    int j, nj = codec_request_structure(r)->n_joints;
 
     if (!e)
         return NULL;
     if (json_object_set_new(e, "converged", json_boolean(c->converged)) ||
         json_object_set_new(e, "iterations", json_integer(c->iterations)) ||
-        json_object_set_new(e, "residual", jreal(c->residual)))
+        json_object_set_new(e, "residual", res_real(c->residual)))
         goto fail;
     if (c->nodes && c->n_nodes > 0) {
         joints = json_object();
         if (!joints)
             goto fail;
-        for (j = 0; j < r->st.n_joints; j++) {
+        for (j = 0; j < nj; j++) {
             int node = sm_model_joint_node(m, j);
             if (node < 0 || node >= c->n_nodes)
                 continue;
-            if (json_object_set_new(joints, r->joint_names[j],
-                                    jtriple(c->nodes + 3 * (size_t)node)))
+            if (json_object_set_new(joints, codec_request_joint_name(r, j),
+                                    res_triple(c->nodes + 3 * (size_t)node)))
                 goto fail;
         }
         if (json_object_set_new(e, "joints", joints))
             goto fail_set;
         joints = NULL;
-        if (json_object_set_new(e, "nodes", jtriples(c->nodes, c->n_nodes)))
+        if (json_object_set_new(e, "nodes", res_triples(c->nodes, c->n_nodes)))
             goto fail;
     }
     if (c->axial_force && c->n_elements > 0 &&
-        json_object_set_new(e, "axial_force", jreals(c->axial_force, c->n_elements)))
+        json_object_set_new(e, "axial_force", res_reals(c->axial_force, c->n_elements)))
         goto fail;
     if (c->nodes && c->n_nodes > 0 &&
-        json_object_set_new(e, "max_frame_rotation", jreal(c->max_frame_rotation)))
+        json_object_set_new(e, "max_frame_rotation", res_real(c->max_frame_rotation)))
         goto fail;
     return e;
 fail:
@@ -1755,7 +1773,7 @@ fail_set:
 }
 
 /* One mode of a case. */
-static json_t *enc_mode(const sm_case *c, int k, int shapes)
+static json_t *res_mode(const sm_case *c, int k, int shapes)
 {
     size_t stride = 3 * (size_t)c->n_nodes;
     json_t *md = json_object(), *shape;
@@ -1764,21 +1782,21 @@ static json_t *enc_mode(const sm_case *c, int k, int shapes)
 
     if (!md)
         return NULL;
-    if (json_object_set_new(md, "frequency_rad_s", jreal(c->frequency[k])) ||
-        json_object_set_new(md, "frequency_hz", jreal(c->frequency[k] / CODEC_TWO_PI)) ||
-        json_object_set_new(md, "eigenvalue",
-                            json_pack("[o, o]", jreal(c->eig_re[k]), jreal(c->eig_im[k]))) ||
-        json_object_set_new(md, "mac_to_previous", mac < 0 ? json_null() : jreal(mac)) ||
+    if (json_object_set_new(md, "frequency_rad_s", res_real(c->frequency[k])) ||
+        json_object_set_new(md, "frequency_hz", res_real(c->frequency[k] / CODEC_TWO_PI)) ||
+        json_object_set_new(md, "eigenvalue", json_pack("[o, o]", res_real(c->eig_re[k]),
+                                                        res_real(c->eig_im[k]))) ||
+        json_object_set_new(md, "mac_to_previous", mac < 0 ? json_null() : res_real(mac)) ||
         json_object_set_new(md, "previous_index", prev < 0 ? json_null() : json_integer(prev)))
         goto fail;
     if (shapes && c->shape_re) {
         shape = json_object();
         if (json_object_set_new(md, "shape", shape))
             goto fail;
-        if (json_object_set_new(shape, "re", jtriples(c->shape_re + k * stride, c->n_nodes)))
+        if (json_object_set_new(shape, "re", res_triples(c->shape_re + k * stride, c->n_nodes)))
             goto fail;
         if (c->shape_im &&
-            json_object_set_new(shape, "im", jtriples(c->shape_im + k * stride, c->n_nodes)))
+            json_object_set_new(shape, "im", res_triples(c->shape_im + k * stride, c->n_nodes)))
             goto fail;
     }
     return md;
@@ -1788,16 +1806,16 @@ fail:
 }
 
 /* One case (speed). */
-static json_t *enc_case(const codec_request *r, const sm_model *m, const sm_case *c)
+static json_t *res_case(const codec_request *r, const sm_model *m, const sm_case *c)
 {
     json_t *o = json_object(), *modes;
-    int k;
+    int k, shapes = codec_request_options(r)->mode_shapes;
 
     if (!o)
         return NULL;
-    if (json_object_set_new(o, "omega", jreal(c->omega)) ||
+    if (json_object_set_new(o, "omega", res_real(c->omega)) ||
         json_object_set_new(o, "status", json_string(codec_case_status_name(c->status))) ||
-        json_object_set_new(o, "equilibrium", enc_equilibrium(r, m, c)))
+        json_object_set_new(o, "equilibrium", res_equilibrium(r, m, c)))
         goto fail;
     if (c->status != SM_CASE_NO_EQUILIBRIUM &&
         json_object_set_new(o, "stability",
@@ -1808,7 +1826,7 @@ static json_t *enc_case(const codec_request *r, const sm_model *m, const sm_case
     if (json_object_set_new(o, "modes", modes))
         goto fail;
     for (k = 0; k < c->n_modes; k++)
-        if (json_array_append_new(modes, enc_mode(c, k, r->opt.mode_shapes)))
+        if (json_array_append_new(modes, res_mode(c, k, shapes)))
             goto fail;
     if (c->warning[0] &&
         json_object_set_new(o, "warnings", json_pack("[s]", c->warning)))
@@ -1816,8 +1834,8 @@ static json_t *enc_case(const codec_request *r, const sm_model *m, const sm_case
     if (c->status != SM_CASE_SOLVED &&
         json_object_set_new(o, "diagnostics",
                             json_pack("{s:i, s:o, s:o, s:s}", "iterations", c->iterations,
-                                      "residual", jreal(c->residual), "last_omega",
-                                      jreal(c->last_omega), "message",
+                                      "residual", res_real(c->residual), "last_omega",
+                                      res_real(c->last_omega), "message",
                                       c->message[0] ? c->message
                                                     : codec_case_status_name(c->status))))
         goto fail;
@@ -1842,7 +1860,7 @@ int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
         goto fail;
     if (json_object_set_new(doc, "solver",
                             json_pack("{s:s, s:s, s:s}", "name", "spinmodal", "version",
-                                      SM_VERSION, "request_sha256", r->sha)) ||
+                                      SM_VERSION, "request_sha256", codec_request_sha256(r))) ||
         json_object_set_new(doc, "model",
                             json_pack("{s:i, s:i, s:i, s:i}", "nodes", info.nodes,
                                       "elements", info.elements, "frames", info.frames,
@@ -1853,15 +1871,15 @@ int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
         goto fail;
     for (i = 0; i < res->n_cases; i++) {
         const sm_case *c = &res->cases[i];
-        if (json_array_append_new(cases, enc_case(r, m, c)))
+        if (json_array_append_new(cases, res_case(r, m, c)))
             goto fail;
         te += c->t_equilibrium;
         tl += c->t_linearize;
         tg += c->t_eigen;
     }
     if (json_object_set_new(doc, "timing_ms",
-                            json_pack("{s:o, s:o, s:o}", "equilibrium", jreal(te),
-                                      "linearize", jreal(tl), "eigen", jreal(tg))))
+                            json_pack("{s:o, s:o, s:o}", "equilibrium", res_real(te),
+                                      "linearize", res_real(tl), "eigen", res_real(tg))))
         goto fail;
     *out = doc;
     return SM_OK;
@@ -1870,7 +1888,7 @@ fail:
     return SM_NOMEM;
 }
 
-/* ================================================================== CSV */
+/* =================================================================== csv */
 
 /* A CSV number: full precision, empty when not finite. */
 static void csv_num(FILE *f, double x)
@@ -1929,7 +1947,7 @@ int codec_result_csv(char **out, size_t *len, const sm_result *res)
     return SM_OK;
 }
 
-/* ============================================================== problem */
+/* =============================================================== problem */
 
 json_t *codec_problem_new(int http_status, const char *type, const char *title,
                           const char *detail, const codec_errors *errs)
