@@ -1,41 +1,17 @@
 /*
- * codec.c — JSON request validation, canonical form, result encoding.
+ * result.c — an sm_result as the result document of DESIGN.md section 4.
  *
- * How it fits: the CLI (cli.c) and the daemon read a request with
- * codec_request_parse, build the core model with codec_model_new, call
- * sm_solve and write codec_result_encode (or codec_result_csv).  Every
- * failure on the way becomes a codec_errors list that codec_problem_* turns
- * into an RFC 9457 document.
- *
- * Validation walks the request once, in document order, and never stops at
- * the first error: each field is checked (type, range, references, unknown
- * keys), errors are appended with the JSON pointer of the field, and a
- * canonical copy of the request is built along the way with every default
- * written out.  Only when no error was found is the canonical copy turned
- * into the core's arrays.  Joints and sections are indexed in sorted name
- * order, so the canonical text (keys sorted) fully determines the model and
- * two requests with the same SHA-256 give the same result.
- *
- * Topology (cycles, disconnected members) is the core's job: sm_model_new
- * reports it in an sm_diag, which codec_diag_error maps back to a pointer.
- * The codec pre-checks only the cheap local cases (zero-length member, a
- * clamp that is no member's end) so those appear with the other errors.
+ * How it fits: after sm_solve, the CLI and the daemon's workers call
+ * codec_result_encode; the document is what the daemon stores and serves
+ * byte for byte, so its layout is a contract (schemas/result.schema.json).
+ * The request supplies the SHA-256 and the joint names (in the sorted order
+ * of request.c), the model the joint -> node map and the sizes.  Numbers
+ * that are not finite become null (JSON has no NaN or infinity).  csv.c
+ * writes the same frequencies as a table.
  */
 #include "codec_internal.h"
 
-#include <limits.h>
 #include <math.h>
-#include <stdarg.h>
-#include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
-
-#include <openssl/evp.h>
-
-/* Flags for dumping canonical text and results. */
-#define CODEC_DUMP_CANON (JSON_SORT_KEYS | JSON_COMPACT | JSON_REAL_PRECISION(17))
-
-/* ================================================================ result */
 
 const char *codec_case_status_name(sm_case_status s)
 {
@@ -259,112 +235,4 @@ int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
 fail:
     json_decref(doc);
     return SM_NOMEM;
-}
-
-/* =================================================================== csv */
-
-/* A CSV number: full precision, empty when not finite. */
-static void csv_num(FILE *f, double x)
-{
-    if (isfinite(x))
-        fprintf(f, "%.17g", x);
-}
-
-int codec_result_csv(char **out, size_t *len, const sm_result *res)
-{
-    char *buf = NULL;
-    size_t n = 0;
-    FILE *f = open_memstream(&buf, &n);
-    int i, k;
-
-    *out = NULL;
-    if (!f)
-        return SM_NOMEM;
-    fputs("omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status\n", f);
-    for (i = 0; i < res->n_cases; i++) {
-        const sm_case *c = &res->cases[i];
-        const char *st = codec_case_status_name(c->status);
-        if (c->n_modes == 0) {
-            csv_num(f, c->omega);
-            fprintf(f, ",,,,,,,%s\n", st);
-        }
-        for (k = 0; k < c->n_modes; k++) {
-            double mac = c->mac_to_previous ? c->mac_to_previous[k] : -1;
-            csv_num(f, c->omega);
-            fprintf(f, ",%d,", k + 1);
-            csv_num(f, c->frequency[k]);
-            fputc(',', f);
-            csv_num(f, c->frequency[k] / CODEC_TWO_PI);
-            fputc(',', f);
-            csv_num(f, c->eig_re[k]);
-            fputc(',', f);
-            csv_num(f, c->eig_im[k]);
-            fputc(',', f);
-            if (mac >= 0)
-                csv_num(f, mac);
-            fprintf(f, ",%s\n", st);
-        }
-    }
-    if (ferror(f)) {
-        fclose(f);
-        free(buf);
-        return SM_NOMEM;
-    }
-    if (fclose(f)) {
-        free(buf);
-        return SM_NOMEM;
-    }
-    *out = buf;
-    if (len)
-        *len = n;
-    return SM_OK;
-}
-
-/* =============================================================== problem */
-
-json_t *codec_problem_new(int http_status, const char *type, const char *title,
-                          const char *detail, const codec_errors *errs)
-{
-    json_t *p = json_pack("{s:s, s:s, s:i}", "type", type ? type : "about:blank", "title",
-                          title ? title : "Error", "status", http_status);
-
-    if (!p)
-        return NULL;
-    if (detail && json_object_set_new(p, "detail", json_string(detail)))
-        goto fail;
-    if (errs && codec_errors_count(errs) > 0 &&
-        json_object_set_new(p, "errors", codec_errors_to_json(errs)))
-        goto fail;
-    return p;
-fail:
-    json_decref(p);
-    return NULL;
-}
-
-int codec_errors_http_status(const codec_errors *e)
-{
-    if (codec_errors_too_large(e))
-        return 413;
-    if (codec_errors_malformed(e))
-        return 400;
-    return 422;
-}
-
-json_t *codec_problem_from_errors(const codec_errors *errs)
-{
-    int status = codec_errors_http_status(errs), n = codec_errors_count(errs);
-    char detail[96];
-
-    switch (status) {
-    case 413:
-        return codec_problem_new(413, NULL, "Content Too Large",
-                                 "The request is larger than the configured limit.", errs);
-    case 400:
-        return codec_problem_new(400, NULL, "Bad Request", "The request is not valid JSON.",
-                                 errs);
-    default:
-        snprintf(detail, sizeof(detail), "The request has %d error%s; see 'errors'.", n,
-                 n == 1 ? "" : "s");
-        return codec_problem_new(422, NULL, "Unprocessable Content", detail, errs);
-    }
 }
