@@ -148,7 +148,10 @@ void field_bool(val_ctx *v, const json_t *obj, const char *key, const char *base
 void field_enum(val_ctx *v, const json_t *obj, const char *key, const char *base,
                 json_t *canon, const char *const *choices, const char *def);
 
-/** Required object field obj[key] (borrowed); NULL, after reporting, when absent or not an object. */
+/**
+ * Required object field obj[key] (borrowed from obj); NULL, after
+ * reporting, when absent or not an object.
+ */
 const json_t *field_object(val_ctx *v, const json_t *obj, const char *key, const char *base);
 
 /**
@@ -174,7 +177,10 @@ json_t *val_request(const json_t *root, const codec_limits *lim, codec_errors *e
 
 /* ====================================================== request.c: req_ */
 
-/** Name of section s (sections are indexed in sorted name order), borrowed; NULL if out of range. */
+/**
+ * Name of section s (sections are indexed in sorted name order), borrowed
+ * from r; NULL if out of range.
+ */
 const char *req_section_name(const codec_request *r, int s);
 
 #endif /* SPINMODAL_CODEC_INTERNAL_H */

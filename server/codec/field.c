@@ -79,17 +79,19 @@ static int field_edit_distance(const char *a, const char *b)
     return row[nb];
 }
 
+/* Error at ptr (NULL: the pointer could not be built, NOMEM), vprintf-style. */
+static void field_verror(val_ctx *v, const char *ptr, const char *fmt, va_list ap)
+{
+    if (!ptr || err_vadd(v->errs, ptr, fmt, ap))
+        v->nomem = 1;
+}
+
 void field_error(val_ctx *v, const char *ptr, const char *fmt, ...)
 {
     va_list ap;
 
-    if (!ptr) {
-        v->nomem = 1;
-        return;
-    }
     va_start(ap, fmt);
-    if (err_vadd(v->errs, ptr, fmt, ap))
-        v->nomem = 1;
+    field_verror(v, ptr, fmt, ap);
     va_end(ap);
 }
 
@@ -99,13 +101,8 @@ void field_error_key(val_ctx *v, const char *base, const char *key, const char *
     va_list ap;
     char *p = err_ptr_key(base, key);
 
-    if (!p) {
-        v->nomem = 1;
-        return;
-    }
     va_start(ap, fmt);
-    if (err_vadd(v->errs, p, fmt, ap))
-        v->nomem = 1;
+    field_verror(v, p, fmt, ap);
     va_end(ap);
     free(p);
 }

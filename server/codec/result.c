@@ -29,19 +29,21 @@ static json_t *res_real(double x)
     return isfinite(x) ? json_real(x) : json_null();
 }
 
-/* [a, b, c] from three reals. */
-static json_t *res_triple(const double *v)
+/* [a, b, ...] from n reals. */
+static json_t *res_reals(const double *v, int n)
 {
     json_t *a = json_array();
+    int k;
 
     if (!a)
         return NULL;
-    if (json_array_append_new(a, res_real(v[0])) || json_array_append_new(a, res_real(v[1])) ||
-        json_array_append_new(a, res_real(v[2]))) {
-        json_decref(a);
-        return NULL;
-    }
+    for (k = 0; k < n; k++)
+        if (json_array_append_new(a, res_real(v[k])))
+            goto fail;
     return a;
+fail:
+    json_decref(a);
+    return NULL;
 }
 
 /* [[x, y, z], ...] from n triples. */
@@ -53,23 +55,7 @@ static json_t *res_triples(const double *v, int n)
     if (!a)
         return NULL;
     for (k = 0; k < n; k++)
-        if (json_array_append_new(a, res_triple(v + 3 * (size_t)k)))
-            goto fail;
-    return a;
-fail:
-    json_decref(a);
-    return NULL;
-}
-
-static json_t *res_reals(const double *v, int n)
-{
-    json_t *a = json_array();
-    int k;
-
-    if (!a)
-        return NULL;
-    for (k = 0; k < n; k++)
-        if (json_array_append_new(a, res_real(v[k])))
+        if (json_array_append_new(a, res_reals(v + 3 * (size_t)k, 3)))
             goto fail;
     return a;
 fail:
@@ -98,7 +84,7 @@ static json_t *res_equilibrium(const codec_request *r, const sm_model *m, const 
             if (node < 0 || node >= c->n_nodes)
                 continue;
             if (json_object_set_new(joints, codec_request_joint_name(r, j),
-                                    res_triple(c->nodes + 3 * (size_t)node)))
+                                    res_reals(c->nodes + 3 * (size_t)node, 3)))
                 goto fail;
         }
         if (json_object_set_new(e, "joints", joints))

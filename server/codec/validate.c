@@ -35,6 +35,24 @@ static int val_joint_xy(const json_t *joints, const char *name, double xy[2])
     return isfinite(xy[0]) && isfinite(xy[1]);
 }
 
+/*
+ * A count n of items at base against its limit: when none is set, n must
+ * also be > 0 (none is the message).  1 when fine, else 0 after reporting.
+ */
+static int val_count(val_ctx *v, const char *base, size_t n, int limit, const char *what,
+                     const char *none)
+{
+    if (n == 0 && none) {
+        field_error(v, base, "%s", none);
+        return 0;
+    }
+    if (n > (size_t)limit) {
+        field_error(v, base, "too many %s (%zu): the limit is %d", what, n, limit);
+        return 0;
+    }
+    return 1;
+}
+
 /* ---------------------------------------------------------- structure */
 
 /* structure.joints: {"name": [x, y], ...}; returns the input object if usable. */
@@ -47,15 +65,9 @@ static const json_t *val_joints(val_ctx *v, const json_t *st, json_t *cst)
 
     if (!joints)
         return NULL;
-    if (json_object_size(joints) == 0) {
-        field_error(v, base, "must name at least one joint");
+    if (!val_count(v, base, json_object_size(joints), v->lim->max_joints, "joints",
+                   "must name at least one joint"))
         return NULL;
-    }
-    if (json_object_size(joints) > (size_t)v->lim->max_joints) {
-        field_error(v, base, "too many joints (%zu): the limit is %d", json_object_size(joints),
-                    v->lim->max_joints);
-        return NULL;
-    }
     cj = json_object();
     if (!cj)
         v->nomem = 1;
@@ -111,15 +123,9 @@ static const json_t *val_sections(val_ctx *v, const json_t *st, json_t *cst)
 
     if (!secs)
         return NULL;
-    if (json_object_size(secs) == 0) {
-        field_error(v, base, "must define at least one section");
+    if (!val_count(v, base, json_object_size(secs), v->lim->max_sections, "sections",
+                   "must define at least one section"))
         return NULL;
-    }
-    if (json_object_size(secs) > (size_t)v->lim->max_sections) {
-        field_error(v, base, "too many sections (%zu): the limit is %d", json_object_size(secs),
-                    v->lim->max_sections);
-        return NULL;
-    }
     cs = json_object();
     if (!cs)
         v->nomem = 1;
@@ -244,15 +250,9 @@ static void val_members(val_ctx *v, const json_t *st, const json_t *joints, cons
         field_error(v, base, "must be an array of members, not %s", field_type_name(mems));
         return;
     }
-    if (json_array_size(mems) == 0) {
-        field_error(v, base, "must list at least one member");
+    if (!val_count(v, base, json_array_size(mems), v->lim->max_members, "members",
+                   "must list at least one member"))
         return;
-    }
-    if (json_array_size(mems) > (size_t)v->lim->max_members) {
-        field_error(v, base, "too many members (%zu): the limit is %d", json_array_size(mems),
-                    v->lim->max_members);
-        return;
-    }
     *ends_ok = joints != NULL;
     cm = json_array();
     ids = json_object();
@@ -286,11 +286,9 @@ static void val_point_masses(val_ctx *v, const json_t *st, const json_t *joints,
         field_error(v, base, "must be an array of {joint, mass}, not %s", field_type_name(pms));
         return;
     }
-    if (json_array_size(pms) > (size_t)v->lim->max_point_masses) {
-        field_error(v, base, "too many point masses (%zu): the limit is %d", json_array_size(pms),
-                    v->lim->max_point_masses);
+    if (!val_count(v, base, json_array_size(pms), v->lim->max_point_masses, "point masses",
+                   NULL))
         return;
-    }
     cp = json_array();
     if (!cp) {
         v->nomem = 1;
@@ -440,15 +438,9 @@ static void val_omega(val_ctx *v, const json_t *an, json_t *can)
                     field_type_name(om));
         return;
     }
-    if (json_array_size(om) == 0) {
-        field_error(v, base, "must list at least one speed");
+    if (!val_count(v, base, json_array_size(om), v->lim->max_speeds, "speeds",
+                   "must list at least one speed"))
         return;
-    }
-    if (json_array_size(om) > (size_t)v->lim->max_speeds) {
-        field_error(v, base, "too many speeds (%zu): the limit is %d", json_array_size(om),
-                    v->lim->max_speeds);
-        return;
-    }
     arr = json_array();
     if (!arr) {
         v->nomem = 1;
