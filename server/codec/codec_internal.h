@@ -3,15 +3,15 @@
  *
  * The codec is one library split by meaning (codec.h lists the public part):
  *
- *   limits.c    the default request limits
- *   errors.c    the error list and RFC 6901 pointer building        err_
+ *   limits.c    the default request limits                           (no helpers)
+ *   errors.c    the error list and RFC 6901 pointer building         err_
  *   field.c     reading one request field: check, report, canonical  field_
  *   validate.c  the request document walked field by field           val_
  *   request.c   canonical text, SHA-256, the core's arrays           req_
  *   diag.c      core diagnostics -> pointers, codec_model_new        diag_
  *   result.c    the result document (DESIGN.md section 4)            res_
  *   csv.c       the result's frequency table as CSV                  csv_
- *   problem.c   RFC 9457 problem documents
+ *   problem.c   RFC 9457 problem documents                           (no helpers)
  *
  * Data flows one way: request.c calls val_request (validate.c, built on
  * field.c, errors.c) and turns the canonical copy into core arrays; diag.c

@@ -38,6 +38,7 @@ static int diag_among(const char *f, const char *const *names)
     return 0;
 }
 
+/* 1 when f is a section property, in the core's or the request's spelling. */
 static int diag_is_section_field(const char *f)
 {
     return !strcmp(f, "E") || !strcmp(f, "A") || !strcmp(f, "I") || !strcmp(f, "mu") ||

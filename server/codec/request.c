@@ -37,6 +37,7 @@ struct codec_request {
     sm_options opt;             /* from the analysis and frames fields */
 };
 
+/* qsort/bsearch order of two (const char *) elements. */
 static int req_cmp_str(const void *a, const void *b)
 {
     return strcmp(*(const char *const *)a, *(const char *const *)b);
@@ -61,12 +62,14 @@ static const char **req_sorted_keys(const json_t *obj, int *n)
     return names;
 }
 
+/* Index of name in the n sorted names; -1 when absent. */
 static int req_name_index(const char **names, int n, const char *name)
 {
     const char **hit = bsearch(&name, names, (size_t)n, sizeof(*names), req_cmp_str);
     return hit ? (int)(hit - names) : -1;
 }
 
+/* A number of the canonical copy (validated: 0 is never used for a non-number). */
 static double req_number(const json_t *x)
 {
     double d = 0;

@@ -370,6 +370,7 @@ static void val_structure(val_ctx *v, const json_t *root, json_t *canon)
 
 /* ----------------------------------------------------- frames, analysis */
 
+/* frames: "single", "per_element", {"per_member": k} or {"elements_per_frame": n}. */
 static void val_frames(val_ctx *v, const json_t *root, json_t *canon)
 {
     static const char *const keys[] = {"per_member", "elements_per_frame", NULL};
@@ -460,6 +461,7 @@ static void val_omega(val_ctx *v, const json_t *an, json_t *can)
     field_set(v, can, "omega", arr);
 }
 
+/* The analysis object: omega, modes and the options, with their defaults. */
 static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
 {
     static const char *const keys[] = {"omega", "modes", "geometric_stiffening", "coriolis",
