@@ -12,6 +12,9 @@
  * Ownership: functions named *_new return objects owned by the caller and
  * released by the matching *_free (NULL is a no-op).  json_t results are new
  * references (json_decref).  Status codes are the core's sm_status values.
+ *
+ * The sections below name the file that implements them; codec_internal.h
+ * (private to server/codec) describes how those files fit together.
  */
 #ifndef SPINMODAL_CODEC_H
 #define SPINMODAL_CODEC_H
@@ -26,7 +29,7 @@
 extern "C" {
 #endif
 
-/* ---------------------------------------------------------------- limits */
+/* ----------------------------------------------------- limits (limits.c) */
 
 /** Size limits applied while validating a request (the daemon configures them). */
 typedef struct codec_limits {
@@ -45,7 +48,7 @@ typedef struct codec_limits {
 /** Fill *lim with the default limits listed in codec_limits. */
 void codec_default_limits(codec_limits *lim);
 
-/* ---------------------------------------------------------------- errors */
+/* ----------------------------------------------------- errors (errors.c) */
 
 /** Most errors kept in one list; later ones are counted, not stored. */
 #define CODEC_MAX_ERRORS 100
@@ -93,7 +96,7 @@ int codec_errors_too_large(const codec_errors *e);
 /** The list as a JSON array [{"pointer","message"}...]; new reference or NULL (NOMEM). */
 json_t *codec_errors_to_json(const codec_errors *e);
 
-/* --------------------------------------------------------------- request */
+/* --------------------------------------- request (validate.c, request.c) */
 
 /** A validated request with its defaults applied.  Opaque, immutable. */
 typedef struct codec_request codec_request;
@@ -148,7 +151,7 @@ const char *codec_request_sha256(const codec_request *r);
  */
 int codec_sha256_hex(const void *data, size_t len, char hex[65]);
 
-/* ------------------------------------------------------------------ core */
+/* --------------------------------------------------------- core (diag.c) */
 
 /**
  * Turn a core diagnostic (sm_model_new, sm_solve) into one error of errs:
@@ -166,7 +169,7 @@ int codec_diag_error(const codec_request *r, const sm_diag *d, codec_errors *err
 int codec_model_new(sm_model **out, const codec_request *r, codec_errors *errs,
                     sm_diag *diag);
 
-/* ---------------------------------------------------------------- result */
+/* ---------------------------------------------- result (result.c, csv.c) */
 
 /** Name of a case status: "solved", "unstable" or "no_equilibrium". */
 const char *codec_case_status_name(sm_case_status s);
@@ -187,7 +190,7 @@ int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
  */
 int codec_result_csv(char **out, size_t *len, const sm_result *res);
 
-/* --------------------------------------------------------------- problem */
+/* --------------------------------------------------- problem (problem.c) */
 
 /**
  * An RFC 9457 problem document {type, title, status, detail, errors}.

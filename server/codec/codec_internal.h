@@ -1,0 +1,189 @@
+/*
+ * codec_internal.h — what the files of server/codec share and nobody else sees.
+ *
+ * The codec is one library split by meaning (codec.h lists the public part):
+ *
+ *   limits.c    the default request limits                           (no helpers)
+ *   errors.c    the error list and RFC 6901 pointer building         err_
+ *   field.c     reading one request field: check, report, canonical  field_
+ *   validate.c  the request document walked field by field           val_
+ *   request.c   canonical text, SHA-256, the core's arrays           req_
+ *   diag.c      core diagnostics -> pointers, codec_model_new        diag_
+ *   result.c    the result document (DESIGN.md section 4)            res_
+ *   csv.c       the result's frequency table as CSV                  csv_
+ *   problem.c   RFC 9457 problem documents                           (no helpers)
+ *   jobdoc.c    the daemon's job documents, the text buffer (jobdoc.h)  jdoc_
+ *   run.c       the pipeline request -> model -> solve -> documents
+ *               (run.h; the CLI and the job workers call it)         run_
+ *
+ * Data flows one way: request.c calls val_request (validate.c, built on
+ * field.c, errors.c) and turns the canonical copy into core arrays; diag.c
+ * reads a request back through its accessors; result.c, csv.c and problem.c
+ * only encode.  This header is not installed and not included outside
+ * server/codec.
+ */
+#ifndef SPINMODAL_CODEC_INTERNAL_H
+#define SPINMODAL_CODEC_INTERNAL_H
+
+#include <stdarg.h>
+#include <stddef.h>
+
+#include <jansson.h>
+
+#include "codec.h"
+
+/* 2*pi, for hertz (M_PI is not C11); result.c and csv.c. */
+#define CODEC_TWO_PI 6.283185307179586476925
+
+/* GCC/Clang printf format check of argument `fmt` (1-based) and `args`. */
+#if defined(__GNUC__)
+#define CODEC_PRINTF(fmt, args) __attribute__((format(printf, fmt, args)))
+#else
+#define CODEC_PRINTF(fmt, args)
+#endif
+
+/* ======================================================== errors.c: err_ */
+
+/** malloc'd vprintf; the caller frees it.  NULL when out of memory. */
+char *err_vfmt(const char *fmt, va_list ap);
+
+/** malloc'd printf; the caller frees it.  NULL when out of memory. */
+char *err_fmt(const char *fmt, ...) CODEC_PRINTF(1, 2);
+
+/**
+ * Append an error with a vprintf message; pointer is copied.  Returns SM_OK
+ * (also when the error is only counted past CODEC_MAX_ERRORS) or SM_NOMEM.
+ */
+int err_vadd(codec_errors *e, const char *pointer, const char *fmt, va_list ap);
+
+/** Mark e as describing text that is not JSON (HTTP 400). */
+void err_mark_malformed(codec_errors *e);
+
+/** Mark e as describing text over max_request_bytes (HTTP 413). */
+void err_mark_too_large(codec_errors *e);
+
+/** Mark e as having lost an error for lack of memory. */
+void err_mark_nomem(codec_errors *e);
+
+/**
+ * base + "/" + key with RFC 6901 escaping (~ -> ~0, / -> ~1); malloc'd,
+ * the caller frees it.  NULL when out of memory.
+ */
+char *err_ptr_key(const char *base, const char *key);
+
+/** base + "/" + index; malloc'd, the caller frees it.  NULL when out of memory. */
+char *err_ptr_idx(const char *base, size_t i);
+
+/* ======================================================== field.c: field_ */
+
+/** Validation state of one request, passed down the walk of validate.c. */
+typedef struct val_ctx {
+    codec_errors *errs;         /* where errors go (borrowed) */
+    const codec_limits *lim;    /* limits (borrowed) */
+    long total_elements;        /* FE elements over all valid members */
+    int nomem;                  /* an allocation failed */
+} val_ctx;
+
+/** A user-supplied name shortened for messages (at most 60 bytes + "..."). */
+typedef struct field_short {
+    char s[72];
+} field_short;
+
+/** name cut to fit field_short on a UTF-8 boundary. */
+field_short field_short_name(const char *name);
+
+/** "an object", "a string", ... for "must be X, not Y" messages. */
+const char *field_type_name(const json_t *x);
+
+/** Error at ptr (borrowed; NULL records NOMEM), message printf-style. */
+void field_error(val_ctx *v, const char *ptr, const char *fmt, ...) CODEC_PRINTF(3, 4);
+
+/** Error at base/key (key escaped), message printf-style. */
+void field_error_key(val_ctx *v, const char *base, const char *key, const char *fmt, ...)
+    CODEC_PRINTF(4, 5);
+
+/** Set canon[key] = value (stolen; canon NULL drops it); records NOMEM. */
+void field_set(val_ctx *v, json_t *canon, const char *key, json_t *value);
+
+/**
+ * Every key of obj must be one of allowed (NULL-terminated); an unknown key
+ * is an error at base/key, with "did you mean" for a near miss.  what names
+ * the object in the message ("member", "analysis", ...).
+ */
+void field_check_keys(val_ctx *v, const json_t *obj, const char *base,
+                      const char *const *allowed, const char *what);
+
+/** Numeric value of an integer or real into *d: 1, or 0 if x is not a number. */
+int field_number(const json_t *x, double *d);
+
+/** Range classes for real fields. */
+enum field_real_kind { FIELD_FINITE, FIELD_NONNEG, FIELD_POSITIVE };
+
+/**
+ * Check a real value x at ptr (borrowed) against kind; unit (" (m)" or "")
+ * goes into messages.  Returns 1 and *out (-0 as 0) when valid, else 0
+ * after reporting.
+ */
+int field_check_real(val_ctx *v, const json_t *x, const char *ptr, enum field_real_kind kind,
+                     const char *unit, double *out);
+
+/**
+ * Required real field obj[key] at base/key: checked, written to canon as a
+ * real, and to *out (out may be NULL).  Returns 1 when valid.
+ */
+int field_real(val_ctx *v, const json_t *obj, const char *key, const char *base,
+               json_t *canon, enum field_real_kind kind, const char *unit, double *out);
+
+/**
+ * Integer field obj[key] in [lo, hi]; when limit_name is set, a value over
+ * hi is reported as over that limit.  Absent: an error when required, else
+ * canon gets def.  Returns 1 and *out (out may be NULL) when valid.
+ */
+int field_int(val_ctx *v, const json_t *obj, const char *key, const char *base,
+              json_t *canon, int required, long def, long lo, long hi,
+              const char *limit_name, long *out);
+
+/** Boolean field obj[key], default def when absent. */
+void field_bool(val_ctx *v, const json_t *obj, const char *key, const char *base,
+                json_t *canon, int def);
+
+/** String field obj[key], one of choices (NULL-terminated, >= 2), default def. */
+void field_enum(val_ctx *v, const json_t *obj, const char *key, const char *base,
+                json_t *canon, const char *const *choices, const char *def);
+
+/**
+ * Required object field obj[key] (borrowed from obj); NULL, after
+ * reporting, when absent or not an object.
+ */
+const json_t *field_object(val_ctx *v, const json_t *obj, const char *key, const char *base);
+
+/**
+ * Required reference obj[key]: a string naming a key of names (a joint,
+ * section ...; what says which in messages).  names NULL (its object was
+ * invalid) checks only the type.  Returns the name (borrowed) when it was
+ * checked against names, else NULL.
+ */
+const char *field_ref(val_ctx *v, const json_t *obj, const char *key, const char *base,
+                      json_t *canon, const json_t *names, const char *what);
+
+/* ===================================================== validate.c: val_ */
+
+/**
+ * Validate root (borrowed) against DESIGN.md section 3, appending every
+ * error to errs.  Returns the canonical request (new reference; defaults
+ * applied), or NULL when root is not an object or memory ran out.  The
+ * request is valid only if no error was added.  *nomem is set to 1 when an
+ * allocation failed (the errors may then be incomplete), else 0.
+ */
+json_t *val_request(const json_t *root, const codec_limits *lim, codec_errors *errs,
+                    int *nomem);
+
+/* ====================================================== request.c: req_ */
+
+/**
+ * Name of section s (sections are indexed in sorted name order), borrowed
+ * from r; NULL if out of range.
+ */
+const char *req_section_name(const codec_request *r, int s);
+
+#endif /* SPINMODAL_CODEC_INTERNAL_H */

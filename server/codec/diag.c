@@ -1,0 +1,172 @@
+/*
+ * diag.c — the core's diagnostics as request errors, and building the model.
+ *
+ * How it fits: the core knows nothing of JSON.  sm_model_new and sm_solve
+ * report a failure in an sm_diag that names an item by kind and index (a
+ * member, joint, section, point mass, the clamp or an option) and a core
+ * field name (mu, basis, omegas...).  This file maps that back to the JSON
+ * pointer of the field in the request (joints and sections by name in the
+ * sorted order of request.c, core field names to request field names) so a
+ * topology error found by the core reads like any validation error.
+ * codec_model_new is the one place the codec calls sm_model_new.
+ */
+#include "codec_internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+/* Request field name of a core field name (mu -> mass_per_length ...). */
+static const char *diag_field_name(const char *f)
+{
+    if (!strcmp(f, "mu"))
+        return "mass_per_length";
+    if (!strcmp(f, "basis"))
+        return "substructure_modes";
+    if (!strcmp(f, "omegas"))
+        return "omega";
+    return f;
+}
+
+/* 1 when f is one of the NULL-terminated names. */
+static int diag_among(const char *f, const char *const *names)
+{
+    int i;
+
+    for (i = 0; names[i]; i++)
+        if (!strcmp(f, names[i]))
+            return 1;
+    return 0;
+}
+
+/* 1 when f is a section property, in the core's or the request's spelling. */
+static int diag_is_section_field(const char *f)
+{
+    return !strcmp(f, "E") || !strcmp(f, "A") || !strcmp(f, "I") || !strcmp(f, "mu") ||
+           !strcmp(f, "mass_per_length");
+}
+
+/* Pointer of an option field reported by the core. */
+static char *diag_options_pointer(const codec_request *r, const char *f, int index)
+{
+    const json_t *canon = codec_request_canonical(r);
+    const json_t *fr = json_object_get(canon, "frames");
+    const json_t *om = json_object_get(json_object_get(canon, "analysis"), "omega");
+
+    if ((!strcmp(f, "omega") || !strcmp(f, "omegas")) && json_is_array(om) && index >= 0 &&
+        (size_t)index < json_array_size(om))
+        return err_fmt("/analysis/omega/%d", index);
+
+    if (!strcmp(f, "frames") || !strcmp(f, "frames_param") || !strcmp(f, "per_member") ||
+        !strcmp(f, "elements_per_frame")) {
+        if (json_is_object(fr) && strcmp(f, "frames")) {
+            const char *key = json_object_get(fr, "per_member") ? "per_member"
+                                                                : "elements_per_frame";
+            return err_fmt("/frames/%s", key);
+        }
+        return strdup("/frames");
+    }
+    if (f[0] == '\0')
+        return strdup("/analysis");
+    return err_ptr_key("/analysis", diag_field_name(f));
+}
+
+/* Pointer of the item a diagnostic names; malloc'd, NULL = NOMEM. */
+static char *diag_pointer(const codec_request *r, const sm_diag *d)
+{
+    const sm_structure *st = codec_request_structure(r);
+    const char *f = d->field;
+    int i = d->item_index;
+    char *base, *p;
+
+    static const char *const member_fields[] = {"id", "from", "to", "section", "elements",
+                                                NULL};
+    static const char *const pm_fields[] = {"joint", "mass", NULL};
+    static const char *const no_fields[] = {NULL};
+    const char *const *known = no_fields;
+
+    switch (d->item) {
+    case SM_ITEM_MEMBER:
+        if (i < 0 || i >= st->n_members)
+            return strdup("/structure/members");
+        if (diag_is_section_field(f) && st->members[i].section >= 0 &&
+            st->members[i].section < st->n_sections) {
+            base = err_ptr_key("/structure/sections",
+                               req_section_name(r, st->members[i].section));
+            known = NULL;
+            break;
+        }
+        base = err_ptr_idx("/structure/members", (size_t)i);
+        known = member_fields;
+        break;
+    case SM_ITEM_JOINT:
+        if (i < 0 || i >= st->n_joints)
+            return strdup("/structure/joints");
+        base = err_ptr_key("/structure/joints", codec_request_joint_name(r, i));
+        if (base && (!strcmp(f, "x") || !strcmp(f, "y"))) {
+            p = err_fmt("%s/%d", base, f[0] == 'y');
+            free(base);
+            return p;
+        }
+        return base;
+    case SM_ITEM_SECTION:
+        if (i < 0 || i >= st->n_sections)
+            return strdup("/structure/sections");
+        base = err_ptr_key("/structure/sections", req_section_name(r, i));
+        known = NULL;
+        break;
+    case SM_ITEM_POINT_MASS:
+        if (i < 0 || i >= st->n_point_masses)
+            return strdup("/structure/point_masses");
+        base = err_ptr_idx("/structure/point_masses", (size_t)i);
+        known = pm_fields;
+        break;
+    case SM_ITEM_CLAMP:
+        return strdup("/structure/clamp");
+    case SM_ITEM_OPTIONS:
+        return diag_options_pointer(r, f, i);
+    case SM_ITEM_NONE:
+    default:
+        return strdup("/structure");
+    }
+    /* a field the request does not have: point at the item itself */
+    if (!base || f[0] == '\0' || (known ? !diag_among(f, known) : !diag_is_section_field(f)))
+        return base;
+    p = err_ptr_key(base, diag_field_name(f));
+    free(base);
+    return p;
+}
+
+int codec_diag_error(const codec_request *r, const sm_diag *d, codec_errors *errs)
+{
+    char *p = diag_pointer(r, d);
+    int rc;
+
+    if (!p) {
+        err_mark_nomem(errs);
+        return SM_NOMEM;
+    }
+    rc = codec_errors_add(errs, p, "%s", d->message[0] ? d->message : sm_strerror(d->status));
+    free(p);
+    return rc;
+}
+
+int codec_model_new(sm_model **out, const codec_request *r, codec_errors *errs,
+                    sm_diag *diag)
+{
+    sm_diag local;
+    sm_diag *d = diag ? diag : &local;
+    int rc;
+
+    memset(d, 0, sizeof(*d));
+    d->item_index = -1;
+    *out = NULL;
+    rc = sm_model_new(out, codec_request_structure(r), codec_request_options(r), d);
+    if (rc == SM_OK)
+        return SM_OK;
+    *out = NULL;
+    if (d->status == SM_OK)
+        d->status = rc;
+    if (rc != SM_NOMEM && codec_diag_error(r, d, errs))
+        return SM_NOMEM;
+    return rc;
+}

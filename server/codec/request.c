@@ -1,0 +1,346 @@
+/*
+ * request.c — a validated request: canonical text, SHA-256 and the core's arrays.
+ *
+ * How it fits: codec_request_parse reads the text (size limit, JSON syntax),
+ * val_request (validate.c) checks it and returns the canonical copy with
+ * every default written out, and only when no error was found this file
+ * dumps that copy as the canonical text (keys sorted, compact, 17 digits),
+ * hashes it, and turns it into the sm_structure, sm_options and speeds that
+ * sm_model_new and sm_solve take.  Joints and sections are indexed in sorted
+ * name order, so the canonical text fully determines the model and two
+ * requests with the same SHA-256 give the same result.  The request is
+ * immutable afterwards; diag.c and result.c read it through the accessors.
+ */
+#include "codec_internal.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include <openssl/evp.h>
+
+/* Flags for dumping canonical text. */
+#define CODEC_DUMP_CANON (JSON_SORT_KEYS | JSON_COMPACT | JSON_REAL_PRECISION(17))
+
+struct codec_request {
+    json_t *canon;              /* canonical request, defaults applied */
+    char *canon_text;           /* its sorted compact dump */
+    char sha[65];               /* SHA-256 of canon_text, hex */
+    const char **joint_names;   /* n_joints, sorted, borrowed from canon */
+    const char **section_names; /* n_sections, sorted, borrowed from canon */
+    double *joint_xy;           /* 2*n_joints */
+    sm_section *sections;       /* n_sections */
+    sm_member *members;         /* n_members */
+    sm_point_mass *point_masses;/* n_point_masses (NULL if 0) */
+    double *speeds;             /* n_speeds, request order */
+    int n_speeds;
+    sm_structure st;            /* points into the arrays above */
+    sm_options opt;             /* from the analysis and frames fields */
+};
+
+/* qsort/bsearch order of two (const char *) elements. */
+static int req_cmp_str(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+/* Sorted key list of obj (borrowed keys); NULL = NOMEM. */
+static const char **req_sorted_keys(const json_t *obj, int *n)
+{
+    size_t k = 0, cnt = json_object_size(obj);
+    const char **names = calloc(cnt ? cnt : 1, sizeof(*names));
+    const char *key;
+    json_t *val;
+
+    if (!names)
+        return NULL;
+    json_object_foreach((json_t *)obj, key, val) {
+        (void)val;
+        names[k++] = key;
+    }
+    qsort(names, cnt, sizeof(*names), req_cmp_str);
+    *n = (int)cnt;
+    return names;
+}
+
+/* Index of name in the n sorted names; -1 when absent. */
+static int req_name_index(const char **names, int n, const char *name)
+{
+    const char **hit = bsearch(&name, names, (size_t)n, sizeof(*names), req_cmp_str);
+    return hit ? (int)(hit - names) : -1;
+}
+
+/* A number of the canonical copy (validated: 0 is never used for a non-number). */
+static double req_number(const json_t *x)
+{
+    double d = 0;
+    field_number(x, &d);
+    return d;
+}
+
+/* Joints and sections arrays, sorted by name. */
+static int req_build_tables(codec_request *r)
+{
+    const json_t *st = json_object_get(r->canon, "structure");
+    const json_t *joints = json_object_get(st, "joints");
+    const json_t *secs = json_object_get(st, "sections");
+    int i, nj = 0, ns = 0;
+
+    r->joint_names = req_sorted_keys(joints, &nj);
+    r->section_names = req_sorted_keys(secs, &ns);
+    if (!r->joint_names || !r->section_names)
+        return SM_NOMEM;
+    r->joint_xy = malloc(2 * (size_t)nj * sizeof(double));
+    r->sections = malloc((size_t)(ns ? ns : 1) * sizeof(sm_section));
+    if (!r->joint_xy || !r->sections)
+        return SM_NOMEM;
+    for (i = 0; i < nj; i++) {
+        const json_t *xy = json_object_get(joints, r->joint_names[i]);
+        r->joint_xy[2 * i] = req_number(json_array_get(xy, 0));
+        r->joint_xy[2 * i + 1] = req_number(json_array_get(xy, 1));
+    }
+    for (i = 0; i < ns; i++) {
+        const json_t *s = json_object_get(secs, r->section_names[i]);
+        r->sections[i].E = req_number(json_object_get(s, "E"));
+        r->sections[i].A = req_number(json_object_get(s, "A"));
+        r->sections[i].I = req_number(json_object_get(s, "I"));
+        r->sections[i].mu = req_number(json_object_get(s, "mass_per_length"));
+    }
+    r->st.n_joints = nj;
+    r->st.joint_xy = r->joint_xy;
+    r->st.n_sections = ns;
+    r->st.sections = r->sections;
+    return SM_OK;
+}
+
+/* Members, point masses and clamp as indices. */
+static int req_build_structure(codec_request *r)
+{
+    const json_t *st = json_object_get(r->canon, "structure");
+    const json_t *mems = json_object_get(st, "members");
+    const json_t *pms = json_object_get(st, "point_masses");
+    const json_t *x;
+    size_t i, nm = json_array_size(mems), np = json_array_size(pms);
+    int nj = r->st.n_joints, ns = r->st.n_sections;
+
+    r->members = malloc((nm ? nm : 1) * sizeof(sm_member));
+    r->point_masses = np ? malloc(np * sizeof(sm_point_mass)) : NULL;
+    if (!r->members || (np && !r->point_masses))
+        return SM_NOMEM;
+    json_array_foreach(mems, i, x) {
+        r->members[i].from = req_name_index(r->joint_names, nj,
+                                            json_string_value(json_object_get(x, "from")));
+        r->members[i].to = req_name_index(r->joint_names, nj,
+                                          json_string_value(json_object_get(x, "to")));
+        r->members[i].section = req_name_index(r->section_names, ns,
+                                               json_string_value(json_object_get(x, "section")));
+        r->members[i].elements = (int)json_integer_value(json_object_get(x, "elements"));
+    }
+    json_array_foreach(pms, i, x) {
+        r->point_masses[i].joint = req_name_index(r->joint_names, nj,
+                                                  json_string_value(json_object_get(x, "joint")));
+        r->point_masses[i].mass = req_number(json_object_get(x, "mass"));
+    }
+    r->st.n_members = (int)nm;
+    r->st.members = r->members;
+    r->st.n_point_masses = (int)np;
+    r->st.point_masses = r->point_masses;
+    r->st.clamp = req_name_index(r->joint_names, nj,
+                                 json_string_value(json_object_get(st, "clamp")));
+    return SM_OK;
+}
+
+/* sm_options and speeds from frames and analysis. */
+static int req_build_options(codec_request *r)
+{
+    const json_t *an = json_object_get(r->canon, "analysis");
+    const json_t *fr = json_object_get(r->canon, "frames");
+    const json_t *om = json_object_get(an, "omega");
+    const json_t *mpf = json_object_get(an, "modes_per_frame");
+    size_t i, n = json_is_array(om) ? json_array_size(om) : 1;
+
+    sm_default_options(&r->opt);
+    if (json_is_string(fr)) {
+        r->opt.frames = !strcmp(json_string_value(fr), "single") ? SM_FRAMES_SINGLE
+                                                                 : SM_FRAMES_PER_ELEMENT;
+        r->opt.frames_param = 0;
+    } else if (json_object_get(fr, "per_member")) {
+        r->opt.frames = SM_FRAMES_PER_MEMBER;
+        r->opt.frames_param = (int)json_integer_value(json_object_get(fr, "per_member"));
+    } else {
+        r->opt.frames = SM_FRAMES_ELEMENTS_PER_FRAME;
+        r->opt.frames_param = (int)json_integer_value(json_object_get(fr, "elements_per_frame"));
+    }
+    r->opt.mass = !strcmp(json_string_value(json_object_get(an, "mass")), "consistent")
+                      ? SM_MASS_CONSISTENT : SM_MASS_LUMPED;
+    r->opt.basis = !strcmp(json_string_value(json_object_get(an, "substructure_modes")),
+                           "paper") ? SM_BASIS_PAPER : SM_BASIS_AUGMENTED;
+    r->opt.modes_per_frame = json_is_integer(mpf) ? (int)json_integer_value(mpf) : 0;
+    r->opt.modes = (int)json_integer_value(json_object_get(an, "modes"));
+    r->opt.geometric_stiffening = json_is_true(json_object_get(an, "geometric_stiffening"));
+    r->opt.coriolis = json_is_true(json_object_get(an, "coriolis"));
+    r->opt.mode_shapes = json_is_true(json_object_get(an, "mode_shapes"));
+
+    r->speeds = malloc(n * sizeof(double));
+    if (!r->speeds)
+        return SM_NOMEM;
+    for (i = 0; i < n; i++)
+        r->speeds[i] = req_number(json_is_array(om) ? json_array_get(om, i) : om);
+    r->n_speeds = (int)n;
+    return SM_OK;
+}
+
+int codec_sha256_hex(const void *data, size_t len, char hex[65])
+{
+    static const char digits[] = "0123456789abcdef";
+    unsigned char md[EVP_MAX_MD_SIZE];
+    unsigned int n = 0, i;
+
+    hex[0] = '\0';
+    if (!EVP_Digest(data, len, md, &n, EVP_sha256(), NULL) || n != 32)
+        return SM_NOMEM;
+    for (i = 0; i < n; i++) {
+        hex[2 * i] = digits[md[i] >> 4];
+        hex[2 * i + 1] = digits[md[i] & 15];
+    }
+    hex[64] = '\0';
+    return SM_OK;
+}
+
+int codec_request_from_json(codec_request **out, const json_t *root,
+                            const codec_limits *lim, codec_errors *errs)
+{
+    codec_limits deflim;
+    codec_request *r = NULL;
+    json_t *canon;
+    int rc = SM_NOMEM, before = codec_errors_count(errs), nomem;
+
+    *out = NULL;
+    if (!lim) {
+        codec_default_limits(&deflim);
+        lim = &deflim;
+    }
+    canon = val_request(root, lim, errs, &nomem);
+    if (nomem)
+        goto fail;
+    if (codec_errors_count(errs) > before || !canon) {
+        rc = SM_INVALID_INPUT;
+        goto fail;
+    }
+    r = calloc(1, sizeof(*r));
+    if (!r)
+        goto fail;
+    r->canon = canon;
+    canon = NULL;
+    r->canon_text = json_dumps(r->canon, CODEC_DUMP_CANON);
+    if (!r->canon_text)
+        goto fail;
+    if ((rc = codec_sha256_hex(r->canon_text, strlen(r->canon_text), r->sha)) ||
+        (rc = req_build_tables(r)) || (rc = req_build_structure(r)) ||
+        (rc = req_build_options(r)))
+        goto fail;
+    *out = r;
+    return SM_OK;
+fail:
+    json_decref(canon);
+    codec_request_free(r);
+    return rc;
+}
+
+int codec_request_parse(codec_request **out, const char *text, size_t len,
+                        const codec_limits *lim, codec_errors *errs)
+{
+    codec_limits deflim;
+    json_error_t jerr;
+    json_t *root;
+    int rc;
+
+    *out = NULL;
+    if (!lim) {
+        codec_default_limits(&deflim);
+        lim = &deflim;
+    }
+    if (len > lim->max_request_bytes) {
+        err_mark_too_large(errs);
+        if (codec_errors_add(errs, "", "the request is %zu bytes: the limit is %zu bytes",
+                             len, lim->max_request_bytes))
+            return SM_NOMEM;
+        return SM_INVALID_INPUT;
+    }
+    root = json_loadb(text, len, JSON_REJECT_DUPLICATES, &jerr);
+    if (!root) {
+        err_mark_malformed(errs);
+        for (size_t k = 0; jerr.text[k]; k++) /* jansson's "near '...'" may cut a UTF-8 char */
+            if ((unsigned char)jerr.text[k] >= 0x80)
+                jerr.text[k] = '?';
+        if (json_error_code(&jerr) == json_error_out_of_memory)
+            return SM_NOMEM;
+        if (codec_errors_add(errs, "", "not valid JSON: %s (line %d, column %d)", jerr.text,
+                             jerr.line, jerr.column))
+            return SM_NOMEM;
+        return SM_INVALID_INPUT;
+    }
+    rc = codec_request_from_json(out, root, lim, errs);
+    json_decref(root);
+    return rc;
+}
+
+void codec_request_free(codec_request *r)
+{
+    if (!r)
+        return;
+    free(r->speeds);
+    free(r->point_masses);
+    free(r->members);
+    free(r->sections);
+    free(r->joint_xy);
+    free(r->section_names);
+    free(r->joint_names);
+    free(r->canon_text);
+    json_decref(r->canon);
+    free(r);
+}
+
+const sm_structure *codec_request_structure(const codec_request *r)
+{
+    return &r->st;
+}
+
+const sm_options *codec_request_options(const codec_request *r)
+{
+    return &r->opt;
+}
+
+const double *codec_request_speeds(const codec_request *r, int *n)
+{
+    *n = r->n_speeds;
+    return r->speeds;
+}
+
+const char *codec_request_joint_name(const codec_request *r, int j)
+{
+    if (j < 0 || j >= r->st.n_joints)
+        return NULL;
+    return r->joint_names[j];
+}
+
+const char *req_section_name(const codec_request *r, int s)
+{
+    if (s < 0 || s >= r->st.n_sections)
+        return NULL;
+    return r->section_names[s];
+}
+
+const json_t *codec_request_canonical(const codec_request *r)
+{
+    return r->canon;
+}
+
+const char *codec_request_canonical_text(const codec_request *r)
+{
+    return r->canon_text;
+}
+
+const char *codec_request_sha256(const codec_request *r)
+{
+    return r->sha;
+}

@@ -1,0 +1,225 @@
+/*
+ * result.c — an sm_result as the result document of DESIGN.md section 4.
+ *
+ * How it fits: after sm_solve, the CLI and the daemon's workers call
+ * codec_result_encode; the document is what the daemon stores and serves
+ * byte for byte, so its layout is a contract (schemas/result.schema.json).
+ * The request supplies the SHA-256 and the joint names (in the sorted order
+ * of request.c), the model the joint -> node map and the sizes.  Numbers
+ * that are not finite become null (JSON has no NaN or infinity).  csv.c
+ * writes the same frequencies as a table.
+ */
+#include "codec_internal.h"
+
+#include <math.h>
+
+const char *codec_case_status_name(sm_case_status s)
+{
+    switch (s) {
+    case SM_CASE_SOLVED: return "solved";
+    case SM_CASE_UNSTABLE: return "unstable";
+    case SM_CASE_NO_EQUILIBRIUM: return "no_equilibrium";
+    case SM_CASE_EIGEN_FAILED: return "eigen_failed";
+    }
+    return "unknown";
+}
+
+/* A real, or null when not finite (JSON has no NaN or infinity). */
+static json_t *res_real(double x)
+{
+    return isfinite(x) ? json_real(x) : json_null();
+}
+
+/* [a, b, ...] from n reals. */
+static json_t *res_reals(const double *v, int n)
+{
+    json_t *a = json_array();
+    int k;
+
+    if (!a)
+        return NULL;
+    for (k = 0; k < n; k++)
+        if (json_array_append_new(a, res_real(v[k])))
+            goto fail;
+    return a;
+fail:
+    json_decref(a);
+    return NULL;
+}
+
+/* [[x, y, z], ...] from n triples. */
+static json_t *res_triples(const double *v, int n)
+{
+    json_t *a = json_array();
+    int k;
+
+    if (!a)
+        return NULL;
+    for (k = 0; k < n; k++)
+        if (json_array_append_new(a, res_reals(v + 3 * (size_t)k, 3)))
+            goto fail;
+    return a;
+fail:
+    json_decref(a);
+    return NULL;
+}
+
+/* case.equilibrium */
+static json_t *res_equilibrium(const codec_request *r, const sm_model *m, const sm_case *c)
+{
+    json_t *e = json_object(), *joints = NULL;
+    int j, nj = codec_request_structure(r)->n_joints;
+
+    if (!e)
+        return NULL;
+    if (json_object_set_new(e, "converged", json_boolean(c->converged)) ||
+        json_object_set_new(e, "iterations", json_integer(c->iterations)) ||
+        json_object_set_new(e, "residual", res_real(c->residual)))
+        goto fail;
+    if (c->nodes && c->n_nodes > 0) {
+        joints = json_object();
+        if (!joints)
+            goto fail;
+        for (j = 0; j < nj; j++) {
+            int node = sm_model_joint_node(m, j);
+            if (node < 0 || node >= c->n_nodes)
+                continue;
+            if (json_object_set_new(joints, codec_request_joint_name(r, j),
+                                    res_reals(c->nodes + 3 * (size_t)node, 3)))
+                goto fail;
+        }
+        if (json_object_set_new(e, "joints", joints))
+            goto fail_set;
+        joints = NULL;
+        if (json_object_set_new(e, "nodes", res_triples(c->nodes, c->n_nodes)))
+            goto fail;
+    }
+    if (c->axial_force && c->n_elements > 0 &&
+        json_object_set_new(e, "axial_force", res_reals(c->axial_force, c->n_elements)))
+        goto fail;
+    if (c->nodes && c->n_nodes > 0 &&
+        json_object_set_new(e, "max_frame_rotation", res_real(c->max_frame_rotation)))
+        goto fail;
+    return e;
+fail:
+    json_decref(joints);
+fail_set:
+    json_decref(e);
+    return NULL;
+}
+
+/* One mode of a case. */
+static json_t *res_mode(const sm_case *c, int k, int shapes)
+{
+    size_t stride = 3 * (size_t)c->n_nodes;
+    json_t *md = json_object(), *shape;
+    double mac = c->mac_to_previous ? c->mac_to_previous[k] : -1;
+    int prev = c->previous_index ? c->previous_index[k] : -1;
+
+    if (!md)
+        return NULL;
+    if (json_object_set_new(md, "frequency_rad_s", res_real(c->frequency[k])) ||
+        json_object_set_new(md, "frequency_hz", res_real(c->frequency[k] / CODEC_TWO_PI)) ||
+        json_object_set_new(md, "eigenvalue", json_pack("[o, o]", res_real(c->eig_re[k]),
+                                                        res_real(c->eig_im[k]))) ||
+        json_object_set_new(md, "mac_to_previous", mac < 0 ? json_null() : res_real(mac)) ||
+        json_object_set_new(md, "previous_index", prev < 0 ? json_null() : json_integer(prev)))
+        goto fail;
+    if (shapes && c->shape_re) {
+        shape = json_object();
+        if (json_object_set_new(md, "shape", shape))
+            goto fail;
+        if (json_object_set_new(shape, "re", res_triples(c->shape_re + k * stride, c->n_nodes)))
+            goto fail;
+        if (c->shape_im &&
+            json_object_set_new(shape, "im", res_triples(c->shape_im + k * stride, c->n_nodes)))
+            goto fail;
+    }
+    return md;
+fail:
+    json_decref(md);
+    return NULL;
+}
+
+/* One case (speed). */
+static json_t *res_case(const codec_request *r, const sm_model *m, const sm_case *c)
+{
+    json_t *o = json_object(), *modes;
+    int k, shapes = codec_request_options(r)->mode_shapes;
+
+    if (!o)
+        return NULL;
+    if (json_object_set_new(o, "omega", res_real(c->omega)) ||
+        json_object_set_new(o, "status", json_string(codec_case_status_name(c->status))) ||
+        json_object_set_new(o, "equilibrium", res_equilibrium(r, m, c)))
+        goto fail;
+    if (c->status != SM_CASE_NO_EQUILIBRIUM && c->status != SM_CASE_EIGEN_FAILED &&
+        json_object_set_new(o, "stability",
+                            json_pack("{s:b, s:i}", "stable", c->stable,
+                                      "negative_eigenvalues", c->negative_eigenvalues)))
+        goto fail;
+    modes = json_array();
+    if (json_object_set_new(o, "modes", modes))
+        goto fail;
+    for (k = 0; k < c->n_modes; k++)
+        if (json_array_append_new(modes, res_mode(c, k, shapes)))
+            goto fail;
+    if (c->warning[0] &&
+        json_object_set_new(o, "warnings", json_pack("[s]", c->warning)))
+        goto fail;
+    if (c->status != SM_CASE_SOLVED &&
+        json_object_set_new(o, "diagnostics",
+                            json_pack("{s:i, s:o, s:o, s:s}", "iterations", c->iterations,
+                                      "residual", res_real(c->residual), "last_omega",
+                                      res_real(c->last_omega), "message",
+                                      c->message[0] ? c->message
+                                                    : codec_case_status_name(c->status))))
+        goto fail;
+    return o;
+fail:
+    json_decref(o);
+    return NULL;
+}
+
+int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
+                        const sm_result *res)
+{
+    json_t *doc = NULL, *cases;
+    sm_model_info info;
+    double te = 0, tl = 0, tg = 0;
+    int i;
+
+    *out = NULL;
+    sm_model_get_info(m, &info);
+    doc = json_object();
+    if (!doc)
+        goto fail;
+    if (json_object_set_new(doc, "solver",
+                            json_pack("{s:s, s:s, s:s}", "name", "spinmodal", "version",
+                                      SM_VERSION, "request_sha256", codec_request_sha256(r))) ||
+        json_object_set_new(doc, "model",
+                            json_pack("{s:i, s:i, s:i, s:i}", "nodes", info.nodes,
+                                      "elements", info.elements, "frames", info.frames,
+                                      "coordinates", info.coordinates)))
+        goto fail;
+    cases = json_array();
+    if (json_object_set_new(doc, "cases", cases))
+        goto fail;
+    for (i = 0; i < res->n_cases; i++) {
+        const sm_case *c = &res->cases[i];
+        if (json_array_append_new(cases, res_case(r, m, c)))
+            goto fail;
+        te += c->t_equilibrium;
+        tl += c->t_linearize;
+        tg += c->t_eigen;
+    }
+    if (json_object_set_new(doc, "timing_ms",
+                            json_pack("{s:o, s:o, s:o}", "equilibrium", res_real(te),
+                                      "linearize", res_real(tl), "eigen", res_real(tg))))
+        goto fail;
+    *out = doc;
+    return SM_OK;
+fail:
+    json_decref(doc);
+    return SM_NOMEM;
+}

@@ -1,0 +1,562 @@
+/*
+ * validate.c — the request document of DESIGN.md section 3, walked field by field.
+ *
+ * How it fits: request.c hands the parsed JSON to val_request, which checks
+ * it against the request's shape and builds the canonical copy with every
+ * default written out; request.c turns that copy into the core's arrays
+ * only when no error was found.  The walk follows the document (structure:
+ * joints, sections, members, point masses, clamp; then frames; then
+ * analysis) and never stops at the first error: each field is checked
+ * (type, range, references, unknown keys) with the readers of field.c, and
+ * each error carries the JSON pointer of its field.  The limits of
+ * codec_limits are checked before anything is built from a count.
+ *
+ * Topology (cycles, disconnected members) is the core's job: sm_model_new
+ * reports it and diag.c maps it back to a pointer.  Here only the cheap
+ * local cases are pre-checked (zero-length member, a joint or clamp that
+ * is no member's end) so those appear with the other errors.
+ */
+#include "codec_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Coordinates of joint `name` in the input joints object, if valid. */
+static int val_joint_xy(const json_t *joints, const char *name, double xy[2])
+{
+    const json_t *j = joints ? json_object_get(joints, name) : NULL;
+
+    if (!json_is_array(j) || json_array_size(j) != 2)
+        return 0;
+    if (!field_number(json_array_get(j, 0), &xy[0]) ||
+        !field_number(json_array_get(j, 1), &xy[1]))
+        return 0;
+    return isfinite(xy[0]) && isfinite(xy[1]);
+}
+
+/*
+ * A count n of items at base against its limit: when none is set, n must
+ * also be > 0 (none is the message).  1 when fine, else 0 after reporting.
+ */
+static int val_count(val_ctx *v, const char *base, size_t n, int limit, const char *what,
+                     const char *none)
+{
+    if (n == 0 && none) {
+        field_error(v, base, "%s", none);
+        return 0;
+    }
+    if (n > (size_t)limit) {
+        field_error(v, base, "too many %s (%zu): the limit is %d", what, n, limit);
+        return 0;
+    }
+    return 1;
+}
+
+/* ---------------------------------------------------------- structure */
+
+/* structure.joints: {"name": [x, y], ...}; returns the input object if usable. */
+static const json_t *val_joints(val_ctx *v, const json_t *st, json_t *cst)
+{
+    static const char *base = "/structure/joints";
+    const json_t *joints = field_object(v, st, "joints", "/structure");
+    json_t *cj, *xy;
+    const char *name;
+
+    if (!joints)
+        return NULL;
+    if (!val_count(v, base, json_object_size(joints), v->lim->max_joints, "joints",
+                   "must name at least one joint"))
+        return NULL;
+    cj = json_object();
+    if (!cj)
+        v->nomem = 1;
+    json_object_foreach((json_t *)joints, name, xy) {
+        char *p = err_ptr_key(base, name);
+        double c[2];
+        size_t k;
+        json_t *arr;
+        if (!p) {
+            v->nomem = 1;
+            break;
+        }
+        if (name[0] == '\0')
+            field_error(v, p, "a joint name must not be empty");
+        if (!json_is_array(xy) || json_array_size(xy) != 2) {
+            if (json_is_array(xy))
+                field_error(v, p, "must be [x, y] (2 numbers), got %zu value%s",
+                            json_array_size(xy), json_array_size(xy) == 1 ? "" : "s");
+            else
+                field_error(v, p, "must be [x, y] (2 numbers), not %s", field_type_name(xy));
+            free(p);
+            continue;
+        }
+        for (k = 0; k < 2; k++) {
+            char *pk = err_ptr_idx(p, k);
+            if (!field_check_real(v, json_array_get(xy, k), pk ? pk : p, FIELD_FINITE, " (m)",
+                                  &c[k]))
+                c[k] = NAN;
+            free(pk);
+        }
+        free(p);
+        if (isfinite(c[0]) && isfinite(c[1])) {
+            arr = json_pack("[f, f]", c[0], c[1]);
+            if (cj && (!arr || json_object_set_new(cj, name, arr)))
+                v->nomem = 1;
+            else if (!cj)
+                json_decref(arr);
+        }
+    }
+    field_set(v, cst, "joints", cj);
+    return joints;
+}
+
+/* structure.sections: {"name": {E, A, I, mass_per_length}, ...}. */
+static const json_t *val_sections(val_ctx *v, const json_t *st, json_t *cst)
+{
+    static const char *const keys[] = {"E", "A", "I", "mass_per_length", NULL};
+    static const char *const units[] = {" (Pa)", " (m^2)", " (m^4)", " (kg/m)"};
+    static const char *base = "/structure/sections";
+    const json_t *secs = field_object(v, st, "sections", "/structure");
+    json_t *cs, *sec;
+    const char *name;
+
+    if (!secs)
+        return NULL;
+    if (!val_count(v, base, json_object_size(secs), v->lim->max_sections, "sections",
+                   "must define at least one section"))
+        return NULL;
+    cs = json_object();
+    if (!cs)
+        v->nomem = 1;
+    json_object_foreach((json_t *)secs, name, sec) {
+        char *p = err_ptr_key(base, name);
+        json_t *c;
+        int k;
+        if (!p) {
+            v->nomem = 1;
+            break;
+        }
+        if (name[0] == '\0')
+            field_error(v, p, "a section name must not be empty");
+        if (!json_is_object(sec)) {
+            field_error(v, p, "must be an object {E, A, I, mass_per_length}, not %s",
+                        field_type_name(sec));
+            free(p);
+            continue;
+        }
+        field_check_keys(v, sec, p, keys, "section");
+        c = json_object();
+        if (!c)
+            v->nomem = 1;
+        for (k = 0; keys[k]; k++)
+            field_real(v, sec, keys[k], p, c, FIELD_POSITIVE, units[k], NULL);
+        free(p);
+        if (cs && c && json_object_set_new(cs, name, c))
+            v->nomem = 1;
+        else if (!cs)
+            json_decref(c);
+    }
+    field_set(v, cst, "sections", cs);
+    return secs;
+}
+
+/* Member i: {id, from, to, section, elements}; adds its elements to *total. */
+static void val_member(val_ctx *v, const json_t *mem, size_t i, const json_t *joints,
+                       const json_t *secs, json_t *cm, json_t *ids, json_t *ends,
+                       int *ends_ok, long *total)
+{
+    static const char *const keys[] = {"id", "from", "to", "section", "elements", NULL};
+    char *p = err_ptr_idx("/structure/members", i);
+    const json_t *id;
+    const char *from, *to;
+    double a[2], b[2];
+    long el;
+    json_t *c = NULL;
+
+    if (!p) {
+        v->nomem = 1;
+        return;
+    }
+    if (!json_is_object(mem)) {
+        field_error(v, p, "must be an object {id, from, to, section, elements}, not %s",
+                    field_type_name(mem));
+        *ends_ok = 0;
+        goto done;
+    }
+    field_check_keys(v, mem, p, keys, "member");
+    c = json_object();
+    if (!c)
+        v->nomem = 1;
+    id = json_object_get(mem, "id");
+    if (id && (!json_is_string(id) || json_string_length(id) == 0)) {
+        field_error_key(v, p, "id", "must be a non-empty string, not %s",
+                        json_is_string(id) ? "an empty string" : field_type_name(id));
+    } else if (id) {
+        const char *s = json_string_value(id);
+        const json_t *seen = json_object_get(ids, s);
+        if (seen)
+            field_error_key(v, p, "id", "duplicate member id '%s' (also /structure/members/%"
+                            JSON_INTEGER_FORMAT ")", field_short_name(s).s,
+                            json_integer_value(seen));
+        else if (json_object_set_new(ids, s, json_integer((json_int_t)i)))
+            v->nomem = 1;
+        field_set(v, c, "id", json_string(s));
+    }
+    from = field_ref(v, mem, "from", p, c, joints, "joint");
+    to = field_ref(v, mem, "to", p, c, joints, "joint");
+    field_ref(v, mem, "section", p, c, secs, "section");
+    if (field_int(v, mem, "elements", p, c, 1, 0, 1, v->lim->max_elements,
+                  "the number of elements", &el))
+        *total += el;
+    if (!from || !to) {
+        *ends_ok = 0;
+    } else {
+        if (json_object_set_new(ends, from, json_true()) ||
+            json_object_set_new(ends, to, json_true()))
+            v->nomem = 1;
+        if (!strcmp(from, to))
+            field_error_key(v, p, "to", "zero-length member: it starts and ends at joint '%s'",
+                            field_short_name(to).s);
+        else if (val_joint_xy(joints, from, a) && val_joint_xy(joints, to, b) && a[0] == b[0] &&
+                 a[1] == b[1])
+            field_error(v, p, "zero-length member: joints '%s' and '%s' are at the same position",
+                        field_short_name(from).s, field_short_name(to).s);
+    }
+done:
+    free(p);
+    if (c && cm && json_array_append_new(cm, c))
+        v->nomem = 1;
+    else if (c && !cm)
+        json_decref(c);
+}
+
+/* structure.members: non-empty array; returns the set of joints that are member ends. */
+static void val_members(val_ctx *v, const json_t *st, const json_t *joints, const json_t *secs,
+                        json_t *cst, json_t *ends, int *ends_ok)
+{
+    static const char *base = "/structure/members";
+    const json_t *mems = json_object_get(st, "members");
+    json_t *cm, *ids, *mem;
+    size_t i;
+    long total = 0;
+
+    *ends_ok = 0;
+    if (!mems) {
+        field_error(v, base, "required field 'members' is missing");
+        return;
+    }
+    if (!json_is_array(mems)) {
+        field_error(v, base, "must be an array of members, not %s", field_type_name(mems));
+        return;
+    }
+    if (!val_count(v, base, json_array_size(mems), v->lim->max_members, "members",
+                   "must list at least one member"))
+        return;
+    *ends_ok = joints != NULL;
+    cm = json_array();
+    ids = json_object();
+    if (!cm || !ids)
+        v->nomem = 1;
+    else
+        json_array_foreach(mems, i, mem)
+            val_member(v, mem, i, joints, secs, cm, ids, ends, ends_ok, &total);
+    json_decref(ids);
+    v->total_elements = total;
+    if (total > v->lim->max_elements)
+        field_error(v, base, "the members have %ld elements in total: the limit is %d", total,
+                    v->lim->max_elements);
+    field_set(v, cst, "members", cm);
+}
+
+/* structure.point_masses: optional array of {joint, mass}. */
+static void val_point_masses(val_ctx *v, const json_t *st, const json_t *joints, json_t *cst)
+{
+    static const char *const keys[] = {"joint", "mass", NULL};
+    static const char *base = "/structure/point_masses";
+    const json_t *pms = json_object_get(st, "point_masses");
+    json_t *cp, *pm;
+    size_t i;
+
+    if (!pms) {
+        field_set(v, cst, "point_masses", json_array());
+        return;
+    }
+    if (!json_is_array(pms)) {
+        field_error(v, base, "must be an array of {joint, mass}, not %s", field_type_name(pms));
+        return;
+    }
+    if (!val_count(v, base, json_array_size(pms), v->lim->max_point_masses, "point masses",
+                   NULL))
+        return;
+    cp = json_array();
+    if (!cp) {
+        v->nomem = 1;
+        return;
+    }
+    json_array_foreach(pms, i, pm) {
+        char *p = err_ptr_idx(base, i);
+        json_t *c;
+        if (!p) {
+            v->nomem = 1;
+            break;
+        }
+        if (!json_is_object(pm)) {
+            field_error(v, p, "must be an object {joint, mass}, not %s", field_type_name(pm));
+            free(p);
+            continue;
+        }
+        field_check_keys(v, pm, p, keys, "point mass");
+        c = json_object();
+        if (!c)
+            v->nomem = 1;
+        field_ref(v, pm, "joint", p, c, joints, "joint");
+        field_real(v, pm, "mass", p, c, FIELD_NONNEG, " (kg)", NULL);
+        free(p);
+        if (c && json_array_append_new(cp, c))
+            v->nomem = 1;
+    }
+    field_set(v, cst, "point_masses", cp);
+}
+
+/* Every joint must be an end of some member (the core rejects it too). */
+static void val_unused_joints(val_ctx *v, const json_t *joints, const json_t *ends)
+{
+    const char *name;
+    json_t *xy;
+
+    json_object_foreach((json_t *)joints, name, xy) {
+        (void)xy;
+        if (!json_object_get(ends, name))
+            field_error_key(v, "/structure/joints", name,
+                            "joint '%s' is not an end of any member", field_short_name(name).s);
+    }
+}
+
+/* The structure object. */
+static void val_structure(val_ctx *v, const json_t *root, json_t *canon)
+{
+    static const char *const keys[] = {"joints", "sections", "members", "point_masses",
+                                       "clamp", NULL};
+    const json_t *st = field_object(v, root, "structure", "");
+    const json_t *joints, *secs, *clamp;
+    json_t *cst, *ends;
+    int ends_ok = 0;
+
+    if (!st)
+        return;
+    field_check_keys(v, st, "/structure", keys, "structure");
+    cst = json_object();
+    ends = json_object();
+    if (!cst || !ends)
+        v->nomem = 1;
+    joints = val_joints(v, st, cst);
+    secs = val_sections(v, st, cst);
+    if (ends)
+        val_members(v, st, joints, secs, cst, ends, &ends_ok);
+    val_point_masses(v, st, joints, cst);
+    if (ends_ok)
+        val_unused_joints(v, joints, ends);
+    clamp = json_object_get(st, "clamp");
+    if (clamp && json_is_string(clamp) && joints &&
+        json_object_get(joints, json_string_value(clamp)) && ends_ok &&
+        !json_object_get(ends, json_string_value(clamp)))
+        field_error(v, "/structure/clamp", "joint '%s' is not an end of any member",
+                    field_short_name(json_string_value(clamp)).s);
+    field_ref(v, st, "clamp", "/structure", cst, joints, "joint");
+    json_decref(ends);
+    field_set(v, canon, "structure", cst);
+}
+
+/* ----------------------------------------------------- frames, analysis */
+
+/* frames: "single", "per_element", {"per_member": k} or {"elements_per_frame": n}. */
+static void val_frames(val_ctx *v, const json_t *root, json_t *canon)
+{
+    static const char *const keys[] = {"per_member", "elements_per_frame", NULL};
+    const json_t *f = json_object_get(root, "frames");
+    json_t *c;
+    int nk;
+
+    if (!f) {
+        field_set(v, canon, "frames", json_string("per_element"));
+        return;
+    }
+    if (json_is_string(f)) {
+        const char *s = json_string_value(f);
+        if (!strcmp(s, "single") || !strcmp(s, "per_element"))
+            field_set(v, canon, "frames", json_string(s));
+        else
+            field_error(v, "/frames", "unknown frame scheme '%s'; expected \"single\", "
+                        "\"per_element\", {\"per_member\": k} or {\"elements_per_frame\": n}",
+                        field_short_name(s).s);
+        return;
+    }
+    if (!json_is_object(f)) {
+        field_error(v, "/frames", "must be \"single\", \"per_element\", {\"per_member\": k} or "
+                    "{\"elements_per_frame\": n}, not %s", field_type_name(f));
+        return;
+    }
+    field_check_keys(v, f, "/frames", keys, "frames");
+    nk = (json_object_get(f, "per_member") != NULL) +
+         (json_object_get(f, "elements_per_frame") != NULL);
+    if (nk != 1) {
+        field_error(v, "/frames",
+                    "must have exactly one of 'per_member' and 'elements_per_frame'");
+        return;
+    }
+    c = json_object();
+    if (!c) {
+        v->nomem = 1;
+        return;
+    }
+    field_int(v, f, json_object_get(f, "per_member") ? "per_member" : "elements_per_frame",
+              "/frames", c, 1, 0, 1, v->lim->max_elements, NULL, NULL);
+    field_set(v, canon, "frames", c);
+}
+
+/* analysis.omega: a number or a non-empty array of numbers, finite, >= 0. */
+static void val_omega(val_ctx *v, const json_t *an, json_t *can)
+{
+    static const char *base = "/analysis/omega";
+    const json_t *om = json_object_get(an, "omega");
+    json_t *arr, *x;
+    size_t i;
+    double d;
+
+    if (!om) {
+        field_error(v, base, "required field 'omega' (the speed in rad/s, or an array of speeds) "
+                    "is missing");
+        return;
+    }
+    if (json_is_number(om)) {
+        if (field_check_real(v, om, base, FIELD_NONNEG, " (rad/s)", &d))
+            field_set(v, can, "omega", json_real(d));
+        return;
+    }
+    if (!json_is_array(om)) {
+        field_error(v, base, "must be a number (rad/s) or an array of numbers, not %s",
+                    field_type_name(om));
+        return;
+    }
+    if (!val_count(v, base, json_array_size(om), v->lim->max_speeds, "speeds",
+                   "must list at least one speed"))
+        return;
+    arr = json_array();
+    if (!arr) {
+        v->nomem = 1;
+        return;
+    }
+    json_array_foreach(om, i, x) {
+        char *p = err_ptr_idx(base, i);
+        if (!p) {
+            v->nomem = 1;
+            break;
+        }
+        if (field_check_real(v, x, p, FIELD_NONNEG, " (rad/s)", &d) &&
+            json_array_append_new(arr, json_real(d)))
+            v->nomem = 1;
+        free(p);
+    }
+    field_set(v, can, "omega", arr);
+}
+
+/* The analysis object: omega, modes and the options, with their defaults. */
+static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
+{
+    static const char *const keys[] = {"omega", "modes", "geometric_stiffening", "coriolis",
+                                       "mass", "substructure_modes", "modes_per_frame",
+                                       "mode_shapes", NULL};
+    static const char *const mass[] = {"lumped", "consistent", NULL};
+    static const char *const basis[] = {"augmented", "paper", NULL};
+    static const char *base = "/analysis";
+    const json_t *an = field_object(v, root, "analysis", "");
+    const json_t *mpf;
+    json_t *can;
+
+    if (!an)
+        return;
+    field_check_keys(v, an, base, keys, "analysis");
+    can = json_object();
+    if (!can)
+        v->nomem = 1;
+    val_omega(v, an, can);
+    field_int(v, an, "modes", base, can, 0, 3, 1, v->lim->max_modes, "the number of modes",
+              NULL);
+    field_bool(v, an, "geometric_stiffening", base, can, 1);
+    field_bool(v, an, "coriolis", base, can, 1);
+    field_enum(v, an, "mass", base, can, mass, "lumped");
+    field_enum(v, an, "substructure_modes", base, can, basis, "augmented");
+    mpf = json_object_get(an, "modes_per_frame");
+    if (!mpf || (json_is_string(mpf) && !strcmp(json_string_value(mpf), "all")))
+        field_set(v, can, "modes_per_frame", json_string("all"));
+    else if (json_is_number(mpf))
+        field_int(v, an, "modes_per_frame", base, can, 1, 0, 1, 100000, NULL, NULL);
+    else
+        field_error(v, "/analysis/modes_per_frame",
+                    "must be \"all\" or a positive integer, not %s",
+                    json_is_string(mpf) ? "another string" : field_type_name(mpf));
+    field_bool(v, an, "mode_shapes", base, can, 1);
+    field_set(v, canon, "analysis", can);
+}
+
+/*
+ * Size of the mode shapes in the result: speeds x modes x nodes x 3
+ * (x 2 with Coriolis: complex shapes) against max_shape_values.
+ */
+static void val_output_size(val_ctx *v, const json_t *canon)
+{
+    const json_t *an = json_object_get(canon, "analysis");
+    const json_t *om = json_object_get(an, "omega");
+    double speeds = json_is_array(om) ? (double)json_array_size(om) : 1;
+    double modes = (double)json_integer_value(json_object_get(an, "modes"));
+    double nodes = (double)v->total_elements + 1; /* a tree of elements */
+    double values = speeds * modes * nodes * 3 *
+                    (json_is_true(json_object_get(an, "coriolis")) ? 2 : 1);
+
+    if (!json_is_true(json_object_get(an, "mode_shapes")) || !(values > v->lim->max_shape_values))
+        return;
+    field_error(v, "/analysis/mode_shapes",
+                "mode shapes for %.0f speeds x %.0f modes x %.0f nodes "
+                "would be %.0f numbers: the limit is %ld; set mode_shapes to false or ask for "
+                "fewer speeds or modes", speeds, modes, nodes, values, v->lim->max_shape_values);
+}
+
+/* Validate root; returns the canonical request (new) or NULL. */
+static json_t *val_document(val_ctx *v, const json_t *root)
+{
+    static const char *const keys[] = {"structure", "frames", "analysis", NULL};
+    json_t *canon;
+
+    if (!json_is_object(root)) {
+        field_error(v, "", "the request must be a JSON object, not %s", field_type_name(root));
+        return NULL;
+    }
+    field_check_keys(v, root, "", keys, "top-level");
+    canon = json_object();
+    if (!canon) {
+        v->nomem = 1;
+        return NULL;
+    }
+    val_structure(v, root, canon);
+    val_frames(v, root, canon);
+    val_analysis(v, root, canon);
+    if (json_object_get(canon, "analysis") && json_object_get(canon, "structure"))
+        val_output_size(v, canon);
+    return canon;
+}
+
+json_t *val_request(const json_t *root, const codec_limits *lim, codec_errors *errs,
+                    int *nomem)
+{
+    val_ctx v;
+    json_t *canon;
+
+    v.errs = errs;
+    v.lim = lim;
+    v.total_elements = 0;
+    v.nomem = 0;
+    canon = val_document(&v, root);
+    *nomem = v.nomem;
+    return canon;
+}
