@@ -46,33 +46,52 @@
 
 /* ------------------------------------------------------ operational routes */
 
-/* GET /readyz */
+/*
+ * GET /readyz: ready when the database takes a real write (store_health: the
+ * file is still the one opened, a WAL frame can be written), the last write
+ * of a job did not fail, every worker runs and the daemon is not stopping.
+ * checks.database is "ok" or the kind of the failure (store_rc_name:
+ * "full", "readonly", "gone", "corrupt", ...; "write_failed" when the probe
+ * passes but a job's result could not be stored).
+ */
 static enum MHD_Result http_readyz(struct MHD_Connection *c, http_req *r)
 {
     http_hdr retry = {MHD_HTTP_HEADER_RETRY_AFTER, HTTP_RETRY_FAULT};
-    jobs_stats s = {0, 0, 0, 0};
-    int db_ok = store_check_writable(r->h->st) == STORE_OK, stopping = 1;
-    char workers[48];
+    jobs_stats s;
+    int db_rc = store_health(r->h->st), stopping = 1, writes_fail = 0;
+    const char *db = db_rc == STORE_OK ? "ok" : store_rc_name(db_rc);
+    char workers[48], detail[300];
     codec_text b = {0};
 
+    memset(&s, 0, sizeof(s));
     if (http_enter(r->h) == 0) {
         jobs_get_stats(r->h->j, &s);
         stopping = jobs_stopping(r->h->j);
         http_leave(r->h);
+        writes_fail = s.store_failing || s.unrecorded > 0;
     }
+    if (db_rc == STORE_OK && writes_fail)
+        db = "write_failed";
     snprintf(workers, sizeof(workers), "%d/%d", s.workers_alive, s.workers);
-    if (db_ok && !stopping && s.workers_alive == s.workers && s.workers > 0) {
+    if (strcmp(db, "ok") == 0 && !stopping && s.workers_alive == s.workers && s.workers > 0) {
         codec_text_printf(&b, "{\"status\":\"ready\",\"checks\":{\"database\":\"ok\","
-                            "\"workers\":\"%s\"}}", workers);
+                              "\"workers\":\"%s\"}}", workers);
         return http_respond_buf(c, r, MHD_HTTP_OK, "application/json", &b, NULL, 0);
     }
+    if (stopping)
+        snprintf(detail, sizeof(detail), "The daemon is stopping.");
+    else if (db_rc != STORE_OK)
+        snprintf(detail, sizeof(detail), "The database is not writable: %s.",
+                 store_strerror(db_rc));
+    else if (writes_fail)
+        snprintf(detail, sizeof(detail), "The database refused the last write of a job "
+                                         "(full disk or read-only); results are not stored.");
+    else
+        snprintf(detail, sizeof(detail), "A worker thread is gone.");
     codec_text_printf(&b, "{\"type\":\"" HTTP_PROBLEMS "not-ready\",\"title\":\"Service "
-                        "Unavailable\",\"status\":503,\"detail\":\"%s\",",
-                    stopping ? "The daemon is stopping."
-                    : !db_ok ? "The database is not writable."
-                             : "A worker thread is gone.");
-    codec_text_printf(&b, "\"checks\":{\"database\":\"%s\","
-                        "\"workers\":\"%s\"}}", db_ok ? "ok" : "unwritable", workers);
+                          "Unavailable\",\"status\":503,\"detail\":\"%s\",", detail);
+    codec_text_printf(&b, "\"checks\":{\"database\":\"%s\",\"workers\":\"%s\"}}", db,
+                      workers);
     if (stopping)
         retry.value = HTTP_RETRY_BUSY;
     return http_respond_buf(c, r, MHD_HTTP_SERVICE_UNAVAILABLE, "application/problem+json", &b,
@@ -83,7 +102,7 @@ static enum MHD_Result http_readyz(struct MHD_Connection *c, http_req *r)
 static enum MHD_Result http_metrics(struct MHD_Connection *c, http_req *r)
 {
     metrics_gauges g;
-    jobs_stats s = {0, 0, 0, 0};
+    jobs_stats s = {0};
     long long counts[STORE_N_STATES];
     char *text = NULL;
     size_t len = 0;
@@ -97,6 +116,8 @@ static enum MHD_Result http_metrics(struct MHD_Connection *c, http_req *r)
     } else if (counted) {
         s.queued = (int)counts[STORE_QUEUED];
     }
+    if (store_size(r->h->st, &g.store_live_bytes, &g.store_file_bytes) != STORE_OK)
+        g.store_live_bytes = g.store_file_bytes = -1;
     g.queue_depth = s.queued;
     g.workers = s.workers;
     g.workers_busy = s.workers_busy;

@@ -66,6 +66,11 @@ struct jobs {
     unsigned long long gen;
     jobs_slot *slots;          /* cfg.workers */
     jobs_worker *workers;      /* cfg.workers */
+    /* jobs that ended while the store refused every write (full disk, read-only):
+     * they are `running` in the store with no worker; retried until recorded */
+    char (*unrecorded)[65];    /* ids, n_unrecorded of cap_unrecorded */
+    int n_unrecorded, cap_unrecorded;
+    int store_failing;         /* 1 from a failed write to the next successful one */
 };
 
 /* ---------------------------------------------------------------- helpers */
@@ -258,37 +263,140 @@ done:
     codec_errors_free(errs);
 }
 
+/* A write to the store succeeded (rc == STORE_OK) or failed: /readyz follows it. */
+static void jobs_store_health(jobs *j, int rc)
+{
+    if (rc == STORE_NOT_FOUND || rc == STORE_CONFLICT)
+        return; /* the store answered */
+    pthread_mutex_lock(&j->lock);
+    j->store_failing = rc != STORE_OK;
+    pthread_mutex_unlock(&j->lock);
+}
+
+/* Remember id as a job whose end is not recorded yet (see jobs_retry_unrecorded). */
+static void jobs_add_unrecorded(jobs *j, const char *id)
+{
+    int i;
+
+    pthread_mutex_lock(&j->lock);
+    for (i = 0; i < j->n_unrecorded; i++)
+        if (strcmp(j->unrecorded[i], id) == 0)
+            goto done;
+    if (j->n_unrecorded == j->cap_unrecorded) {
+        int ncap = j->cap_unrecorded ? 2 * j->cap_unrecorded : 8;
+        char(*nu)[65] = realloc(j->unrecorded, (size_t)ncap * sizeof(*nu));
+        if (!nu) /* a restart re-queues it (it is `running` in the store) */
+            goto done;
+        j->unrecorded = nu;
+        j->cap_unrecorded = ncap;
+    }
+    memcpy(j->unrecorded[j->n_unrecorded++], id, 65);
+done:
+    pthread_mutex_unlock(&j->lock);
+}
+
+/*
+ * The end of a job could not be written as computed (its result is too big
+ * for a full disk, or the store refused the write): store it as failed with
+ * the reason and no result; if even that fails, put it back to the queue;
+ * if that fails too, keep it in memory and retry (jobs_retry_unrecorded).
+ * Never leaves a job `running` without a worker.  Returns the state stored,
+ * or STORE_RUNNING when nothing could be stored.
+ */
+static store_state jobs_record_fallback(jobs *j, const char *id, int why)
+{
+    char detail[256], *err;
+    int rc;
+
+    snprintf(detail, sizeof(detail),
+             "the analysis ended but its result could not be stored (%s); it is not kept: "
+             "submit the request again once the database accepts writes",
+             store_strerror(why));
+    err = codec_job_error_text("store_error", "Result not stored", detail, NULL, NULL);
+    rc = err ? store_finish(j->st, id, STORE_FAILED, log_now(), 0, err, NULL, 0, NULL, 0)
+             : STORE_NOMEM;
+    free(err);
+    jobs_store_health(j, rc);
+    if (rc == STORE_OK || rc == STORE_CONFLICT || rc == STORE_NOT_FOUND)
+        return STORE_FAILED;
+    rc = store_requeue(j->st, id);
+    jobs_store_health(j, rc);
+    if (rc == STORE_OK) {
+        pthread_mutex_lock(&j->lock);
+        j->queued++;
+        pthread_mutex_unlock(&j->lock);
+        return STORE_QUEUED;
+    }
+    jobs_add_unrecorded(j, id);
+    return STORE_RUNNING;
+}
+
+/* Try again to record the jobs whose end no write could store yet. */
+static void jobs_retry_unrecorded(jobs *j)
+{
+    char id[65];
+    store_state st;
+
+    for (;;) {
+        pthread_mutex_lock(&j->lock);
+        if (j->n_unrecorded == 0) {
+            pthread_mutex_unlock(&j->lock);
+            return;
+        }
+        memcpy(id, j->unrecorded[--j->n_unrecorded], sizeof(id));
+        pthread_mutex_unlock(&j->lock);
+        st = jobs_record_fallback(j, id, STORE_ERROR);
+        log_event(st == STORE_RUNNING ? "error" : "warn", "job_recorded_late", "job", id,
+                  "state", st == STORE_RUNNING ? "still unrecorded" : store_state_name(st),
+                  (char *)NULL);
+        if (st == STORE_RUNNING)
+            return; /* the store still refuses: the next loop tries again */
+        jobs_bump(j);
+    }
+}
+
 /* Record rec in the store, count and log it. */
 static void jobs_record(jobs *j, const store_job *job, const jobs_outcome_rec *rec)
 {
     char secs[32], speeds[32];
+    store_state kept = rec->state;
     int rc;
 
     snprintf(secs, sizeof(secs), "%.3f", rec->solve_seconds < 0 ? 0.0 : rec->solve_seconds);
     snprintf(speeds, sizeof(speeds), "%d/%d", rec->speeds_done, job->speeds_total);
     if (rec->state == STORE_QUEUED) {
         rc = store_requeue(j->st, job->id);
+        jobs_store_health(j, rc);
         if (rc == STORE_OK) {
             pthread_mutex_lock(&j->lock);
             j->queued++;
             pthread_mutex_unlock(&j->lock);
+        } else if (rc != STORE_CONFLICT && rc != STORE_NOT_FOUND) {
+            jobs_add_unrecorded(j, job->id);
         }
         log_event(rc == STORE_OK ? "info" : "error", "job_requeued", "job", job->id, "speeds",
-                  speeds, "reason", "shutdown", "store", rc == STORE_OK ? NULL : "failed",
+                  speeds, "reason", "shutdown", "store", rc == STORE_OK ? NULL : store_strerror(rc),
                   (char *)NULL);
         return;
     }
     rc = store_finish(j->st, job->id, rec->state, log_now(), rec->speeds_done, rec->error,
                       rec->result, rec->result ? strlen(rec->result) : 0, rec->csv, rec->csv_len);
+    jobs_store_health(j, rc);
+    if (rc != STORE_OK && rc != STORE_CONFLICT && rc != STORE_NOT_FOUND)
+        kept = jobs_record_fallback(j, job->id, rc);
     if (rec->solve_seconds >= 0 && rec->state != STORE_CANCELED)
         metrics_solve_seconds(j->mx, rec->solve_seconds);
-    metrics_job_finished(j->mx, rec->state);
+    if (kept != STORE_QUEUED && kept != STORE_RUNNING)
+        metrics_job_finished(j->mx, kept);
     log_event(rc == STORE_OK ? "info" : "error",
               rec->state == STORE_DONE     ? "job_done"
               : rec->state == STORE_FAILED ? "job_failed"
                                            : "job_canceled",
               "job", job->id, "state", store_state_name(rec->state), "speeds", speeds, "seconds",
-              secs, "attempts", NULL, "store", rc == STORE_OK ? NULL : "finish failed",
+              secs, "attempts", NULL, "store",
+              rc == STORE_OK ? NULL : store_strerror(rc), "stored_as",
+              rc == STORE_OK ? NULL : kept == STORE_RUNNING ? "nothing yet (retried)"
+                                                            : store_state_name(kept),
               (char *)NULL);
 }
 
@@ -317,6 +425,7 @@ static int jobs_claim(jobs *j, jobs_slot *slot, store_job *job)
     pthread_mutex_unlock(&j->claim_lock);
     if (rc != STORE_OK && rc != STORE_NOT_FOUND) {
         log_event("error", "store_error", "op", "claim", (char *)NULL);
+        jobs_store_health(j, rc);
         return -1;
     }
     return rc == STORE_OK;
@@ -370,6 +479,7 @@ static void *jobs_worker_main(void *arg)
             break;
         }
         pthread_mutex_unlock(&j->lock);
+        jobs_retry_unrecorded(j);
         got = jobs_claim(j, slot, &job);
         if (got < 0) {
             until = jobs_deadline(1.0);
@@ -419,6 +529,7 @@ static void jobs_free(jobs *j)
     pthread_mutex_destroy(&j->lock);
     free(j->slots);
     free(j->workers);
+    free(j->unrecorded);
     free(j);
 }
 
@@ -659,5 +770,7 @@ void jobs_get_stats(jobs *j, jobs_stats *s)
     s->workers = j->cfg.workers;
     s->workers_alive = j->alive;
     s->workers_busy = j->busy;
+    s->store_failing = j->store_failing;
+    s->unrecorded = j->n_unrecorded;
     pthread_mutex_unlock(&j->lock);
 }

@@ -105,6 +105,8 @@ typedef struct jobs_stats {
     int workers;            /* configured */
     int workers_alive;      /* threads running their loop */
     int workers_busy;       /* threads running a job */
+    int store_failing;      /* 1 while the last write to the store failed (full disk, read-only) */
+    int unrecorded;         /* finished jobs whose end the store has not taken yet */
 } jobs_stats;
 
 /** Fill *s. */

@@ -19,6 +19,7 @@
 #include <getopt.h>
 #include <limits.h>
 #include <math.h>
+#include <poll.h>
 #include <pthread.h>
 #include <signal.h>
 #include <stdio.h>
@@ -40,6 +41,7 @@
 enum { EXIT_START = 1, EXIT_USAGE = 64 };
 
 #define MAIN_TOKEN_MAX 4096   /* bytes of a token file */
+#define MAIN_PRUNE_EVERY_MS (10 * 60 * 1000) /* retention runs at start and then this often */
 
 /* The flags, in --help order. */
 enum {
@@ -56,6 +58,8 @@ enum {
     F_CORS_ORIGIN,
     F_MAX_CONNECTIONS_PER_CLIENT,
     F_REQUEST_DEADLINE,
+    F_RETAIN_AGE,
+    F_RETAIN_BYTES,
     F_SHUTDOWN_GRACE,
     F_LOG_FORMAT,
     F_N
@@ -89,6 +93,10 @@ static const main_flag main_flags[F_N] = {
      "open connections from one IP address (0 = no limit; behind a proxy raise it)"},
     {"request-deadline", "SPINMODAL_REQUEST_DEADLINE", "S", "30",
      "seconds for a request's head and body to arrive, however slowly sent"},
+    {"retain-age", "SPINMODAL_RETAIN_AGE", "S", "2592000 (30 days)",
+     "finished jobs older than this are removed (0 = keep by age)"},
+    {"retain-bytes", "SPINMODAL_RETAIN_BYTES", "BYTES", "1073741824 (1 GiB)",
+     "oldest finished jobs are removed above this much live data (0 = no bound)"},
     {"shutdown-grace", "SPINMODAL_SHUTDOWN_GRACE", "S", "10",
      "seconds running jobs get to finish on SIGTERM"},
     {"log-format", "SPINMODAL_LOG_FORMAT", "text|json", "text", "log lines on stderr"},
@@ -103,6 +111,8 @@ typedef struct main_opts {
     long workers, queue_max, max_body, max_elements, max_speeds;
     double job_timeout;      /* s, > 0 */
     double shutdown_grace;   /* s, >= 0 */
+    double retain_age;       /* s, 0 = no age bound */
+    long long retain_bytes;  /* bytes, 0 = no size bound */
     const char *token_file;  /* NULL = no auth */
     int auth_reads;          /* 1: reads need the token too */
     const char *cors_origin; /* NULL = no CORS */
@@ -286,6 +296,17 @@ static int main_set(main_opts *o, int f, const char *v, const char **want)
     case F_REQUEST_DEADLINE:
         *want = "a number of seconds from 1 to 3600";
         return main_seconds(v, 1.0, 3600.0, &o->request_deadline);
+    case F_RETAIN_AGE:
+        *want = "a number of seconds from 0 (keep) to 3153600000 (100 years)";
+        return main_seconds(v, 0.0, 3153600000.0, &o->retain_age);
+    case F_RETAIN_BYTES: {
+        long b = 0;
+        *want = "a number of bytes from 0 (no bound) to 1099511627776 (1 TiB)";
+        if (main_long(v, 0, 1099511627776L, &b))
+            return -1;
+        o->retain_bytes = b;
+        return 0;
+    }
     case F_SHUTDOWN_GRACE:
         *want = "a number of seconds from 0 to 3600";
         return main_seconds(v, 0.0, 3600.0, &o->shutdown_grace);
@@ -315,6 +336,8 @@ static void main_defaults(main_opts *o)
     o->per_client = 64;
     o->request_deadline = 30.0;
     o->shutdown_grace = 10.0;
+    o->retain_age = 2592000.0;
+    o->retain_bytes = 1073741824LL;
     o->format = LOG_TEXT;
 }
 
@@ -469,24 +492,67 @@ static void main_fail(const char *what, const char *detail)
 }
 
 /* Open the store and the metrics; 0 or EXIT_START. */
+/*
+ * The store's error callback (on the failing thread, at the failure): log
+ * the kind and SQLite's own text, count it by kind.  Never calls the store.
+ */
+static void main_store_error(void *ctx, const store_error *e)
+{
+    char code[16];
+
+    snprintf(code, sizeof(code), "%d", e->backend_rc);
+    log_event("error", "store_error", "op", e->op, "kind", store_rc_name(e->rc), "code", code,
+              "detail", e->text, (const char *)NULL);
+    metrics_store_error(ctx, e->rc);
+}
+
 static int main_open(const main_opts *o, main_daemon *d)
 {
+    store_settings set;
     char err[512], n[32];
-    int requeued = 0;
+    int requeued = 0, rc;
 
-    err[0] = '\0';
-    if (store_open(&d->st, o->db, &requeued, err, sizeof(err)) != STORE_OK) {
-        main_fail("cannot open the database", err[0] ? err : o->db);
-        return EXIT_START;
-    }
-    snprintf(n, sizeof(n), "%d", requeued);
-    log_event("info", "recovered", "jobs", n, "db", o->db, (const char *)NULL);
     d->mx = metrics_new();
     if (!d->mx) {
         main_fail("out of memory", NULL);
         return EXIT_START;
     }
+    err[0] = '\0';
+    store_default_settings(&set);
+    set.path = o->db;
+    set.on_error = main_store_error;
+    set.on_error_ctx = d->mx;
+    rc = store_open_with(&d->st, &set, &requeued, err, sizeof(err));
+    if (rc != STORE_OK) {
+        log_event("error", "store_open_failed", "kind", store_rc_name(rc), "db", o->db,
+                  "detail", err[0] ? err : store_strerror(rc), (const char *)NULL);
+        main_fail("cannot open the database", err[0] ? err : o->db);
+        return EXIT_START;
+    }
+    snprintf(n, sizeof(n), "%d", requeued);
+    log_event("info", "recovered", "jobs", n, "db", o->db, (const char *)NULL);
     return 0;
+}
+
+/*
+ * Retention: remove the oldest finished jobs beyond --retain-age and
+ * --retain-bytes (queued and running jobs are never removed); count and log.
+ */
+static void main_prune(const main_opts *o, main_daemon *d)
+{
+    long long removed = 0;
+    char n[32];
+    int rc;
+
+    if (o->retain_age <= 0.0 && o->retain_bytes <= 0)
+        return;
+    rc = store_prune(d->st, log_now(), o->retain_age, o->retain_bytes, &removed);
+    metrics_store_pruned(d->mx, removed);
+    if (removed > 0 || rc != STORE_OK) {
+        snprintf(n, sizeof(n), "%lld", removed);
+        log_event(rc == STORE_OK ? "info" : "error", "store_pruned", "jobs", n, "store",
+                  rc == STORE_OK ? NULL : store_rc_name(rc), (const char *)NULL);
+    }
 }
 
 /* Start the pool and the HTTP server; 0 or EXIT_START. */
@@ -602,12 +668,25 @@ static int main_signals(int fds[2], sigset_t *set)
 }
 
 /* Wait for SIGTERM/SIGINT (a byte on the self-pipe); returns the signal. */
-static int main_wait_signal(int fd, const sigset_t *set)
+static int main_wait_signal(int fd, const sigset_t *set, const main_opts *o, main_daemon *d)
 {
+    struct pollfd p = {fd, POLLIN, 0};
     unsigned char b = 0;
     ssize_t n;
+    int ready;
 
     pthread_sigmask(SIG_UNBLOCK, set, NULL);
+    main_prune(o, d);
+    for (;;) {
+        ready = poll(&p, 1, MAIN_PRUNE_EVERY_MS);
+        if (ready == 0) {
+            main_prune(o, d);
+            continue;
+        }
+        if (ready < 0 && errno == EINTR)
+            continue;
+        break;
+    }
     do
         n = read(fd, &b, 1);
     while (n < 0 && errno == EINTR);
@@ -657,7 +736,7 @@ int main(int argc, char **argv)
         main_close_pipe(fds);
         return rc;
     }
-    sig = main_wait_signal(fds[0], &set);
+    sig = main_wait_signal(fds[0], &set, &o, &d);
     http_begin_stop(d.h); /* refuse first, then say so: a client that reads the log sees 503 */
     log_event("info", "stopping", "signal", sig == SIGINT ? "SIGINT" : "SIGTERM",
               (const char *)NULL);

@@ -38,6 +38,8 @@ struct metrics {
     unsigned long long solve_count;
     unsigned long long cache_hits, cache_misses;
     unsigned long long deadline_closed; /* connections closed by the request deadline */
+    unsigned long long store_errors[-STORE_RC_MIN + 1]; /* failures by -store_rc */
+    unsigned long long store_pruned;    /* finished jobs removed by retention */
     unsigned long long finished[STORE_N_STATES];
 };
 
@@ -135,6 +137,22 @@ void metrics_deadline_closed(metrics *m, int n)
     pthread_mutex_unlock(&m->lock);
 }
 
+void metrics_store_error(metrics *m, int rc)
+{
+    if (rc > 0 || rc < STORE_RC_MIN)
+        rc = STORE_ERROR;
+    pthread_mutex_lock(&m->lock);
+    m->store_errors[-rc]++;
+    pthread_mutex_unlock(&m->lock);
+}
+
+void metrics_store_pruned(metrics *m, long long n)
+{
+    pthread_mutex_lock(&m->lock);
+    m->store_pruned += (unsigned long long)(n > 0 ? n : 0);
+    pthread_mutex_unlock(&m->lock);
+}
+
 void metrics_job_finished(metrics *m, store_state s)
 {
     if ((int)s < 0 || s >= STORE_N_STATES)
@@ -224,6 +242,18 @@ static void metrics_render_locked(const metrics *m, metrics_buf *b)
                       "# TYPE spinmodal_http_deadline_closed_total counter\n"
                       "spinmodal_http_deadline_closed_total %llu\n",
                    m->deadline_closed);
+    metrics_printf(b, "# HELP spinmodal_store_errors_total Failures of the job store, by kind "
+                      "(full, busy, corrupt, readonly, ioerr, gone, ...).\n"
+                      "# TYPE spinmodal_store_errors_total counter\n");
+    for (i = 1; i <= -STORE_RC_MIN; i++)
+        if (store_is_db_error(-i) || -i == STORE_NOMEM)
+            metrics_printf(b, "spinmodal_store_errors_total{kind=\"%s\"} %llu\n",
+                           store_rc_name(-i), m->store_errors[i]);
+    metrics_printf(b, "# HELP spinmodal_store_pruned_jobs_total Finished jobs removed by the "
+                      "retention policy (--retain-age, --retain-bytes).\n"
+                      "# TYPE spinmodal_store_pruned_jobs_total counter\n"
+                      "spinmodal_store_pruned_jobs_total %llu\n",
+                   m->store_pruned);
     metrics_printf(b, "# HELP spinmodal_jobs_finished_total Jobs that ended, by final state.\n"
                       "# TYPE spinmodal_jobs_finished_total counter\n");
     for (i = STORE_DONE; i < STORE_N_STATES; i++)
@@ -261,6 +291,14 @@ int metrics_render(metrics *m, const metrics_gauges *g, char **out, size_t *len)
                        "# TYPE spinmodal_workers_busy gauge\n"
                        "spinmodal_workers_busy %d\n",
                    g->queue_depth, g->workers, g->workers_busy);
+    if (g->store_live_bytes >= 0)
+        metrics_printf(&b, "# HELP spinmodal_store_live_bytes Bytes of live data in the database.\n"
+                           "# TYPE spinmodal_store_live_bytes gauge\n"
+                           "spinmodal_store_live_bytes %lld\n"
+                           "# HELP spinmodal_store_file_bytes Bytes of the database files on disk.\n"
+                           "# TYPE spinmodal_store_file_bytes gauge\n"
+                           "spinmodal_store_file_bytes %lld\n",
+                       g->store_live_bytes, g->store_file_bytes);
     if (b.failed) {
         free(b.s);
         return -1;

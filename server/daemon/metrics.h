@@ -41,6 +41,12 @@ void metrics_cache(metrics *m, int hit);
 /** Count n connections closed because their request missed --request-deadline. */
 void metrics_deadline_closed(metrics *m, int n);
 
+/** Count one failure of the store, by kind (store_rc_name: "full", "busy", "corrupt" ...). */
+void metrics_store_error(metrics *m, int rc);
+
+/** Count n finished jobs removed by the retention policy. */
+void metrics_store_pruned(metrics *m, long long n);
+
 /** Count a job that ended in state s (done, failed or canceled). */
 void metrics_job_finished(metrics *m, store_state s);
 
@@ -50,6 +56,8 @@ typedef struct metrics_gauges {
     int queue_depth;
     int workers;
     int workers_busy;
+    long long store_live_bytes;     /* bytes of live data in the database, -1 when unknown */
+    long long store_file_bytes;     /* bytes of the database files, -1 when unknown */
 } metrics_gauges;
 
 /**

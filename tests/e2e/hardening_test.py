@@ -202,7 +202,7 @@ def scenario_cors(exe, tmp):
 
 
 def main():
-    exe, name = sys.argv[1], sys.argv[2]
+    exe, name = os.path.abspath(sys.argv[1]), sys.argv[2]
     timescale.calibrate(exe)
     with tempfile.TemporaryDirectory(prefix="spinmodal-hardening-") as tmp:
         globals()["scenario_" + name](exe, tmp)
