@@ -43,6 +43,11 @@ typedef struct codec_limits {
     int max_modes;            /* analysis.modes, default 200 */
     long max_shape_values;    /* numbers in the mode shapes of a result (speeds x modes x
                                  nodes x 3, x 2 with Coriolis), default 4e6 (~90 MB JSON) */
+    int max_coordinates;      /* modal coordinates of the model (the size of the dense Newton
+                                 and eigen problems: cost ~ n^3), default 4000 */
+    int max_frame_dofs;       /* degrees of freedom of one substructure's component-mode
+                                 problem (3 x its free nodes; cost ~ dofs^3 each), default 1200
+                                 (~3 s on one core) */
 } codec_limits;
 
 /** Fill *lim with the default limits listed in codec_limits. */
@@ -123,6 +128,13 @@ void codec_request_free(codec_request *r);
 
 /** The structure for sm_model_new; borrowed from r. */
 const sm_structure *codec_request_structure(const codec_request *r);
+
+/**
+ * The sizes the model of r will have (nodes, elements, frames, coordinates,
+ * largest frame), from the core's structure check run at validation (no
+ * model is built to know them); borrowed from r.
+ */
+const sm_model_info *codec_request_model_info(const codec_request *r);
 
 /** The options for sm_model_new; borrowed from r. */
 const sm_options *codec_request_options(const codec_request *r);

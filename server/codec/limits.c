@@ -20,4 +20,6 @@ void codec_default_limits(codec_limits *lim)
     lim->max_speeds = 1001;
     lim->max_modes = 200;
     lim->max_shape_values = 4000000;
+    lim->max_coordinates = 4000;
+    lim->max_frame_dofs = 1200;
 }

@@ -35,6 +35,7 @@ struct codec_request {
     int n_speeds;
     sm_structure st;            /* points into the arrays above */
     sm_options opt;             /* from the analysis and frames fields */
+    sm_model_info info;         /* sizes of its model (sm_structure_check) */
 };
 
 /* qsort/bsearch order of two (const char *) elements. */
@@ -206,6 +207,43 @@ int codec_sha256_hex(const void *data, size_t len, char hex[65])
     return SM_OK;
 }
 
+/*
+ * The checks that need the model's topology and sizes, without building it
+ * (sm_structure_check is linear in the size): a tree rooted at the clamp,
+ * then the cost bounds of lim (a 422 that says what to change).  Returns
+ * SM_OK, SM_INVALID_INPUT (errs filled) or SM_NOMEM.
+ */
+static int req_check_model(codec_request *r, const codec_limits *lim, codec_errors *errs)
+{
+    sm_diag d;
+    int st = sm_structure_check(&r->st, &r->opt, &r->info, &d), dofs;
+
+    if (st == SM_INVALID_INPUT)
+        return codec_diag_error(r, &d, errs) == SM_NOMEM ? SM_NOMEM : SM_INVALID_INPUT;
+    if (st != SM_OK)
+        return st;
+    dofs = 3 * r->info.max_frame_nodes;
+    if (dofs > lim->max_frame_dofs &&
+        codec_errors_add(errs, "/frames",
+                         "one reference frame would carry %d degrees of freedom (%d FE nodes), "
+                         "more than the limit of %d: its component modes cost ~dofs^3; use more "
+                         "frames (\"per_element\", or {\"elements_per_frame\": n} with n up to "
+                         "%d)",
+                         dofs, r->info.max_frame_nodes, lim->max_frame_dofs,
+                         lim->max_frame_dofs / 3) == SM_NOMEM)
+        return SM_NOMEM;
+    if (r->info.coordinates > lim->max_coordinates &&
+        codec_errors_add(errs, "/structure",
+                         "the model would have %d modal coordinates, more than the limit of %d "
+                         "(the dense Newton and eigen problems cost ~n^3): use fewer elements, "
+                         "or fewer frames with \"modes_per_frame\"",
+                         r->info.coordinates, lim->max_coordinates) == SM_NOMEM)
+        return SM_NOMEM;
+    return dofs > lim->max_frame_dofs || r->info.coordinates > lim->max_coordinates
+               ? SM_INVALID_INPUT
+               : SM_OK;
+}
+
 int codec_request_from_json(codec_request **out, const json_t *root,
                             const codec_limits *lim, codec_errors *errs)
 {
@@ -236,7 +274,7 @@ int codec_request_from_json(codec_request **out, const json_t *root,
         goto fail;
     if ((rc = codec_sha256_hex(r->canon_text, strlen(r->canon_text), r->sha)) ||
         (rc = req_build_tables(r)) || (rc = req_build_structure(r)) ||
-        (rc = req_build_options(r)))
+        (rc = req_build_options(r)) || (rc = req_check_model(r, lim, errs)))
         goto fail;
     *out = r;
     return SM_OK;
@@ -303,6 +341,11 @@ void codec_request_free(codec_request *r)
 const sm_structure *codec_request_structure(const codec_request *r)
 {
     return &r->st;
+}
+
+const sm_model_info *codec_request_model_info(const codec_request *r)
+{
+    return &r->info;
 }
 
 const sm_options *codec_request_options(const codec_request *r)

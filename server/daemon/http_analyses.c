@@ -388,31 +388,6 @@ static enum MHD_Result http_validated(struct MHD_Connection *c, http_req *r,
     return http_respond_buf(c, r, MHD_HTTP_OK, "application/json", &b, NULL, 0);
 }
 
-/*
- * Topology checks of the core (cycles, disconnected members …) that the
- * codec alone does not see: build the model and drop it.  Skipped for a
- * POST of a job the store already holds (it passed them when submitted).
- * Returns an sm_status; errs is filled on failure.
- */
-static int http_check_model(http_req *r, const codec_request *req, codec_errors *errs)
-{
-    sm_model *m = NULL;
-    store_job jb;
-    char id[65];
-    int st, known = 0;
-
-    memset(&jb, 0, sizeof(jb));
-    if (r->route == R_ANALYSES && codec_job_id(req, id) == SM_OK &&
-        http_job_read(r->h, id, 0, &jb) == JOBS_OK)
-        known = jb.state != STORE_FAILED && jb.state != STORE_CANCELED;
-    store_job_clear(&jb);
-    if (known)
-        return SM_OK;
-    st = codec_model_new(&m, req, errs, NULL);
-    sm_model_free(m);
-    return st;
-}
-
 /* The whole body of a POST is in: validate, then submit or describe, answer. */
 enum MHD_Result http_post_end(struct MHD_Connection *c, http_req *r)
 {
@@ -431,8 +406,6 @@ enum MHD_Result http_post_end(struct MHD_Connection *c, http_req *r)
     rc = codec_request_parse(&req, r->body ? r->body : "", r->len, &r->h->limits, errs);
     free(r->body);
     r->body = NULL;
-    if (rc == SM_OK)
-        rc = http_check_model(r, req, errs);
     if (rc == SM_OK && r->route == R_VALIDATE)
         q = http_validated(c, r, req);
     else if (rc == SM_OK)

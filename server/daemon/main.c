@@ -52,6 +52,8 @@ enum {
     F_MAX_BODY,
     F_MAX_ELEMENTS,
     F_MAX_SPEEDS,
+    F_MAX_COORDINATES,
+    F_MAX_FRAME_DOFS,
     F_JOB_TIMEOUT,
     F_TOKEN_FILE,
     F_AUTH_READS,
@@ -82,6 +84,10 @@ static const main_flag main_flags[F_N] = {
     {"max-body", "SPINMODAL_MAX_BODY", "BYTES", "1048576", "largest request body (413 above)"},
     {"max-elements", "SPINMODAL_MAX_ELEMENTS", "N", "2000", "most finite elements of a request"},
     {"max-speeds", "SPINMODAL_MAX_SPEEDS", "N", "1001", "most speeds of a request"},
+    {"max-coordinates", "SPINMODAL_MAX_COORDINATES", "N", "4000",
+     "most modal coordinates of a model (dense Newton and eigen problems, cost ~n^3)"},
+    {"max-frame-dofs", "SPINMODAL_MAX_FRAME_DOFS", "N", "1200",
+     "most degrees of freedom in one frame's component-mode problem (cost ~n^3)"},
     {"job-timeout", "SPINMODAL_JOB_TIMEOUT", "S", "300", "seconds of solving before a job fails"},
     {"token-file", "SPINMODAL_TOKEN_FILE", "PATH", "none (no auth)",
      "file holding the bearer token POST and DELETE need"},
@@ -108,7 +114,7 @@ typedef struct main_opts {
     int port;                /* 0..65535 */
     int ipv6;                /* host was given in [brackets] */
     const char *db;
-    long workers, queue_max, max_body, max_elements, max_speeds;
+    long workers, queue_max, max_body, max_elements, max_speeds, max_coordinates, max_frame_dofs;
     double job_timeout;      /* s, > 0 */
     double shutdown_grace;   /* s, >= 0 */
     double retain_age;       /* s, 0 = no age bound */
@@ -272,6 +278,12 @@ static int main_set(main_opts *o, int f, const char *v, const char **want)
     case F_MAX_SPEEDS:
         *want = "an integer from 1 to 100000";
         return main_long(v, 1, 100000, &o->max_speeds);
+    case F_MAX_COORDINATES:
+        *want = "an integer from 1 to 1000000";
+        return main_long(v, 1, 1000000, &o->max_coordinates);
+    case F_MAX_FRAME_DOFS:
+        *want = "an integer from 3 to 1000000";
+        return main_long(v, 3, 1000000, &o->max_frame_dofs);
     case F_JOB_TIMEOUT:
         *want = "a number of seconds greater than 0 (at most 1000000)";
         return main_seconds(v, 1e-3, 1e6, &o->job_timeout);
@@ -332,6 +344,8 @@ static void main_defaults(main_opts *o)
     o->max_body = 1048576;
     o->max_elements = 2000;
     o->max_speeds = 1001;
+    o->max_coordinates = 4000;
+    o->max_frame_dofs = 1200;
     o->job_timeout = 300.0;
     o->per_client = 64;
     o->request_deadline = 30.0;
@@ -570,6 +584,8 @@ static int main_serve(const main_opts *o, const char *token, main_daemon *d)
     hc.limits.max_request_bytes = (size_t)o->max_body;
     hc.limits.max_elements = (int)o->max_elements;
     hc.limits.max_speeds = (int)o->max_speeds;
+    hc.limits.max_coordinates = (int)o->max_coordinates;
+    hc.limits.max_frame_dofs = (int)o->max_frame_dofs;
     hc.token = token;
     hc.auth_reads = o->auth_reads;
     hc.cors_origin = o->cors_origin;

@@ -15,6 +15,11 @@ holds; none decides a pass by elapsed time.
   auth_reads    with --auth-reads yes, reading jobs, /metrics and POST
                 /v1/validate need the token; probes and static files do not;
                 without a token file the flag is refused.
+  cost_bound    the 314-byte request that took 13 minutes and 330 MB on the HTTP
+                thread (one frame over a 2000-element member) is a 422 naming
+                /frames, for POST /v1/validate and /v1/analyses, ten times over;
+                the daemon answers /livez meanwhile and builds no model (its
+                memory stays small); a cycle is still a 422 at POST.
   cors          --cors-origin accepts one exact origin only ('*', lists and
                 paths are refused at start); OPTIONS answers 204 on a route and
                 404 on an unknown path.
@@ -182,6 +187,51 @@ def scenario_auth_reads(exe, tmp):
     r = d2.get("/v1/analyses")
     check(r.status == 200, "without --auth-reads a read needs no token (%s)" % r.status)
     check(d2.stop() == 0, "second daemon stops cleanly")
+
+
+def rss_kb(pid):
+    with open("/proc/%d/status" % pid) as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1])
+    return -1
+
+
+def scenario_cost_bound(exe, tmp):
+    hostile = (b'{"structure":{"joints":{"O":[0,0],"T":[50,0]},"sections":{"s":{"E":7e10,'
+               b'"A":4e-4,"I":2e-7,"mass_per_length":1.2}},"members":[{"id":"m","from":"O",'
+               b'"to":"T","section":"s","elements":2000}],"clamp":"O"},"frames":"single",'
+               b'"analysis":{"omega":[0,5,10]}}')
+    js = {"Content-Type": "application/json"}
+    d = Daemon(exe, tmp, ["--workers", "1"])
+    d.start()
+    before = rss_kb(d.proc.pid)
+    for i in range(10):
+        for path in ("/v1/validate", "/v1/analyses"):
+            r = d.request("POST", path, body=hostile, headers=js)
+            ptrs = [e.get("pointer") for e in (r.json() or {}).get("errors", [])] \
+                if r.status == 422 else []
+            check(r.status == 422 and "/frames" in ptrs,
+                  "POST %s #%d of the single-frame 2000-element request: 422 at /frames (%s %s)"
+                  % (path, i + 1, r.status, ptrs))
+    r = d.get("/livez")
+    check(r.status == 200, "/livez answers")
+    after = rss_kb(d.proc.pid)
+    check(after - before < 100 * 1024,
+          "no model was built: RSS grew %d KB (< 100 MB; a build of this model takes ~330 MB)"
+          % (after - before))
+    r = d.get("/v1/analyses")
+    items = r.json().get("items", []) if r.status == 200 else None
+    check(items == [], "nothing was queued (%r)" % (None if items is None else len(items)))
+    cycle = (b'{"structure":{"joints":{"O":[0,0],"C":[1,0],"P":[1,1]},"sections":{"s":{"E":7e10,'
+             b'"A":4e-4,"I":2e-7,"mass_per_length":1.2}},"members":[{"id":"a","from":"O","to":"C",'
+             b'"section":"s","elements":2},{"id":"b","from":"C","to":"P","section":"s",'
+             b'"elements":2},{"id":"c","from":"P","to":"O","section":"s","elements":2}],'
+             b'"clamp":"O"},"analysis":{"omega":1}}')
+    r = d.request("POST", "/v1/analyses", body=cycle, headers=js)
+    check(r.status == 422 and b"/structure/members/" in r.body,
+          "a cycle is a 422 at POST naming a member (%s)" % r.status)
+    check(d.stop() == 0, "daemon stops cleanly")
 
 
 def scenario_cors(exe, tmp):
