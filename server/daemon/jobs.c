@@ -35,6 +35,7 @@ extern void openblas_set_num_threads(int n) __attribute__((weak));
 
 #define JOBS_MAX_ATTEMPTS 3   /* claims before a job that keeps dying is failed */
 #define JOBS_IDLE_POLL 5.0    /* s between store polls of an idle worker */
+#define JOBS_STORE_FAIL_MEMORY 30.0 /* s a failed write keeps /readyz false without a newer one */
 
 typedef struct jobs_slot {
     char id[65];          /* running job, "" when idle */
@@ -70,7 +71,7 @@ struct jobs {
      * they are `running` in the store with no worker; retried until recorded */
     char (*unrecorded)[65];    /* ids, n_unrecorded of cap_unrecorded */
     int n_unrecorded, cap_unrecorded;
-    int store_failing;         /* 1 from a failed write to the next successful one */
+    double store_failed_at;    /* log_now() of the last failed write, 0 after a successful one */
 };
 
 /* ---------------------------------------------------------------- helpers */
@@ -269,7 +270,7 @@ static void jobs_store_health(jobs *j, int rc)
     if (rc == STORE_NOT_FOUND || rc == STORE_CONFLICT)
         return; /* the store answered */
     pthread_mutex_lock(&j->lock);
-    j->store_failing = rc != STORE_OK;
+    j->store_failed_at = rc == STORE_OK ? 0.0 : log_now();
     pthread_mutex_unlock(&j->lock);
 }
 
@@ -770,7 +771,8 @@ void jobs_get_stats(jobs *j, jobs_stats *s)
     s->workers = j->cfg.workers;
     s->workers_alive = j->alive;
     s->workers_busy = j->busy;
-    s->store_failing = j->store_failing;
+    s->store_failing = j->store_failed_at > 0.0 &&
+                       log_now() - j->store_failed_at < JOBS_STORE_FAIL_MEMORY;
     s->unrecorded = j->n_unrecorded;
     pthread_mutex_unlock(&j->lock);
 }

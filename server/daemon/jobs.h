@@ -105,7 +105,8 @@ typedef struct jobs_stats {
     int workers;            /* configured */
     int workers_alive;      /* threads running their loop */
     int workers_busy;       /* threads running a job */
-    int store_failing;      /* 1 while the last write to the store failed (full disk, read-only) */
+    int store_failing;      /* 1 when a write to the store failed (full disk, read-only) in the
+                               last 30 s and none succeeded since */
     int unrecorded;         /* finished jobs whose end the store has not taken yet */
 } jobs_stats;
 

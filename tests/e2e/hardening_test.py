@@ -20,6 +20,15 @@ holds; none decides a pass by elapsed time.
                 /frames, for POST /v1/validate and /v1/analyses, ten times over;
                 the daemon answers /livez meanwhile and builds no model (its
                 memory stays small); a cycle is still a 422 at POST.
+  full_disk     the database on a 3 MB tmpfs (skipped when this process may not
+                mount): a job whose result does not fit is never left running
+                without a worker (failed with error type store_error, or back in
+                the queue); /readyz says the database is not writable; once space
+                is freed /readyz recovers and the same request completes.
+  db_faults     a second daemon on the same database refuses to start (the
+                first keeps working); a corrupt database refuses to start
+                naming the corruption; deleting the database under a running
+                daemon makes /readyz 503 ("gone") and POST 503, not silence.
   cors          --cors-origin accepts one exact origin only ('*', lists and
                 paths are refused at start); OPTIONS answers 204 on a route and
                 404 on an unknown path.
@@ -232,6 +241,126 @@ def scenario_cost_bound(exe, tmp):
     check(r.status == 422 and b"/structure/members/" in r.body,
           "a cycle is a 422 at POST naming a member (%s)" % r.status)
     check(d.stop() == 0, "daemon stops cleanly")
+
+
+SKIP = 77
+
+
+def angled_sweep(n_speeds, first):
+    """The angled-beam example with n_speeds speeds from `first` (distinct requests), shapes on."""
+    import json
+    with open(EXAMPLE) as f:
+        req = json.load(f)
+    req["analysis"]["omega"] = [first + 0.25 * i for i in range(n_speeds)]
+    req["analysis"]["modes"] = 6
+    return json.dumps(req).encode()
+
+
+def job_state(d, job):
+    r = d.get("/v1/analyses/" + job)
+    return r.json() if r.status == 200 else {"state": "http-%s" % r.status}
+
+
+def scenario_full_disk(exe, tmp):
+    disk = os.path.join(tmp, "disk")
+    os.makedirs(disk)
+    p = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=3m", "tmpfs", disk],
+                       capture_output=True, text=True)
+    if p.returncode != 0:
+        print("SKIP: cannot mount a 3 MB tmpfs here (%s); this scenario needs root and "
+              "mount permission" % (p.stderr.strip() or p.returncode))
+        sys.exit(SKIP)
+    js = {"Content-Type": "application/json"}
+    d = None
+    try:
+        d = Daemon(exe, tmp, ["--workers", "1", "--retain-age", "0", "--retain-bytes", "0"],
+                   db=os.path.join(disk, "jobs.db"))
+        d.start()
+        check(d.get("/readyz").status == 200, "ready on an empty 3 MB disk")
+        filler = os.path.join(disk, "filler")
+        st = os.statvfs(disk)
+        free = st.f_bavail * st.f_frsize
+        with open(filler, "wb") as f:           # leave about 150 KB free
+            f.write(b"\0" * max(0, free - 150 * 1024))
+        r = d.request("POST", "/v1/analyses", body=angled_sweep(40, 0.0), headers=js)
+        check(r.status == 202, "a job with a ~2 MB result is accepted (%s)" % r.status)
+        job = r.json()["id"]
+
+        def settled():
+            doc = job_state(d, job)
+            return doc if doc.get("state") in ("failed", "queued", "done") and \
+                doc.get("attempts", 0) >= 1 else None
+        doc = wait_until(settled, 120)
+        check(doc is not None and doc["state"] != "running",
+              "the job is not left running without a worker (%s)" % (doc and doc.get("state")))
+        if doc and doc.get("state") == "failed":
+            check((doc.get("error") or {}).get("type") in ("store_error", "interrupted"),
+                  "failed with error type store_error (%s)" % (doc.get("error") or {}).get("type"))
+        rz = wait_until(lambda: d.get("/readyz").status == 503 or None, 30)
+        r = d.get("/readyz")
+        db = (r.json() or {}).get("checks", {}).get("database")
+        check(rz and db in ("full", "write_failed", "ioerr"),
+              "/readyz 503 with checks.database %r" % db)
+        os.unlink(filler)
+        check(wait_until(lambda: d.get("/readyz").status == 200, 60),
+              "/readyz is 200 again once space is freed")
+        r = d.request("POST", "/v1/analyses?wait=30", body=angled_sweep(40, 0.0), headers=js)
+        doc = wait_until(lambda: job_state(d, job) if job_state(d, job).get("state") == "done"
+                         else None, 120)
+        check(doc is not None, "the same request completes now (%s)"
+              % job_state(d, job).get("state"))
+        check(d.stop() == 0, "daemon stops cleanly")
+        d = None
+    finally:
+        if d is not None:
+            d.kill()
+        subprocess.run(["umount", disk], capture_output=True)
+
+
+def scenario_db_faults(exe, tmp):
+    db = os.path.join(tmp, "shared.db")
+    js = {"Content-Type": "application/json"}
+    a = Daemon(exe, tmp, ["--workers", "1"], db=db, name="first")
+    a.start()
+    r = a.request("POST", "/v1/analyses?wait=30", body=open(EXAMPLE, "rb").read(), headers=js)
+    check(r.status in (200, 202), "first daemon takes a job (%s)" % r.status)
+    p = subprocess.run([exe, "--db", db, "--listen", "127.0.0.1:0"], capture_output=True,
+                       text=True, timeout=timescale.budget(30))
+    check(p.returncode == 1 and ("in use" in p.stderr or "lock" in p.stderr),
+          "a second daemon on the same database refuses to start (exit %d: %s)"
+          % (p.returncode, p.stderr.strip()[:160]))
+    check(a.get("/readyz").status == 200, "the first daemon is still ready")
+    check(a.stop() == 0, "first daemon stops cleanly")
+    # corrupt pages: overwrite the middle of the database file
+    size = os.path.getsize(db)
+    with open(db, "r+b") as f:
+        f.seek(4096 if size > 8192 else size // 2)
+        f.write(os.urandom(4096))
+    for ext in ("-wal", "-shm"):
+        if os.path.exists(db + ext):
+            os.unlink(db + ext)
+    p = subprocess.run([exe, "--db", db, "--listen", "127.0.0.1:0"], capture_output=True,
+                       text=True, timeout=timescale.budget(30))
+    check(p.returncode == 1 and "corrupt" in (p.stderr + p.stdout).lower(),
+          "a corrupt database refuses to start, saying so (exit %d: %s)"
+          % (p.returncode, p.stderr.strip()[-200:]))
+    # deleted under a running daemon
+    db2 = os.path.join(tmp, "deleted.db")
+    b = Daemon(exe, tmp, ["--workers", "1"], db=db2, name="deleted")
+    b.start()
+    check(b.get("/readyz").status == 200, "ready before the delete")
+    os.unlink(db2)
+    r = b.get("/readyz")
+    db_check = (r.json() or {}).get("checks", {}).get("database")
+    check(r.status == 503 and db_check == "gone",
+          "/readyz 503 with database 'gone' after the file is deleted (%s %r)"
+          % (r.status, db_check))
+    r = b.request("POST", "/v1/analyses", body=angled_sweep(2, 1.0), headers=js)
+    check(r.status == 503, "POST answers 503 on a deleted database, no silent loss (%s)"
+          % r.status)
+    check(any("store_error" in l for l in b.log_lines()),
+          "the failure is logged at error level (event=store_error)")
+    b.stop()
 
 
 def scenario_cors(exe, tmp):
