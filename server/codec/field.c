@@ -13,6 +13,8 @@
  */
 #include "codec_internal.h"
 
+#include <float.h>
+
 #include <limits.h>
 #include <math.h>
 #include <stdarg.h>
@@ -200,6 +202,11 @@ int field_check_real(val_ctx *v, const json_t *x, const char *ptr,
     }
     if (!isfinite(d)) {
         field_error(v, ptr, "must be a finite number");
+        return 0;
+    }
+    if (d != 0 && fabs(d) < DBL_MIN) {
+        field_error(v, ptr, "%g is below the smallest normal double (%g): not a value the "
+                    "numerics can carry%s", d, DBL_MIN, unit);
         return 0;
     }
     if (kind == FIELD_POSITIVE && !(d > 0)) {

@@ -14,6 +14,8 @@
 #include "codec_internal.h"
 
 #include <stdlib.h>
+#include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include <openssl/evp.h>
@@ -244,6 +246,96 @@ static int req_check_model(codec_request *r, const codec_limits *lim, codec_erro
                : SM_OK;
 }
 
+/*
+ * Conditioning (issue: a 1e-9 m member gave three identical modes at
+ * 2.6e7 rad/s, marked solved): the element stiffnesses scale like
+ * EI/l^3, so elements whose lengths differ by more than REQ_MIN_LENGTH_RATIO
+ * leave the stiffness matrix too ill-conditioned for double precision, and
+ * section values whose element stiffness or mass overflow (E = 1.8e308) or
+ * vanish give numbers that mean nothing.  Both are refused with the pointer
+ * of the member or section field and the ratio.  Returns SM_OK,
+ * SM_INVALID_INPUT or SM_NOMEM.
+ */
+#define REQ_MIN_LENGTH_RATIO 1e-4   /* shortest / longest element length */
+#define REQ_MAX_MAGNITUDE 1e150     /* |element stiffness or mass| in SI units */
+
+static double req_element_length(const codec_request *r, int i)
+{
+    const sm_member *b = &r->members[i];
+    double dx = r->joint_xy[2 * b->to] - r->joint_xy[2 * b->from];
+    double dy = r->joint_xy[2 * b->to + 1] - r->joint_xy[2 * b->from + 1];
+
+    return hypot(dx, dy) / b->elements;
+}
+
+/* One error at pointer base/key (key escaped); SM_OK or SM_NOMEM. */
+static int req_error_at(codec_errors *errs, const char *base, const char *key, const char *msg)
+{
+    char *p = err_ptr_key(base, key);
+    int rc = p ? codec_errors_add(errs, p, "%s", msg) : SM_NOMEM;
+
+    free(p);
+    return rc;
+}
+
+static int req_check_conditioning(const codec_request *r, codec_errors *errs)
+{
+    int i, bad = 0;
+    double lmax = 0, lmin = HUGE_VAL;
+    char msg[400], base[48];
+
+    for (i = 0; i < r->st.n_members; i++) {
+        double l = req_element_length(r, i);
+        lmax = fmax(lmax, l);
+        lmin = fmin(lmin, l);
+    }
+    for (i = 0; i < r->st.n_members; i++) {
+        double l = req_element_length(r, i), ratio = l / lmax;
+        if (!(ratio >= REQ_MIN_LENGTH_RATIO)) {
+            snprintf(base, sizeof(base), "/structure/members/%d", i);
+            snprintf(msg, sizeof(msg),
+                     "its elements are %.3g m long, %.3g times the longest (%.3g m): below %g "
+                     "the stiffness matrix (~ratio^-3) is too ill-conditioned to give "
+                     "meaningful frequencies; merge this member into its neighbour or give "
+                     "the long members more elements",
+                     l, ratio, lmax, REQ_MIN_LENGTH_RATIO);
+            if (codec_errors_add(errs, base, "%s", msg) == SM_NOMEM)
+                return SM_NOMEM;
+            bad = 1;
+        }
+    }
+    for (i = 0; i < r->st.n_sections; i++) {
+        const sm_section *c = &r->sections[i];
+        const char *name = r->section_names[i];
+        double kb = c->E * c->I / (lmin * lmin * lmin), ka = c->E * c->A / lmin;
+        double mass = c->mu * lmax;
+        const char *field = NULL;
+        if (!(kb < REQ_MAX_MAGNITUDE && ka < REQ_MAX_MAGNITUDE) ||
+            !(kb > 1 / REQ_MAX_MAGNITUDE && ka > 1 / REQ_MAX_MAGNITUDE))
+            field = "E";
+        else if (!(mass < REQ_MAX_MAGNITUDE && mass > 1 / REQ_MAX_MAGNITUDE))
+            field = "mass_per_length";
+        if (!field)
+            continue;
+        snprintf(base, sizeof(base), "/structure/sections");
+        snprintf(msg, sizeof(msg),
+                 "with this value the element %s (EI/l^3 = %.3g N/m, EA/l = %.3g N/m, "
+                 "mu*l = %.3g kg) leaves the range the numerics carry (%g to %g): check the "
+                 "units (SI: Pa, m^2, m^4, kg/m)",
+                 field[0] == 'E' ? "stiffness" : "mass", kb, ka, mass, 1 / REQ_MAX_MAGNITUDE,
+                 REQ_MAX_MAGNITUDE);
+        {
+            char *sec = err_ptr_key(base, name);
+            int rc = sec ? req_error_at(errs, sec, field, msg) : SM_NOMEM;
+            free(sec);
+            if (rc == SM_NOMEM)
+                return SM_NOMEM;
+        }
+        bad = 1;
+    }
+    return bad ? SM_INVALID_INPUT : SM_OK;
+}
+
 int codec_request_from_json(codec_request **out, const json_t *root,
                             const codec_limits *lim, codec_errors *errs)
 {
@@ -274,7 +366,8 @@ int codec_request_from_json(codec_request **out, const json_t *root,
         goto fail;
     if ((rc = codec_sha256_hex(r->canon_text, strlen(r->canon_text), r->sha)) ||
         (rc = req_build_tables(r)) || (rc = req_build_structure(r)) ||
-        (rc = req_build_options(r)) || (rc = req_check_model(r, lim, errs)))
+        (rc = req_build_options(r)) || (rc = req_check_model(r, lim, errs)) ||
+        (rc = req_check_conditioning(r, errs)))
         goto fail;
     *out = r;
     return SM_OK;
