@@ -127,10 +127,12 @@ int mesh_build(sm_model *m, const sm_structure *st, sm_diag *diag);
  * N, K_s, T_e, d_e, G_e, the coordinate offsets q0 and m->n, and the mass
  * points m->mp.  Everything allocated belongs to m (sm_model_free).  Returns
  * SM_OK, SM_NOMEM, SM_SINGULAR (a substructure stiffness or mass matrix that
- * is not positive definite) or SM_LAPACK_FAILED, with diag->status and
- * diag->message set (diag may be NULL).
+ * is not positive definite), SM_LAPACK_FAILED or SM_CANCELED (cb, may be
+ * NULL, is asked before each substructure after the first with done =
+ * substructures built, total = all of them; nonzero stops), with
+ * diag->status and diag->message set (diag may be NULL).
  */
-int modes_build(sm_model *m, sm_diag *diag);
+int modes_build(sm_model *m, sm_progress_fn cb, void *user, sm_diag *diag);
 /**
  * Modal coordinates substructure b (topology from mesh_build) gets under the
  * options o: *nm component modes plus *na attachment columns (both written);

@@ -110,6 +110,12 @@ static int model_fail(sm_diag *d, int rc)
 
 int sm_model_new(sm_model **out, const sm_structure *st, const sm_options *opt, sm_diag *diag)
 {
+    return sm_model_build(out, st, opt, NULL, NULL, diag);
+}
+
+int sm_model_build(sm_model **out, const sm_structure *st, const sm_options *opt,
+                   sm_progress_fn cb, void *user, sm_diag *diag)
+{
     sm_diag scratch;
     sm_diag *d = diag ? diag : &scratch;
     sm_model *m = NULL;
@@ -117,7 +123,7 @@ int sm_model_new(sm_model **out, const sm_structure *st, const sm_options *opt, 
     *out = NULL;
     if (rc < 0)
         return model_fail(d, rc);
-    if ((rc = modes_build(m, d)) < 0) {
+    if ((rc = modes_build(m, cb, user, d)) < 0) {
         sm_model_free(m);
         return model_fail(d, rc);
     }

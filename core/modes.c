@@ -413,10 +413,17 @@ static int modes_mass_points(sm_model *m)
     return SM_OK;
 }
 
-int modes_build(sm_model *m, sm_diag *d)
+int modes_build(sm_model *m, sm_progress_fn cb, void *user, sm_diag *d)
 {
     int rc = SM_OK, q0 = 0;
     for (int s = 0; s < m->n_subs && rc == SM_OK; s++) {
+        if (cb && s > 0 && cb(user, s, m->n_subs)) {
+            d->status = SM_CANCELED;
+            snprintf(d->message, sizeof d->message,
+                     "canceled while building the component modes (%d of %d frames done)", s,
+                     m->n_subs);
+            return SM_CANCELED;
+        }
         sm_sub *b = &m->subs[s];
         int D = 3 * b->nfree;
         dmat K = {0}, M = {0};

@@ -216,6 +216,18 @@ int sm_model_node_position(const sm_model *m, int node, double xy[2]);
  */
 typedef int (*sm_progress_fn)(void *user, int done, int total);
 
+/**
+ * sm_model_new that can be stopped: cb (may be NULL) is called with user
+ * before each substructure's component modes after the first, with done =
+ * substructures built and total = all of them; a nonzero return stops the
+ * build and returns SM_CANCELED (*out NULL, diag says how far it got).  The
+ * cost of one substructure is ~(3 x its free nodes)^3, so this bounds how
+ * long a cancel, a time limit or a shutdown waits.  Other returns as
+ * sm_model_new.
+ */
+int sm_model_build(sm_model **out, const sm_structure *st, const sm_options *opt,
+                   sm_progress_fn cb, void *user, sm_diag *diag);
+
 typedef enum sm_case_status {
     SM_CASE_SOLVED = 0,       /* equilibrium found, steady state stable */
     SM_CASE_UNSTABLE,         /* equilibrium found, K* has negative eigenvalues or Re(lambda) > 0 */

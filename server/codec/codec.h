@@ -181,6 +181,14 @@ int codec_diag_error(const codec_request *r, const sm_diag *d, codec_errors *err
 int codec_model_new(sm_model **out, const codec_request *r, codec_errors *errs,
                     sm_diag *diag);
 
+/**
+ * codec_model_new that can be stopped: cb (may be NULL) is asked between
+ * substructures (sm_model_build); nonzero stops with SM_CANCELED (errs
+ * untouched).
+ */
+int codec_model_build(sm_model **out, const codec_request *r, sm_progress_fn cb, void *user,
+                      codec_errors *errs, sm_diag *diag);
+
 /* ---------------------------------------------- result (result.c, csv.c) */
 
 /** Name of a case status: "solved", "unstable" or "no_equilibrium". */

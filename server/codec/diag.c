@@ -153,6 +153,12 @@ int codec_diag_error(const codec_request *r, const sm_diag *d, codec_errors *err
 int codec_model_new(sm_model **out, const codec_request *r, codec_errors *errs,
                     sm_diag *diag)
 {
+    return codec_model_build(out, r, NULL, NULL, errs, diag);
+}
+
+int codec_model_build(sm_model **out, const codec_request *r, sm_progress_fn cb, void *user,
+                      codec_errors *errs, sm_diag *diag)
+{
     sm_diag local;
     sm_diag *d = diag ? diag : &local;
     int rc;
@@ -160,13 +166,13 @@ int codec_model_new(sm_model **out, const codec_request *r, codec_errors *errs,
     memset(d, 0, sizeof(*d));
     d->item_index = -1;
     *out = NULL;
-    rc = sm_model_new(out, codec_request_structure(r), codec_request_options(r), d);
+    rc = sm_model_build(out, codec_request_structure(r), codec_request_options(r), cb, user, d);
     if (rc == SM_OK)
         return SM_OK;
     *out = NULL;
     if (d->status == SM_OK)
         d->status = rc;
-    if (rc != SM_NOMEM && codec_diag_error(r, d, errs))
+    if (rc != SM_NOMEM && rc != SM_CANCELED && codec_diag_error(r, d, errs))
         return SM_NOMEM;
     return rc;
 }

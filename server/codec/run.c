@@ -31,6 +31,7 @@ typedef struct run_progress {
     sm_progress_fn cb;
     void *user;
     int done;
+    int total;     /* speeds requested */
 } run_progress;
 
 static int run_progress_cb(void *user, int done, int total)
@@ -39,6 +40,16 @@ static int run_progress_cb(void *user, int done, int total)
 
     p->done = done;
     return p->cb ? p->cb(p->user, done, total) : 0;
+}
+
+/* While the model is built: no speed is done yet; the caller may stop it. */
+static int run_build_cb(void *user, int built, int frames)
+{
+    run_progress *p = user;
+
+    (void)built;
+    (void)frames;
+    return p->cb ? p->cb(p->user, 0, p->total) : 0;
 }
 
 /* Diagnostics object of a case without modes. */
@@ -112,7 +123,7 @@ static int run_encode(const codec_request *req, const sm_model *m, const sm_resu
 codec_run_outcome codec_run(const codec_request *req, unsigned want, sm_progress_fn cb,
                             void *user, codec_errors *errs, codec_run_out *out)
 {
-    run_progress prog = {cb, user, 0};
+    run_progress prog = {cb, user, 0, 0};
     sm_model *m = NULL;
     sm_result *res = NULL;
     const double *speeds;
@@ -124,13 +135,17 @@ codec_run_outcome codec_run(const codec_request *req, unsigned want, sm_progress
     memset(out, 0, sizeof(*out));
     out->seconds = -1;
     speeds = codec_request_speeds(req, &n);
-    out->speeds_total = n;
+    out->speeds_total = prog.total = n;
     memset(&d, 0, sizeof(d));
-    st = codec_model_new(&m, req, errs, &d);
+    st = codec_model_build(&m, req, run_build_cb, &prog, errs, &d);
     out->seconds = run_clock() - t0;
     out->status = st;
     if (st == SM_NOMEM)
         goto nomem;
+    if (st == SM_CANCELED) {
+        out->outcome = CODEC_RUN_CANCELED;
+        goto done;
+    }
     if (st != SM_OK) {
         snprintf(detail, sizeof(detail), "the model could not be built: %s%s%s", sm_strerror(st),
                  d.message[0] ? ": " : "", d.message);

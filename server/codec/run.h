@@ -58,8 +58,9 @@ typedef struct codec_run_out {
 /**
  * Run a validated request (borrowed): build its model, solve every speed
  * with continuation, and write the documents of want.  cb (may be NULL) is
- * the core's progress/cancel callback, called with user after every Newton
- * iteration and every speed; a nonzero return stops the run (CANCELED).
+ * the core's progress/cancel callback, called with user between the
+ * substructures of the model build (done = 0), after every Newton iteration
+ * and after every speed; a nonzero return stops the run (CANCELED).
  * errs (borrowed, not NULL) receives the pointer of a core refusal
  * (INVALID).  *out is always initialised; release it with codec_run_clear.
  * Returns out->outcome.

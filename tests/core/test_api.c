@@ -2,7 +2,8 @@
  * test_api.c — public API behaviour: status texts, free(NULL), topology and
  * property errors naming the offending item and field, model sizes for every
  * frame scheme and basis (n = 2 free nodes + attachment nodes), branched
- * trees and a clamp in the middle of a structure.
+ * trees and a clamp in the middle of a structure; sm_model_build stopped by
+ * its callback.
  */
 #include "testutil.h"
 
@@ -21,8 +22,48 @@ static int build(int nj, const double *xy, int nm, const sm_member *mem, int cla
     return rc;
 }
 
+/* Cancel callback: stop once `after` substructures are built; counts calls. */
+typedef struct cancel_ctx {
+    int after, calls, last_done, last_total;
+} cancel_ctx;
+
+static int cancel_cb(void *user, int done, int total)
+{
+    cancel_ctx *c = user;
+    c->calls++;
+    c->last_done = done;
+    c->last_total = total;
+    return done >= c->after;
+}
+
+/* sm_model_build: the callback sees every substructure and can stop the build. */
+static void build_cancel(void)
+{
+    double xy[4] = {0, 0, 5, 0};
+    sm_member mem = {0, 1, 0, 24};
+    sm_section sec = {7e10, 4e-4, 2e-7, 1.2};
+    sm_structure st = {2, xy, 1, &sec, 1, &mem, 0, NULL, 0};
+    sm_options o;
+    sm_default_options(&o);
+    o.frames = SM_FRAMES_ELEMENTS_PER_FRAME;
+    o.frames_param = 4; /* 6 substructures */
+    sm_model *m = (sm_model *)1;
+    sm_diag d;
+    cancel_ctx c = {2, 0, 0, 0};
+    int rc = sm_model_build(&m, &st, &o, cancel_cb, &c, &d);
+    TU_CHECK(rc == SM_CANCELED && m == NULL && d.status == SM_CANCELED,
+             "a callback returning nonzero stops the build: rc %d", rc);
+    TU_CHECK(c.calls == 2 && c.last_done == 2 && c.last_total == 6,
+             "asked between substructures: %d calls, last %d/%d", c.calls, c.last_done, c.last_total);
+    c = (cancel_ctx){100, 0, 0, 0};
+    rc = sm_model_build(&m, &st, &o, cancel_cb, &c, &d);
+    TU_CHECK(rc == SM_OK && m && c.calls == 5, "never stopping: the model is built (%d calls)", c.calls);
+    sm_model_free(m);
+}
+
 int main(void)
 {
+    build_cancel();
     TU_CHECK(!strcmp(sm_strerror(SM_NOT_CONVERGED), "Newton-Raphson did not converge"), "strerror");
     TU_CHECK(!strcmp(sm_strerror(12345), "unknown status"), "strerror unknown");
     sm_model_free(NULL);

@@ -29,6 +29,11 @@ holds; none decides a pass by elapsed time.
                 first keeps working); a corrupt database refuses to start
                 naming the corruption; deleting the database under a running
                 daemon makes /readyz 503 ("gone") and POST 503, not silence.
+  build_cancel  the model build is inside the job time limit: a request whose
+                five frames each sit near the --max-frame-dofs bound, with
+                --job-timeout 0.05, fails with error type timeout after its first
+                frame, in well under the time the whole run takes (measured by the
+                CLI in the same test: a ratio, not a fixed budget).
   cors          --cors-origin accepts one exact origin only ('*', lists and
                 paths are refused at start); OPTIONS answers 204 on a route and
                 404 on an unknown path.
@@ -361,6 +366,44 @@ def scenario_db_faults(exe, tmp):
     check(any("store_error" in l for l in b.log_lines()),
           "the failure is logged at error level (event=store_error)")
     b.stop()
+
+
+HEAVY = (b'{"structure":{"joints":{"O":[0,0],"T":[60,0]},"sections":{"s":{"E":7e10,"A":4e-4,'
+         b'"I":2e-7,"mass_per_length":1.2}},"members":[{"id":"m","from":"O","to":"T",'
+         b'"section":"s","elements":2000}],"clamp":"O"},"frames":{"elements_per_frame":400},'
+         b'"analysis":{"omega":0,"modes_per_frame":20,"mass":"consistent","mode_shapes":false}}')
+
+
+def scenario_build_cancel(exe, tmp):
+    cli = os.environ.get("SPINMODAL_TEST_CLI") or os.path.join(os.path.dirname(exe), "spinmodal")
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+    t0 = time.monotonic()
+    p = subprocess.run([cli, "solve", "-"], input=HEAVY, capture_output=True, env=env,
+                       timeout=timescale.budget(120))
+    full = time.monotonic() - t0
+    check(p.returncode == 0, "the CLI solves the 5-frame request (exit %d, %.2f s)"
+          % (p.returncode, full))
+    js = {"Content-Type": "application/json"}
+    d = Daemon(exe, tmp, ["--workers", "1", "--job-timeout", "0.05"])
+    d.start()
+    r = d.request("POST", "/v1/analyses", body=HEAVY, headers=js)
+    check(r.status == 202, "accepted (%s)" % r.status)
+    job = r.json()["id"]
+    doc = wait_until(lambda: job_state(d, job) if job_state(d, job).get("state") in
+                     ("failed", "done") else None, 120)
+    err = (doc or {}).get("error") or {}
+    check(doc is not None and doc["state"] == "failed" and err.get("type") == "timeout",
+          "the job fails with error type timeout (%s %s)"
+          % (doc and doc.get("state"), err.get("type")))
+    if doc and doc.get("started_at") and doc.get("finished_at"):
+        import datetime
+        def ts(x):
+            return datetime.datetime.strptime(x, "%Y-%m-%dT%H:%M:%S.%fZ").timestamp()
+        ran = ts(doc["finished_at"]) - ts(doc["started_at"])
+        check(ran < 0.6 * full,
+              "it stopped inside the build: ran %.2f s, the whole run takes %.2f s (ratio %.2f "
+              "< 0.6; one frame of five is ~0.2)" % (ran, full, ran / full))
+    check(d.stop() == 0, "daemon stops cleanly")
 
 
 def scenario_cors(exe, tmp):
