@@ -205,6 +205,12 @@ void store_default_settings(store_settings *set)
     set->lease_s = 30;
 }
 
+/* Is path a PostgreSQL URI (libpq's two prefixes)? */
+static int is_pg_uri(const char *path)
+{
+    return strncmp(path, "postgresql://", 13) == 0 || strncmp(path, "postgres://", 11) == 0;
+}
+
 /* The owner id: the settings' (at most 63 bytes), or "<host>:<pid>:<8 hex>"
  * with 32 random bits (or the clock's, without /dev/urandom) so two opens
  * in one process, or a restarted process with a reused pid, differ. */
@@ -263,7 +269,7 @@ int store_open_with(store **out, const store_settings *set, int *requeued, char 
             snprintf(err, errlen, "cannot create the store's error lock");
         return STORE_ERROR;
     }
-    s->be = &store_sqlite_backend;
+    s->be = is_pg_uri(set->path) ? &store_pg_backend : &store_sqlite_backend;
     s->lease_s = set->lease_s > 0 ? set->lease_s : 30;
     rc = make_owner(s, set->owner) == 0 ? STORE_OK : STORE_INVALID;
     if (rc != STORE_OK) {
