@@ -1011,6 +1011,66 @@ static void test_lease_pg(const backend *b)
     store_close(c);
 }
 
+/* Retention on PostgreSQL: by age, then by size; never unfinished jobs. */
+static void test_prune_pg(const backend *b)
+{
+    store *s = NULL;
+    store_job j;
+    char path[600], err[256], id[65], *res = malloc(20000);
+    long long removed = -1, live = 0, file = 0, live2 = 0, counts[STORE_N_STATES];
+    int outcome;
+
+    CHECK(fresh_db(b, "prune", path, sizeof path) == 0, "fresh database prune");
+    CHECK(store_open(&s, path, NULL, err, sizeof err) == STORE_OK, "open: %s", err);
+    if (s == NULL || res == NULL) {
+        free(res);
+        store_close(s);
+        return;
+    }
+    unsigned x = 2463534242u;
+    for (int i = 0; i < 20000; i++) {   /* pseudo-random: pglz cannot shrink it */
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        res[i] = (char)('!' + x % 90);
+    }
+    /* ten jobs finished at 100 … 109, one queued, one running */
+    for (unsigned i = 0; i < 12; i++) {
+        CHECK(submit(s, 9500 + i, i, &outcome, NULL) == STORE_OK, "submit %u", i);
+        CHECK(store_claim_next(s, 50, &j) == STORE_OK, "claim %u", i);
+        store_job_clear(&j);
+        make_id(9500 + i, id);
+        if (i < 10)
+            CHECK(store_finish(s, id, STORE_DONE, 100 + i, 11, NULL, res, 20000, NULL, 0) ==
+                      STORE_OK, "finish %u", i);
+    }
+    CHECK(submit(s, 9600, 1, &outcome, NULL) == STORE_OK, "a queued one");
+    CHECK(store_size(s, &live, &file) == STORE_OK && live > 10 * 20000 && file > live,
+          "size: live %lld file %lld", live, file);
+    CHECK(store_prune(s, 1000, 1000 - 103.5, 0, &removed) == STORE_OK && removed == 4,
+          "by age: the 4 ended before 103.5, removed %lld", removed);
+    make_id(9503, id);
+    CHECK(store_get(s, id, 0, &j) == STORE_NOT_FOUND, "job ended at 103 gone");
+    make_id(9504, id);
+    CHECK(store_get(s, id, 0, &j) == STORE_OK, "job ended at 104 kept");
+    store_job_clear(&j);
+    CHECK(store_size(s, &live2, &file) == STORE_OK && live2 < live, "live shrank: %lld -> %lld",
+          live, live2);
+    /* keep about two results' worth: the oldest finished go first */
+    CHECK(store_prune(s, 1000, 0, live2 - (live2 - 3000) / 6 * 4, &removed) == STORE_OK &&
+              removed >= 3 && removed <= 5, "by size: removed %lld", removed);
+    make_id(9509, id);
+    CHECK(store_get(s, id, 0, &j) == STORE_OK, "the newest finished job kept");
+    store_job_clear(&j);
+    CHECK(store_prune(s, 1000, 0, 1, &removed) == STORE_OK, "size 1: everything finished");
+    CHECK(store_count(s, counts) == STORE_OK && counts[STORE_DONE] == 0 &&
+              counts[STORE_QUEUED] == 1 && counts[STORE_RUNNING] == 2,
+          "unfinished kept: %lld queued %lld running %lld done", counts[STORE_QUEUED],
+          counts[STORE_RUNNING], counts[STORE_DONE]);
+    free(res);
+    store_close(s);
+}
+
 typedef struct err_seen {
     pthread_mutex_t lock;
     int unavailable;
@@ -1178,6 +1238,7 @@ static int run_pg(void)
     test_open_together(&b);
     test_replicas(&b);
     test_lease_pg(&b);
+    test_prune_pg(&b);
     test_restart(&b);
     pg_cluster_destroy(&cl);
     return 0;
