@@ -17,6 +17,8 @@ required=(
   libjansson-dev libssl-dev                # codec, request SHA-256
   liblapacke-dev libopenblas-dev           # LAPACK(E) + BLAS for core/
   libmicrohttpd-dev libsqlite3-dev         # daemon (spinmodald)
+  libpq-dev                                # daemon: the store's PostgreSQL backend (DESIGN.md §6)
+  postgresql                               # tests: server binaries for the throwaway cluster (15 on Debian 12)
   python3 python3-jsonschema               # schema validation tests
   curl ca-certificates                     # clients, end-to-end tests
   nodejs npm chromium                      # web front end (clients/web) and its browser test (tests/web)

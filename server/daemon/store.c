@@ -10,8 +10,11 @@
  * the backend table (store_backend.h).  The SQLite backend lives in
  * store_sqlite.c (statements, connections, the job operations, health,
  * retention) and store_sqlite_open.c (the lock file, checks, schema and
- * migrations at open); a PostgreSQL backend (DESIGN.md §6) would be one
- * more table chosen in store_open_with by the form of the path.
+ * migrations at open); the PostgreSQL backend (DESIGN.md §6) in
+ * store_pg.c (pool, reconnection, job operations) and store_pg_open.c
+ * (migrations under an advisory lock, probes, retention).
+ * store_open_with chooses by the form of the path: a "postgresql://" or
+ * "postgres://" URI is PostgreSQL, anything else a SQLite file.
  *
  * Errors.  A backend turns each failure into a store_rc kind and reports
  * it with store_note_error: the record (kind, backend code, errno, text,
@@ -24,9 +27,12 @@
 #include "store_backend.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#include <unistd.h>
 
 /* ---- return codes --------------------------------------------------------- */
 
@@ -68,6 +74,7 @@ int store_is_db_error(int rc)
     case STORE_IOERR:
     case STORE_IN_USE:
     case STORE_GONE:
+    case STORE_UNAVAILABLE:
         return 1;
     default:
         return 0;
@@ -98,6 +105,35 @@ int store_errno_kind(int e)
     }
 }
 
+/* Record e (kind, codes and texts filled) and call the callback. */
+static int note(store *s, store_error *e, const char *op, const char *text)
+{
+    snprintf(e->op, sizeof e->op, "%s", op ? op : "");
+    snprintf(e->text, sizeof e->text, "%s", text ? text : store_strerror(e->rc));
+    if (pthread_mutex_lock(&s->err_lock) == 0) {
+        e->seq = s->last.seq + 1;
+        s->last = *e;
+        (void)pthread_mutex_unlock(&s->err_lock);
+    }
+    if (s->on_error)
+        s->on_error(s->on_error_ctx, e);
+    return e->rc;
+}
+
+int store_note_error_state(store *s, int kind, const char *sqlstate, const char *op,
+                           const char *text)
+{
+    store_error e;
+
+    if (s == NULL)
+        return kind;
+    memset(&e, 0, sizeof e);
+    e.rc = kind;
+    if (sqlstate)
+        snprintf(e.sqlstate, sizeof e.sqlstate, "%s", sqlstate);
+    return note(s, &e, op, text);
+}
+
 int store_note_error(store *s, int kind, int backend_rc, int sys_errno, const char *op,
                      const char *text)
 {
@@ -109,16 +145,7 @@ int store_note_error(store *s, int kind, int backend_rc, int sys_errno, const ch
     e.rc = kind;
     e.backend_rc = backend_rc;
     e.sys_errno = sys_errno;
-    snprintf(e.op, sizeof e.op, "%s", op ? op : "");
-    snprintf(e.text, sizeof e.text, "%s", text ? text : store_strerror(kind));
-    if (pthread_mutex_lock(&s->err_lock) == 0) {
-        e.seq = s->last.seq + 1;
-        s->last = e;
-        (void)pthread_mutex_unlock(&s->err_lock);
-    }
-    if (s->on_error)
-        s->on_error(s->on_error_ctx, &e);
-    return kind;
+    return note(s, &e, op, text);
 }
 
 int store_last_error(store *s, store_error *out)
@@ -175,6 +202,43 @@ void store_default_settings(store_settings *set)
     memset(set, 0, sizeof *set);
     set->busy_timeout_ms = 5000;
     set->quick_check = 1;
+    set->lease_s = 30;
+}
+
+/* Is path a PostgreSQL URI (libpq's two prefixes)? */
+static int is_pg_uri(const char *path)
+{
+    return strncmp(path, "postgresql://", 13) == 0 || strncmp(path, "postgres://", 11) == 0;
+}
+
+/* The owner id: the settings' (at most 63 bytes), or "<host>:<pid>:<8 hex>"
+ * with 32 random bits (or the clock's, without /dev/urandom) so two opens
+ * in one process, or a restarted process with a reused pid, differ. */
+static int make_owner(store *s, const char *given)
+{
+    char host[40] = "";
+    unsigned r = 0;
+    struct timespec ts;
+    int fd;
+
+    if (given != NULL) {
+        if (given[0] == '\0' || strlen(given) >= sizeof s->owner)
+            return -1;
+        snprintf(s->owner, sizeof s->owner, "%s", given);
+        return 0;
+    }
+    if (gethostname(host, sizeof host - 1) != 0 || host[0] == '\0')
+        snprintf(host, sizeof host, "localhost");
+    host[sizeof host - 1] = '\0';
+    fd = open("/dev/urandom", O_RDONLY | O_CLOEXEC);
+    if (fd < 0 || read(fd, &r, sizeof r) != (ssize_t)sizeof r) {
+        (void)clock_gettime(CLOCK_REALTIME, &ts);
+        r = (unsigned)ts.tv_nsec ^ (unsigned)ts.tv_sec ^ (unsigned)(size_t)s;
+    }
+    if (fd >= 0)
+        (void)close(fd);
+    snprintf(s->owner, sizeof s->owner, "%s:%ld:%08x", host, (long)getpid(), r);
+    return 0;
 }
 
 int store_open_with(store **out, const store_settings *set, int *requeued, char *err,
@@ -205,8 +269,15 @@ int store_open_with(store **out, const store_settings *set, int *requeued, char 
             snprintf(err, errlen, "cannot create the store's error lock");
         return STORE_ERROR;
     }
-    s->be = &store_sqlite_backend;   /* a "postgresql://" path would choose another here */
-    rc = s->be->open(s, set, requeued, err, errlen);
+    s->be = is_pg_uri(set->path) ? &store_pg_backend : &store_sqlite_backend;
+    s->lease_s = set->lease_s > 0 ? set->lease_s : 30;
+    rc = make_owner(s, set->owner) == 0 ? STORE_OK : STORE_INVALID;
+    if (rc != STORE_OK) {
+        if (err && errlen > 0)
+            snprintf(err, errlen, "the owner id must be 1 to %zu bytes", sizeof s->owner - 1);
+    } else {
+        rc = s->be->open(s, set, requeued, err, errlen);
+    }
     if (rc != STORE_OK) {
         if (requeued)
             *requeued = 0;
@@ -242,6 +313,16 @@ void store_close(store *s)
 int store_schema_version(store *s)
 {
     return s->be->schema_version(s);
+}
+
+const char *store_backend_name(store *s)
+{
+    return s->be->name;
+}
+
+const char *store_owner(store *s)
+{
+    return s->owner;
 }
 
 /* ---- jobs ----------------------------------------------------------------- */
@@ -318,6 +399,48 @@ int store_count(store *s, long long counts[STORE_N_STATES])
     for (int i = 0; i < STORE_N_STATES; i++)
         counts[i] = 0;
     return s->be->count(s, counts);
+}
+
+/* ---- several replicas ----------------------------------------------------- */
+
+int store_renew_lease(store *s, const char *id, const char *owner, double now, double lease_s)
+{
+    if (id == NULL)
+        return STORE_NOT_FOUND;
+    if (owner == NULL || !(lease_s > 0))
+        return STORE_INVALID;
+    return s->be->renew_lease(s, id, owner, now, lease_s);
+}
+
+int store_requeue_expired(store *s, double now, int max_attempts, int *requeued, int *failed)
+{
+    int dummy_r = 0, dummy_f = 0;
+
+    if (requeued == NULL)
+        requeued = &dummy_r;
+    if (failed == NULL)
+        failed = &dummy_f;
+    *requeued = 0;
+    *failed = 0;
+    if (max_attempts < 1)
+        return STORE_INVALID;
+    return s->be->requeue_expired(s, now, max_attempts, requeued, failed);
+}
+
+int store_cancel_requested(store *s, const char *id, int *flag)
+{
+    *flag = 0;
+    if (id == NULL)
+        return STORE_NOT_FOUND;
+    return s->be->cancel_requested(s, id, flag);
+}
+
+int store_state_of(store *s, const char *id, store_state *state)
+{
+    *state = STORE_QUEUED;
+    if (id == NULL)
+        return STORE_NOT_FOUND;
+    return s->be->state_of(s, id, state);
 }
 
 /* ---- the database itself -------------------------------------------------- */

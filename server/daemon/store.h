@@ -1,20 +1,30 @@
 /*
- * store.h — the durable record of every analysis job (SQLite, WAL).
+ * store.h — the durable record of every analysis job: SQLite (WAL, one
+ * process) or PostgreSQL (several replicas), chosen by the path given.
  *
  * One row per job, keyed by its content-addressed id (server/DAEMON.md).
  * The store is the queue's durable half: workers claim the oldest queued
  * job with store_claim_next, and at start store_open puts jobs left
  * `running` by a crash back to `queued`.  Results are stored as the exact
- * bytes served.  One process owns a database file at a time (a lock file,
- * store_open_with).  DESIGN.md §6: this interface is what a PostgreSQL
- * backend will implement later (claim = SELECT … FOR UPDATE SKIP LOCKED);
- * store_backend.h is where it plugs in.
+ * bytes served.
+ *
+ * Backends (DESIGN.md §6).  A path "postgresql://…" or "postgres://…" opens
+ * the PostgreSQL backend (libpq): any number of stores, in any number of
+ * processes ("replicas"), share one database; a claim is an UPDATE of the
+ * row chosen by SELECT … FOR UPDATE SKIP LOCKED, and stamps the job with
+ * the store's owner id and a lease (lease_until) its worker renews
+ * (store_renew_lease); jobs whose lease ran out are put back by any replica
+ * (store_requeue_expired).  Anything else is a SQLite file, owned by one
+ * process at a time (a lock file, store_open_with); there owners and
+ * leases are not stored and the multi-replica calls are cheap checks or
+ * no-ops (each says which).
  *
  * Thread safety: every function may be called from any thread at once; the
- * store keeps a small pool of connections (WAL: readers never block the
- * writer).  Return values are store_rc codes (0 = STORE_OK, failures < 0);
- * a failure of the database also leaves SQLite's own words in
- * store_last_error and the settings' on_error callback.
+ * store keeps a small pool of connections (SQLite in WAL: readers never
+ * block the writer).  Return values are store_rc codes (0 = STORE_OK,
+ * failures < 0); a failure of the database also leaves the backend's own
+ * words (SQLite's message, libpq's text and SQLSTATE) in store_last_error
+ * and the settings' on_error callback.
  */
 #ifndef SPINMODAL_STORE_H
 #define SPINMODAL_STORE_H
@@ -32,7 +42,9 @@ extern "C" {
  * operator solves differently: free disk space (FULL), find the other
  * writer (BUSY), restore a backup (CORRUPT), fix permissions or the mount
  * (READONLY), look at the disk (IOERR), stop the other daemon (IN_USE),
- * find who deleted the file (GONE).  STORE_NOMEM stays apart from them.
+ * find who deleted the file (GONE), bring the database server or the
+ * network back (UNAVAILABLE: PostgreSQL only, the store reconnects by
+ * itself).  STORE_NOMEM stays apart from them.
  * X(name, value, token for logs and metric labels, sentence)
  */
 #define STORE_RC_MAP(X)                                                                        \
@@ -49,14 +61,16 @@ extern "C" {
     X(IOERR, -9, "ioerr", "input/output error on the database file")                           \
     X(IN_USE, -10, "in_use", "the database is in use by another process")                      \
     X(GONE, -11, "gone", "the database file was deleted or replaced while the store had it open") \
-    X(INVALID, -12, "invalid", "invalid argument (a caller's mistake)")
+    X(INVALID, -12, "invalid", "invalid argument (a caller's mistake)")                      \
+    X(UNAVAILABLE, -13, "unavailable",                                                         \
+      "the database server cannot be reached (down, restarting, or the network); retried")
 
 /** Return codes of the store (STORE_RC_MAP). */
 typedef enum store_rc {
 #define STORE_RC_ENUM(name, value, token, text) STORE_##name = value,
     STORE_RC_MAP(STORE_RC_ENUM)
 #undef STORE_RC_ENUM
-    STORE_RC_MIN = -12      /* the lowest code, for tables indexed by -rc */
+    STORE_RC_MIN = -13      /* the lowest code, for tables indexed by -rc */
 } store_rc;
 
 /** A sentence for rc ("the database or its disk is full"); never NULL. */
@@ -65,13 +79,14 @@ const char *store_strerror(int rc);
 /**
  * A short token for rc, for log fields and metric labels: "ok",
  * "not_found", "conflict", "nomem", "error", "full", "busy", "corrupt",
- * "readonly", "ioerr", "in_use", "gone", "invalid"; "unknown" otherwise.
+ * "readonly", "ioerr", "in_use", "gone", "invalid", "unavailable";
+ * "unknown" otherwise.
  */
 const char *store_rc_name(int rc);
 
 /**
  * 1 when rc is a database failure (STORE_ERROR, FULL, BUSY, CORRUPT,
- * READONLY, IOERR, IN_USE, GONE): the kinds a caller that only needs
+ * READONLY, IOERR, IN_USE, GONE, UNAVAILABLE): the kinds a caller that only needs
  * "the database failed" (a 503, readiness) treats alike.  0 for
  * STORE_OK, NOT_FOUND, CONFLICT, NOMEM and INVALID.
  */
@@ -79,13 +94,16 @@ int store_is_db_error(int rc);
 
 /**
  * One failure, as recorded by the store: the kind, the backend's own code
- * and text (for SQLite: the extended result code and sqlite3_errmsg), the
- * errno of the failing system call when the backend knows it, and which
- * store operation failed.  Plain data, no pointers.
+ * and text (for SQLite: the extended result code and sqlite3_errmsg; for
+ * PostgreSQL: the SQLSTATE and libpq's message), the errno of the failing
+ * system call when the backend knows it, and which store operation
+ * failed.  Plain data, no pointers.
  */
 typedef struct store_error {
     int rc;                    /* store_rc kind; STORE_OK when nothing failed yet */
     int backend_rc;            /* SQLite extended result code, 0 when not SQLite's */
+    char sqlstate[6];          /* PostgreSQL SQLSTATE ("57P01"), "" when none (a lost
+                                * connection, SQLite) */
     int sys_errno;             /* errno of the failing system call, 0 when unknown */
     unsigned long long seq;    /* failures recorded by this store so far, this one included */
     char op[24];               /* "submit", "claim", "finish", "health", "prune", … */
@@ -138,6 +156,10 @@ typedef struct store_job {
     char *result_csv;        /* result CSV text (STORE_WITH_CSV), or NULL */
     size_t csv_len;
     int has_result;          /* 1 when a result is stored, whatever the flags */
+    char owner[64];          /* PostgreSQL: the owner id of the store that claimed it
+                              * last ("" before; kept after it ends); SQLite: "" */
+    double lease_until;      /* PostgreSQL, while running: the claim holds until this
+                              * unix time (store_renew_lease); 0 otherwise and on SQLite */
 } store_job;
 
 /** Free the strings of j and zero it; NULL is a no-op. */
@@ -156,19 +178,32 @@ typedef void (*store_error_cb)(void *ctx, const store_error *e);
 
 /** How to open a store; fill with store_default_settings, then change fields. */
 typedef struct store_settings {
-    const char *path;          /* SQLite database file (required; not ":memory:") */
-    int busy_timeout_ms;       /* wait this long for another process's SQLite lock; 5000 */
-    int quick_check;           /* 1: PRAGMA quick_check at open, refuse a corrupt file
-                                * (reads the whole file once: ~0.3 s per GB cached); 0: skip */
+    const char *path;          /* required: a SQLite database file (not ":memory:"), or a
+                                * PostgreSQL URI "postgresql://…" / "postgres://…" (libpq
+                                * syntax; its parameters, e.g. connect_timeout, apply) */
+    int busy_timeout_ms;       /* SQLite: wait this long for another process's lock;
+                                * PostgreSQL: lock_timeout of a row lock; 5000 */
+    int quick_check;           /* SQLite: 1: PRAGMA quick_check at open, refuse a corrupt
+                                * file (reads the whole file once: ~0.3 s per GB cached);
+                                * 0: skip.  PostgreSQL: unused */
     store_error_cb on_error;   /* may be NULL */
     void *on_error_ctx;        /* passed to on_error */
+    const char *owner;         /* the id claims are stamped with (PostgreSQL), copied, at
+                                * most 63 bytes; NULL: "<hostname>:<pid>:<8 hex>", unique
+                                * per open.  Must differ between live replicas */
+    double lease_s;            /* PostgreSQL: a claim holds for this long unless renewed
+                                * (store_renew_lease); 30.  SQLite: unused */
 } store_settings;
 
-/** Defaults: no path, busy_timeout_ms 5000, quick_check 1, no callback. */
+/** Defaults: no path, busy_timeout_ms 5000, quick_check 1, no callback, owner
+ *  NULL (generated), lease_s 30. */
 void store_default_settings(store_settings *set);
 
 /**
- * Open (creating if needed) the database at set->path for this process
+ * Open the store named by set->path: PostgreSQL when it begins with
+ * "postgresql://" or "postgres://" (see PostgreSQL below), else SQLite:
+ *
+ * SQLite.  Open (creating if needed) the database at set->path for this process
  * alone, check it, switch it to WAL, apply the migrations up to the
  * current schema version, and put every `running` job back to `queued` (a
  * crash or kill -9 left them so).  *requeued receives how many (may be
@@ -191,6 +226,22 @@ void store_default_settings(store_settings *set);
  * STORE_ERROR (a newer schema, a database of another application, a
  * missing directory, ":memory:" or a file system without WAL, anything
  * else).
+ *
+ * PostgreSQL.  Connect (one connection now, up to 8 on demand later),
+ * take pg_advisory_lock so that N replicas starting together migrate once,
+ * refuse a database with a newer schema (STORE_ERROR) or with a `jobs`
+ * table that is not spinmodal's (STORE_ERROR), apply the migrations, let
+ * go of the lock, then put back to `queued` the `running` jobs whose lease
+ * ended before this host's clock (their replica died; attempts and cancel
+ * requests kept, as for SQLite; jobs of live replicas are left alone).
+ * Not exclusive: any number of stores may share the database.  Returns
+ * STORE_OK; STORE_INVALID (a DSN libpq cannot parse); STORE_UNAVAILABLE
+ * (the server cannot be reached, or refuses the login: err has libpq's
+ * text); STORE_READONLY (a read-only server or no privilege to create
+ * the tables); STORE_ERROR; STORE_NOMEM.  Later, while the server cannot
+ * be reached, every call fails with STORE_UNAVAILABLE at once (after at
+ * most one connect_timeout, 2 s by default, per second) and the store
+ * reconnects by itself when it can: the handle stays usable.
  */
 int store_open_with(store **out, const store_settings *set, int *requeued, char *err,
                     size_t errlen);
@@ -204,8 +255,19 @@ int store_open(store **out, const char *path, int *requeued, char *err, size_t e
 /** Close every connection (checkpointing the WAL) and drop the lock; NULL is a no-op. */
 void store_close(store *s);
 
-/** The schema version of the open database (PRAGMA user_version). */
+/** The schema version of the open database (SQLite: PRAGMA user_version;
+ *  PostgreSQL: the table spinmodal_schema), as seen at open. */
 int store_schema_version(store *s);
+
+/** "sqlite" or "postgresql": the backend store_open_with chose. */
+const char *store_backend_name(store *s);
+
+/**
+ * The owner id this store stamps on the jobs it claims (settings' owner,
+ * or the generated one); valid until store_close, never NULL.  Pass it to
+ * store_renew_lease.  On SQLite it is not stored in the jobs.
+ */
+const char *store_owner(store *s);
 
 /**
  * The most recent failure recorded by s, from any thread, into *out (a
@@ -239,17 +301,22 @@ int store_get(store *s, const char *id, unsigned flags, store_job *out);
 /**
  * Claim the oldest `queued` job (lowest seq): in one transaction set it
  * `running`, started_at = now, attempts + 1.  *out receives it with its
- * request text.  Returns STORE_OK, STORE_NOT_FOUND (queue empty),
- * STORE_NOMEM or a database kind.
+ * request text.  PostgreSQL: the job is also stamped owner =
+ * store_owner(s), lease_until = now + settings' lease_s, and concurrent
+ * claims of any replicas skip each other's locked rows (FOR UPDATE SKIP
+ * LOCKED): a job is handed to one claimer only.  Returns STORE_OK,
+ * STORE_NOT_FOUND (queue empty), STORE_NOMEM or a database kind.
  */
 int store_claim_next(store *s, double now, store_job *out);
 
 /**
  * Record the end of a `running` job: state is STORE_DONE, STORE_FAILED or
  * STORE_CANCELED; error (JSON text), result (JSON text) and csv may be NULL.
- * speeds_done is stored too.  Returns STORE_OK, STORE_CONFLICT (the job is
- * not running, or state is not an end state), STORE_NOT_FOUND, STORE_NOMEM
- * or a database kind.
+ * speeds_done is stored too.  PostgreSQL: only the owner's (the store that
+ * claimed it) end is recorded: a worker whose lease ran out and whose job
+ * another replica took gets STORE_CONFLICT.  Returns STORE_OK,
+ * STORE_CONFLICT (the job is not running, or not this store's, or state is
+ * not an end state), STORE_NOT_FOUND, STORE_NOMEM or a database kind.
  */
 int store_finish(store *s, const char *id, store_state state, double now, int speeds_done,
                  const char *error, const char *result, size_t result_len,
@@ -258,7 +325,8 @@ int store_finish(store *s, const char *id, store_state state, double now, int sp
 /**
  * Put a `running` job back to `queued` (graceful shutdown while it ran):
  * started_at cleared, attempts - 1 (the interruption was not its fault),
- * seq kept so it runs first again.  Returns STORE_OK, STORE_CONFLICT,
+ * seq kept so it runs first again.  PostgreSQL: only this store's own job
+ * (owner), and owner/lease cleared.  Returns STORE_OK, STORE_CONFLICT,
  * STORE_NOT_FOUND, STORE_NOMEM or a database kind.
  */
 int store_requeue(store *s, const char *id);
@@ -271,6 +339,52 @@ int store_requeue(store *s, const char *id);
  * STORE_NOT_FOUND, STORE_NOMEM or a database kind.
  */
 int store_cancel(store *s, const char *id, double now, store_state *state);
+
+/**
+ * Heartbeat of a running job: lease_until = now + lease_s when the job is
+ * `running` and owned by owner (store_owner(s) of the store that claimed
+ * it).  Call it every lease_s / 3 while the job runs.  PostgreSQL: one
+ * UPDATE by primary key.  SQLite (one process, no leases): checks that the
+ * job is running, writes nothing.  Returns STORE_OK; STORE_CONFLICT when
+ * the job is no longer running or no longer owner's (its lease ran out and
+ * another replica requeued or took it, or it was finished elsewhere): the
+ * worker must stop it without recording a result; STORE_NOT_FOUND;
+ * STORE_INVALID (owner NULL, lease_s <= 0); STORE_NOMEM or a database kind.
+ */
+int store_renew_lease(store *s, const char *id, const char *owner, double now, double lease_s);
+
+/**
+ * Jobs of dead replicas: every `running` job whose lease_until < now goes
+ * back to `queued` (started_at, speeds_done, owner and lease cleared;
+ * attempts and a cancel request kept, seq kept so it runs first), unless
+ * its attempts already reached max_attempts: then it becomes `failed`
+ * (finished_at = now) with the error object
+ * {"type":"interrupted","title":"Job interrupted repeatedly","detail":"…"}.
+ * Safe to call from every replica at any rate (each expired job is moved
+ * by one of them).  *requeued and *failed (each may be NULL) receive the
+ * counts.  SQLite: nothing to do (running jobs of a dead process are
+ * requeued at open), both counts 0, STORE_OK.  Returns STORE_OK,
+ * STORE_INVALID (max_attempts < 1), STORE_NOMEM or a database kind.
+ */
+int store_requeue_expired(store *s, double now, int max_attempts, int *requeued, int *failed);
+
+/**
+ * Has a cancel been asked for job id (store_cancel, from any replica)?
+ * *flag (required) receives 1 or 0.  For a running job's worker between
+ * heartbeats (its progress callback, rate-limited by the caller).  One
+ * read by primary key on both backends.  Returns STORE_OK,
+ * STORE_NOT_FOUND, STORE_NOMEM or a database kind (*flag 0).
+ */
+int store_cancel_requested(store *s, const char *id, int *flag);
+
+/**
+ * The state of job id into *state (required): the cheap read of a
+ * `?wait=` poll across replicas (one column by primary key; the daemon
+ * polls it with backoff: it cannot see another replica's condition
+ * variable).  Returns STORE_OK, STORE_NOT_FOUND, STORE_NOMEM or a
+ * database kind.
+ */
+int store_state_of(store *s, const char *id, store_state *state);
 
 /**
  * Jobs newest first (descending seq), without the large texts:
@@ -291,9 +405,10 @@ int store_count(store *s, long long counts[STORE_N_STATES]);
 
 /**
  * Light readiness probe: STORE_OK when the database grants a write
- * transaction (BEGIN IMMEDIATE; ROLLBACK), else the kind of the failure
- * (STORE_BUSY, STORE_READONLY, STORE_GONE, … or STORE_NOMEM).  Writes
- * nothing; store_health is the deeper check.
+ * transaction (SQLite: BEGIN IMMEDIATE; ROLLBACK; PostgreSQL: the session
+ * is not read-only, e.g. not a standby), else the kind of the failure
+ * (STORE_BUSY, STORE_READONLY, STORE_GONE, STORE_UNAVAILABLE, … or
+ * STORE_NOMEM).  Writes nothing; store_health is the deeper check.
  */
 int store_check_writable(store *s);
 
@@ -308,6 +423,9 @@ int store_check_writable(store *s);
  *    read-only remount, revoked permissions or a full WAL device show.
  * Returns STORE_OK, STORE_GONE, STORE_READONLY, STORE_FULL, STORE_IOERR,
  * STORE_BUSY, STORE_CORRUPT, STORE_NOMEM or STORE_ERROR.
+ * PostgreSQL: a real write commits (the schema version rewritten
+ * unchanged); STORE_UNAVAILABLE while the server cannot be reached, and
+ * STORE_OK again by itself once it can (no reopen).
  */
 int store_health(store *s);
 
@@ -332,12 +450,17 @@ int store_health(store *s);
  * bound it stops there (STORE_OK).  *removed (may be NULL) receives how
  * many jobs were deleted, also on failure (the batches committed before).
  * Returns STORE_OK, STORE_NOMEM or a database kind.
+ * PostgreSQL: the same rules; live data is the stored size of the jobs'
+ * texts plus 120 bytes per row (the space a vacuum can give back), and
+ * the server's autovacuum, not store_prune, reclaims the space.
  */
 int store_prune(store *s, double now, double max_age_s, long long max_bytes,
                 long long *removed);
 
 /**
  * Live data and file size in bytes (see store_prune), for a gauge.
+ * PostgreSQL: live as in store_prune, file = pg_total_relation_size of
+ * the jobs table (with its TOAST and indexes).
  * Returns STORE_OK, STORE_NOMEM or a database kind (*live, *file 0).
  */
 int store_size(store *s, long long *live_bytes, long long *file_bytes);

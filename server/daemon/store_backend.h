@@ -2,8 +2,8 @@
  * store_backend.h — private to the store: the line where a backend plugs in.
  *
  * store.c owns what every backend shares: argument checks, the public
- * entry points, the error record and callback, state names.  A backend
- * (store_sqlite*.c today; PostgreSQL later, DESIGN.md §6) fills one
+ * entry points, the error record and callback, state names, the owner id.
+ * A backend (store_sqlite*.c; store_pg*.c, DESIGN.md §6) fills one
  * store_backend table; store.c calls it after checking arguments and
  * zeroing out-parameters, so a backend sees only valid ids, states and
  * filters.  A backend reports every failure through store_note_error.
@@ -21,7 +21,7 @@
  * of the public functions of the same name in store.h.  open sets s->impl
  * (NULL on failure, after freeing what it made); close frees it. */
 typedef struct store_backend {
-    const char *name;   /* "sqlite" */
+    const char *name;   /* "sqlite", "postgresql" */
     int (*open)(store *s, const store_settings *set, int *requeued, char *err, size_t errlen);
     void (*close)(store *s);
     int (*schema_version)(store *s);
@@ -43,10 +43,18 @@ typedef struct store_backend {
      * finished jobs that ended before cutoff; max_bytes <= 0: no size bound */
     int (*prune)(store *s, int by_age, double cutoff, long long max_bytes, long long *removed);
     int (*size)(store *s, long long *live_bytes, long long *file_bytes);
+    /* the calls several replicas need (store.h); owner is never NULL */
+    int (*renew_lease)(store *s, const char *id, const char *owner, double now,
+                       double lease_s);
+    int (*requeue_expired)(store *s, double now, int max_attempts, int *requeued, int *failed);
+    int (*cancel_requested)(store *s, const char *id, int *flag);
+    int (*state_of)(store *s, const char *id, store_state *state);
 } store_backend;
 
 /* The SQLite backend (store_sqlite.c, store_sqlite_open.c). */
 extern const store_backend store_sqlite_backend;
+/* The PostgreSQL backend (store_pg.c, store_pg_open.c). */
+extern const store_backend store_pg_backend;
 
 struct store {
     const store_backend *be;
@@ -55,6 +63,8 @@ struct store {
     void *on_error_ctx;
     pthread_mutex_t err_lock;   /* guards last */
     store_error last;           /* the most recent failure */
+    char owner[64];             /* store_owner: settings' owner or generated */
+    double lease_s;             /* settings' lease_s (> 0) */
 };
 
 /*
@@ -65,6 +75,10 @@ struct store {
  */
 int store_note_error(store *s, int kind, int backend_rc, int sys_errno, const char *op,
                      const char *text);
+
+/* store_note_error with a PostgreSQL SQLSTATE (5 characters, or NULL/""). */
+int store_note_error_state(store *s, int kind, const char *sqlstate, const char *op,
+                           const char *text);
 
 /* errno of a failed system call → store_rc kind (EACCES → STORE_READONLY,
  * ENOSPC → STORE_FULL, EIO → STORE_IOERR, …; STORE_ERROR otherwise). */

@@ -109,6 +109,7 @@ const char *const store_sqlite_sql[STMT_N] = {
     "SELECT seq FROM jobs WHERE " JOB_FINISHED " ORDER BY finished_at, seq LIMIT ?1",
     /* STMT_PRUNE_ONE: the state test again, in case the job was resubmitted */
     "DELETE FROM jobs WHERE seq = ?1 AND " JOB_FINISHED,
+    /* STMT_CANCEL_FLAG */ "SELECT cancel_requested FROM jobs WHERE id = ?1",
 };
 
 /* ---- errors --------------------------------------------------------------- */
@@ -796,6 +797,74 @@ static int sq_count(store *s, long long counts[STORE_N_STATES])
     return status;
 }
 
+/* ---- the calls of several replicas ---------------------------------------- */
+
+/* One process owns the file and nothing stores leases: a renewal only
+ * tells the worker whether its job is still running (a read, no write). */
+static int sq_renew_lease(store *s, const char *id, const char *owner, double now,
+                          double lease_s)
+{
+    store_conn *c = reader_acquire(s, "renew_lease");
+    store_state state = STORE_QUEUED;
+    int status;
+
+    if (c == NULL)
+        return STORE_ERROR;
+    status = conn_state(c, id, &state);
+    reader_release(s, c);
+    if (status == STORE_OK && state != STORE_RUNNING)
+        status = STORE_CONFLICT;
+    return status;
+}
+
+/* Nothing expires: the running jobs of a dead process are requeued when
+ * the next one opens the file (store_sqlite_open). */
+static int sq_requeue_expired(store *s, double now, int max_attempts, int *requeued,
+                              int *failed)
+{
+    return STORE_OK;
+}
+
+static int sq_cancel_requested(store *s, const char *id, int *flag)
+{
+    store_conn *c = reader_acquire(s, "cancel_requested");
+    sqlite3_stmt *st;
+    int rc, status;
+
+    if (c == NULL)
+        return STORE_ERROR;
+    st = store_sqlite_stmt(c, STMT_CANCEL_FLAG, &rc);
+    if (st == NULL) {
+        status = store_sqlite_fail(c, rc);
+        goto done;
+    }
+    rc = bind_text(st, 1, id, strlen(id));
+    if (rc == SQLITE_OK)
+        rc = sqlite3_step(st);
+    if (rc == SQLITE_ROW) {
+        *flag = sqlite3_column_int(st, 0) != 0;
+        status = STORE_OK;
+    } else {
+        status = rc == SQLITE_DONE ? STORE_NOT_FOUND : store_sqlite_fail(c, rc);
+    }
+    store_sqlite_stmt_done(st);
+done:
+    reader_release(s, c);
+    return status;
+}
+
+static int sq_state_of(store *s, const char *id, store_state *state)
+{
+    store_conn *c = reader_acquire(s, "state_of");
+    int status;
+
+    if (c == NULL)
+        return STORE_ERROR;
+    status = conn_state(c, id, state);
+    reader_release(s, c);
+    return status;
+}
+
 /* ---- the backend table --------------------------------------------------- */
 
 const store_backend store_sqlite_backend = {
@@ -815,4 +884,8 @@ const store_backend store_sqlite_backend = {
     .health = store_sqlite_health,
     .prune = store_sqlite_prune,
     .size = store_sqlite_size,
+    .renew_lease = sq_renew_lease,
+    .requeue_expired = sq_requeue_expired,
+    .cancel_requested = sq_cancel_requested,
+    .state_of = sq_state_of,
 };

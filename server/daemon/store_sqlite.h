@@ -39,6 +39,7 @@ enum {
     STMT_PRUNE_AGE,
     STMT_PRUNE_OLDEST,
     STMT_PRUNE_ONE,
+    STMT_CANCEL_FLAG,
     STMT_N
 };
 

@@ -1,12 +1,27 @@
 /*
- * test_store.c — behaviour of the SQLite job store (server/daemon/store.h) on a
- * real database file in a mkdtemp directory: schema version and WAL on a
- * fresh open, submission outcomes, claim order, finish with large texts
- * read back byte-exactly, cancel and requeue in every state, newest-first
- * pagination and state filters, counts, crash recovery on reopen, refusal
- * of newer, foreign and non-SQLite files, and 4 threads claiming 200 jobs
- * (each exactly once) while 2 threads read.
+ * test_store.c — behaviour of the job store (server/daemon/store.h), one
+ * suite run against each backend: `test_store sqlite` on a real database
+ * file in a mkdtemp directory, `test_store postgresql` on a throwaway
+ * PostgreSQL cluster it starts itself (pg_cluster.c; exit 77, skipped,
+ * when the server binaries are missing).
+ *
+ * Both backends: schema version on a fresh open, submission outcomes,
+ * claim order, finish with large texts read back byte-exactly, cancel and
+ * requeue in every state, newest-first pagination and state filters,
+ * counts, crash recovery on reopen, 4 threads claiming 200 jobs (each
+ * exactly once) while 2 threads read, a cancel seen by the job's worker
+ * (store_cancel_requested, store_state_of), the lease calls.
+ * SQLite only: WAL, refusal of newer, foreign and non-SQLite files.
+ * PostgreSQL only (several replicas = several store handles): refusals
+ * (bad URI, unreachable server without the password in the message, newer
+ * schema, foreign table), six stores opening a fresh database at once
+ * (one migration), two handles × two threads claiming 400 jobs (each
+ * exactly once; claims/s printed) and submitting the same ids at once
+ * (one insert each), lease expiry and renewal, the attempt limit, and a
+ * server restart and stop survived by the same handle (STORE_UNAVAILABLE
+ * quickly while it is down, then working again without a reopen).
  */
+#include "pg_cluster.h"
 #include "store.h"
 
 #include <pthread.h>
@@ -14,6 +29,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 static int failures = 0;
@@ -31,6 +47,31 @@ static int checks = 0;
     } while (0)
 
 enum { N_CONC = 200, N_CLAIMERS = 4, N_READERS = 2 };
+
+/* The backend under test: a SQLite file in dir, or databases of a cluster. */
+typedef struct backend {
+    int pg;               /* 0: SQLite; 1: PostgreSQL */
+    const char *dir;      /* SQLite: the mkdtemp directory */
+    pg_cluster *cl;       /* PostgreSQL: the throwaway cluster */
+} backend;
+
+/* A fresh, empty database called name: a file path in b->dir (SQLite) or
+ * the URI of a new database of the cluster.  Returns 0 or -1. */
+static int fresh_db(const backend *b, const char *name, char *out, size_t len)
+{
+    if (b->pg)
+        return pg_cluster_createdb(b->cl, name, out, len);
+    snprintf(out, len, "%s/%s.db", b->dir, name);
+    return 0;
+}
+
+static double mono(void)
+{
+    struct timespec ts;
+
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
 
 /* Job id number n: 64 hex digits. */
 static void make_id(unsigned n, char id[65])
@@ -60,7 +101,7 @@ static int raw_exec(const char *path, const char *sql)
     return rc;
 }
 
-/* First column of the first row of sql as text into buf. */
+/* First column of the first row of sql as text into buf (SQLite file). */
 static int raw_text(const char *path, const char *sql, char *buf, size_t len)
 {
     sqlite3 *db = NULL;
@@ -75,6 +116,15 @@ static int raw_text(const char *path, const char *sql, char *buf, size_t len)
     sqlite3_finalize(st);
     sqlite3_close(db);
     return rc;
+}
+
+/* The same on either backend: SQLITE_OK (0) on success. */
+static int raw_text_b(const backend *b, const char *target, const char *sql, char *buf,
+                      size_t len)
+{
+    if (b->pg)
+        return pg_raw(target, sql, buf, len) == 0 ? SQLITE_OK : SQLITE_ERROR;
+    return raw_text(target, sql, buf, len);
 }
 
 static void remove_db(const char *path)
@@ -103,7 +153,7 @@ static void test_names(void)
 }
 
 /* Submit, claim, finish, cancel, requeue on one database. */
-static void test_lifecycle(store *s, const char *path)
+static void test_lifecycle(const backend *b, store *s, const char *path)
 {
     store_job j, k;
     store_state state = STORE_QUEUED;
@@ -112,9 +162,13 @@ static void test_lifecycle(store *s, const char *path)
     long long counts[STORE_N_STATES];
 
     CHECK(store_schema_version(s) == 1, "fresh schema version 1, got %d", store_schema_version(s));
-    CHECK(raw_text(path, "PRAGMA journal_mode", buf, sizeof buf) == SQLITE_OK && !strcmp(buf, "wal"),
-          "journal mode wal, got '%s'", buf);
-    CHECK(raw_text(path, "PRAGMA user_version", buf, sizeof buf) == SQLITE_OK && !strcmp(buf, "1"),
+    CHECK(!strcmp(store_backend_name(s), b->pg ? "postgresql" : "sqlite"), "backend %s",
+          store_backend_name(s));
+    if (!b->pg)
+        CHECK(raw_text(path, "PRAGMA journal_mode", buf, sizeof buf) == SQLITE_OK &&
+                  !strcmp(buf, "wal"), "journal mode wal, got '%s'", buf);
+    CHECK(raw_text_b(b, path, b->pg ? "SELECT version FROM spinmodal_schema" : "PRAGMA user_version",
+                     buf, sizeof buf) == SQLITE_OK && !strcmp(buf, "1"),
           "user_version 1 in the file, got '%s'", buf);
     CHECK(store_check_writable(s) == STORE_OK, "writable");
     CHECK(store_claim_next(s, 1.0, &j) == STORE_NOT_FOUND, "claim on empty store");
@@ -128,7 +182,7 @@ static void test_lifecycle(store *s, const char *path)
               j.finished_at == 0 && !j.has_result && j.request == NULL && j.error == NULL,
           "new job as stored (seq %lld state %d)", j.seq, (int)j.state);
     store_job_clear(&j);
-    CHECK(raw_text(path, "SELECT count(*) FROM jobs", buf, sizeof buf) == SQLITE_OK &&
+    CHECK(raw_text_b(b, path, "SELECT count(*) FROM jobs", buf, sizeof buf) == SQLITE_OK &&
               !strcmp(buf, "1"), "committed: another connection sees the job (%s)", buf);
     CHECK(submit(s, 2, 101, &outcome, NULL) == STORE_OK && outcome == 1, "submit 2");
     CHECK(submit(s, 3, 102, &outcome, NULL) == STORE_OK && outcome == 1, "submit 3");
@@ -493,7 +547,7 @@ static void *read_loop(void *arg)
 }
 
 /* 4 threads claim 200 jobs while 2 threads read: each claimed exactly once. */
-static void test_concurrent(const char *dir)
+static void test_concurrent(const backend *b)
 {
     store *s = NULL;
     char path[600], err[256];
@@ -503,7 +557,7 @@ static void test_concurrent(const char *dir)
     int outcome, started_c = 0, started_r = 0, total = 0, once = 1, errors = 0;
     long long counts[STORE_N_STATES];
 
-    snprintf(path, sizeof path, "%s/conc.db", dir);
+    CHECK(fresh_db(b, "conc", path, sizeof path) == 0, "fresh database conc");
     CHECK(cl != NULL, "alloc");
     CHECK(store_open(&s, path, NULL, err, sizeof err) == STORE_OK, "open: %s", err);
     if (s == NULL || cl == NULL) {
@@ -549,15 +603,595 @@ static void test_concurrent(const char *dir)
     CHECK(store_check_writable(s) == STORE_OK, "writable after the run");
     store_close(s);
     free(cl);
+    if (!b->pg)
+        remove_db(path);
+}
+
+
+/* ---- the calls of several replicas, on either backend --------------------- */
+
+/* A cancel asked through one handle (another replica's, on PostgreSQL) is
+ * seen by the worker of the job through store_cancel_requested and
+ * store_state_of. */
+static void test_cancel_seen(const backend *b)
+{
+    store *s = NULL, *other = NULL;
+    store_job j;
+    store_state state = STORE_DONE;
+    char path[600], err[256], id[65];
+    int flag = -1, outcome;
+
+    CHECK(fresh_db(b, "cancelseen", path, sizeof path) == 0, "fresh database cancelseen");
+    CHECK(store_open(&s, path, NULL, err, sizeof err) == STORE_OK, "open: %s", err);
+    if (s == NULL)
+        return;
+    other = s;   /* SQLite: one store per file; the same handle plays both parts */
+    if (b->pg)
+        CHECK(store_open(&other, path, NULL, err, sizeof err) == STORE_OK, "second: %s", err);
+    if (other == NULL) {
+        store_close(s);
+        return;
+    }
+    make_id(7000, id);
+    CHECK(store_cancel_requested(s, id, &flag) == STORE_NOT_FOUND && flag == 0,
+          "cancel_requested of an unknown job");
+    CHECK(store_state_of(s, id, &state) == STORE_NOT_FOUND, "state_of an unknown job");
+    CHECK(submit(s, 7000, 10, &outcome, NULL) == STORE_OK && outcome == 1, "submit");
+    CHECK(store_state_of(other, id, &state) == STORE_OK && state == STORE_QUEUED, "state queued");
+    CHECK(store_claim_next(s, 20, &j) == STORE_OK && !strcmp(j.id, id), "claim");
+    if (b->pg)
+        CHECK(!strcmp(j.owner, store_owner(s)) && j.lease_until == 20 + 30,
+              "claim stamps owner '%s' and lease %.1f", j.owner, j.lease_until);
+    else
+        CHECK(j.owner[0] == '\0' && j.lease_until == 0, "SQLite stores no owner or lease");
+    store_job_clear(&j);
+    CHECK(store_cancel_requested(s, id, &flag) == STORE_OK && flag == 0, "not asked yet");
+    CHECK(store_cancel(other, id, 30, &state) == STORE_OK && state == STORE_RUNNING,
+          "cancel through the other replica");
+    CHECK(store_cancel_requested(s, id, &flag) == STORE_OK && flag == 1, "the worker sees it");
+    CHECK(store_state_of(other, id, &state) == STORE_OK && state == STORE_RUNNING,
+          "still running");
+    CHECK(store_renew_lease(s, id, store_owner(s), 40, 30) == STORE_OK, "heartbeat while running");
+    CHECK(store_finish(s, id, STORE_CANCELED, 50, 0, NULL, NULL, 0, NULL, 0) == STORE_OK,
+          "the worker finishes it canceled");
+    CHECK(store_state_of(other, id, &state) == STORE_OK && state == STORE_CANCELED,
+          "state_of canceled");
+    CHECK(store_renew_lease(s, id, store_owner(s), 60, 30) == STORE_CONFLICT,
+          "no heartbeat for an ended job");
+    make_id(7001, id);
+    CHECK(store_renew_lease(s, id, store_owner(s), 60, 30) == STORE_NOT_FOUND,
+          "no heartbeat for an unknown job");
+    CHECK(store_renew_lease(s, id, NULL, 60, 30) == STORE_INVALID, "owner required");
+    CHECK(store_renew_lease(s, id, "x", 60, 0) == STORE_INVALID, "lease > 0 required");
+    CHECK(store_requeue_expired(s, 1e12, 0, NULL, NULL) == STORE_INVALID, "max_attempts >= 1");
+    if (other != s)
+        store_close(other);
+    store_close(s);
+    if (!b->pg)
+        remove_db(path);
+}
+
+/* SQLite: nothing expires (one process); renewals only check the state. */
+static void test_lease_sqlite(const backend *b)
+{
+    store *s = NULL;
+    store_job j;
+    char path[600], err[256], id[65];
+    int requeued = -1, failed = -1, outcome;
+
+    CHECK(fresh_db(b, "lease", path, sizeof path) == 0, "fresh database lease");
+    CHECK(store_open(&s, path, NULL, err, sizeof err) == STORE_OK, "open: %s", err);
+    if (s == NULL)
+        return;
+    CHECK(store_owner(s) != NULL && store_owner(s)[0] != '\0', "an owner id: '%s'", store_owner(s));
+    CHECK(submit(s, 8000, 10, &outcome, NULL) == STORE_OK, "submit");
+    make_id(8000, id);
+    CHECK(store_renew_lease(s, id, store_owner(s), 11, 30) == STORE_CONFLICT, "queued: conflict");
+    CHECK(store_claim_next(s, 20, &j) == STORE_OK, "claim");
+    store_job_clear(&j);
+    CHECK(store_renew_lease(s, id, "anyone", 1e9, 30) == STORE_OK, "running: ok, owner unused");
+    CHECK(store_requeue_expired(s, 1e12, 1, &requeued, &failed) == STORE_OK && requeued == 0 &&
+              failed == 0, "nothing expires on SQLite");
+    CHECK(store_get(s, id, 0, &j) == STORE_OK && j.state == STORE_RUNNING, "still running");
+    store_job_clear(&j);
+    store_close(s);
     remove_db(path);
 }
 
-int main(void)
+/* ---- PostgreSQL only ------------------------------------------------------- */
+
+/* Opens that must be refused with a sentence, or fail fast. */
+static void test_refused_pg(const backend *b)
 {
-    char tmpl[512], path[600], err[256];
-    const char *tmp = getenv("TMPDIR");
+    store *s = (store *)&s;
+    char dsn[256], path[600], err[512];
+    double t;
+    int port = pg_free_port(), rc;
+
+    CHECK(store_open(&s, "postgresql://127.0.0.1/x?nosuchparam=1", NULL, err, sizeof err) ==
+              STORE_INVALID && s == NULL && strstr(err, "invalid PostgreSQL URI") != NULL,
+          "bad URI refused: '%s'", err);
+    snprintf(dsn, sizeof dsn, "postgresql://postgres:sekrit@127.0.0.1:%d/x", port);
+    t = mono();
+    rc = store_open(&s, dsn, NULL, err, sizeof err);
+    t = mono() - t;
+    CHECK(rc == STORE_UNAVAILABLE && s == NULL, "nothing listening: unavailable (%s)",
+          store_rc_name(rc));
+    CHECK(strstr(err, "cannot connect to PostgreSQL database 127.0.0.1:") != NULL &&
+              strstr(err, "sekrit") == NULL, "unreachable sentence without the password: '%s'",
+          err);
+    CHECK(t < 3.0, "refused quickly: %.3f s", t);
+    CHECK(store_is_db_error(STORE_UNAVAILABLE) && !strcmp(store_rc_name(STORE_UNAVAILABLE),
+                                                          "unavailable"), "unavailable kind");
+
+    CHECK(fresh_db(b, "newer", path, sizeof path) == 0, "fresh database newer");
+    CHECK(store_open(&s, path, NULL, err, sizeof err) == STORE_OK, "open newer: %s", err);
+    store_close(s);
+    CHECK(pg_raw(path, "UPDATE spinmodal_schema SET version = 999", NULL, 0) == 0, "bump version");
+    CHECK(store_open(&s, path, NULL, err, sizeof err) == STORE_ERROR && s == NULL &&
+              strstr(err, "database schema version 999 is newer than this spinmodald (1)"),
+          "newer schema refused: '%s'", err);
+
+    CHECK(fresh_db(b, "foreign_app", path, sizeof path) == 0, "fresh database foreign_app");
+    CHECK(pg_raw(path, "CREATE TABLE jobs (x integer)", NULL, 0) == 0, "foreign table");
+    CHECK(store_open(&s, path, NULL, err, sizeof err) == STORE_ERROR && s == NULL &&
+              strstr(err, "not a spinmodal one"), "foreign database refused: '%s'", err);
+}
+
+typedef struct opener {
+    const char *dsn;
+    int rc;
+    int version;
+    char err[256];
+} opener;
+
+static void *open_loop(void *arg)
+{
+    opener *o = arg;
     store *s = NULL;
+
+    o->rc = store_open(&s, o->dsn, NULL, o->err, sizeof o->err);
+    if (s != NULL) {
+        o->version = store_schema_version(s);
+        store_close(s);
+    }
+    return NULL;
+}
+
+/* Six replicas start together on a fresh database: one migrates. */
+static void test_open_together(const backend *b)
+{
+    enum { N = 6 };
+    pthread_t t[N];
+    opener o[N];
+    char path[600], buf[32];
+    int ok = 0;
+
+    CHECK(fresh_db(b, "together", path, sizeof path) == 0, "fresh database together");
+    for (int i = 0; i < N; i++) {
+        memset(&o[i], 0, sizeof o[i]);
+        o[i].dsn = path;
+        o[i].rc = -100;
+        if (pthread_create(&t[i], NULL, open_loop, &o[i]) != 0)
+            o[i].dsn = NULL;
+    }
+    for (int i = 0; i < N; i++) {
+        if (o[i].dsn)
+            pthread_join(t[i], NULL);
+        ok += o[i].rc == STORE_OK && o[i].version == 1;
+        if (o[i].rc != STORE_OK)
+            printf("opener %d: %s: %s\n", i, store_rc_name(o[i].rc), o[i].err);
+    }
+    CHECK(ok == N, "%d of %d opened at version 1", ok, N);
+    CHECK(pg_raw(path, "SELECT count(*) FROM spinmodal_schema", buf, sizeof buf) == 0 &&
+              !strcmp(buf, "1"), "one schema row: %s", buf);
+}
+
+enum { N_REPL = 400 };
+
+typedef struct replica_claimer {
+    store *s;
+    unsigned base;
+    int *claimed;          /* shared [N_REPL], updated under lock */
+    pthread_mutex_t *lock;
+    int n;
+    int errors;
+} replica_claimer;
+
+static void *replica_claim_loop(void *arg)
+{
+    replica_claimer *c = arg;
+    store_job j;
+    int rc;
+
+    while ((rc = store_claim_next(c->s, 5000, &j)) == STORE_OK) {
+        unsigned n = (unsigned)strtoul(j.id, NULL, 16);
+        if (n >= c->base && n < c->base + N_REPL && !strcmp(j.owner, store_owner(c->s))) {
+            pthread_mutex_lock(c->lock);
+            c->claimed[n - c->base]++;
+            pthread_mutex_unlock(c->lock);
+        } else {
+            c->errors++;
+        }
+        c->n++;
+        store_job_clear(&j);
+    }
+    if (rc != STORE_NOT_FOUND)
+        c->errors++;
+    return NULL;
+}
+
+/* Claim N_REPL jobs (ids base …) with nthreads threads over the handles
+ * hs[t % nh]; returns claims per second, checks each job claimed once. */
+static double claim_all(store **hs, int nh, int nthreads, unsigned base, const char *what)
+{
+    pthread_t t[8];
+    replica_claimer c[8];
+    pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
+    int *claimed = calloc(N_REPL, sizeof *claimed), outcome, once = 1, total = 0, errors = 0;
+    int per_handle[2] = {0, 0};
+    double t0, secs;
+
+    if (claimed == NULL)
+        return 0;
+    for (unsigned i = 0; i < N_REPL; i++)
+        CHECK(submit(hs[i % (unsigned)nh], base + i, 1000 + i, &outcome, NULL) == STORE_OK &&
+                  outcome == 1, "submit %u", base + i);
+    t0 = mono();
+    for (int i = 0; i < nthreads; i++) {
+        c[i] = (replica_claimer){hs[i % nh], base, claimed, &lock, 0, 0};
+        if (pthread_create(&t[i], NULL, replica_claim_loop, &c[i]) != 0)
+            c[i].s = NULL;
+    }
+    for (int i = 0; i < nthreads; i++) {
+        if (c[i].s != NULL)
+            pthread_join(t[i], NULL);
+        total += c[i].n;
+        errors += c[i].errors;
+        per_handle[i % nh] += c[i].n;
+    }
+    secs = mono() - t0;
+    for (int i = 0; i < N_REPL; i++)
+        once = once && claimed[i] == 1;
+    CHECK(total == N_REPL && once && errors == 0,
+          "%s: each job claimed once: total %d, errors %d", what, total, errors);
+    if (nh == 2)
+        CHECK(per_handle[0] > 0 && per_handle[1] > 0, "%s: both replicas claimed (%d, %d)", what,
+              per_handle[0], per_handle[1]);
+    printf("%s: %d claims in %.3f s = %.0f claims/s (per handle: %d, %d)\n", what, total, secs,
+           total / secs, per_handle[0], per_handle[1]);
+    free(claimed);
+    return total / secs;
+}
+
+typedef struct racer {
+    store *s;
+    int inserted;
+    int errors;
+} racer;
+
+static void *submit_race(void *arg)
+{
+    racer *r = arg;
+    int outcome;
+
+    for (unsigned i = 0; i < 100; i++) {
+        if (submit(r->s, 90000 + i, 1, &outcome, NULL) != STORE_OK)
+            r->errors++;
+        else
+            r->inserted += outcome == 1;
+    }
+    return NULL;
+}
+
+/* Two replicas (handles) claiming and submitting at once. */
+static void test_replicas(const backend *b)
+{
+    store *s[2] = {NULL, NULL};
+    pthread_t t[2];
+    racer r[2];
+    char path[600], err[256];
+    long long counts[STORE_N_STATES];
+
+    CHECK(fresh_db(b, "replicas", path, sizeof path) == 0, "fresh database replicas");
+    for (int i = 0; i < 2; i++)
+        CHECK(store_open(&s[i], path, NULL, err, sizeof err) == STORE_OK, "replica %d: %s", i, err);
+    if (s[0] == NULL || s[1] == NULL) {
+        store_close(s[0]);
+        store_close(s[1]);
+        return;
+    }
+    CHECK(strcmp(store_owner(s[0]), store_owner(s[1])) != 0, "owners differ: %s, %s",
+          store_owner(s[0]), store_owner(s[1]));
+    claim_all(s, 1, 1, 10000, "one handle, 1 thread");
+    claim_all(s, 1, 2, 20000, "one handle, 2 threads");
+    claim_all(s, 2, 2, 30000, "two handles, 1 thread each");
+    claim_all(s, 2, 4, 40000, "two handles, 2 threads each");
+
+    /* the same 100 new ids submitted by both replicas at once: one insert each */
+    for (int i = 0; i < 2; i++) {
+        r[i] = (racer){s[i], 0, 0};
+        if (pthread_create(&t[i], NULL, submit_race, &r[i]) != 0)
+            r[i].s = NULL;
+    }
+    for (int i = 0; i < 2; i++)
+        if (r[i].s)
+            pthread_join(t[i], NULL);
+    CHECK(r[0].inserted + r[1].inserted == 100 && r[0].errors + r[1].errors == 0,
+          "racing submissions: %d + %d inserted, %d errors", r[0].inserted, r[1].inserted,
+          r[0].errors + r[1].errors);
+    CHECK(store_count(s[1], counts) == STORE_OK && counts[STORE_QUEUED] == 100 &&
+              counts[STORE_RUNNING] == 4 * N_REPL, "shared counts: %lld queued, %lld running",
+          counts[STORE_QUEUED], counts[STORE_RUNNING]);
+    store_close(s[0]);
+    store_close(s[1]);
+}
+
+/* Leases: renewal, expiry, the owner's exclusive finish, the attempt limit. */
+static void test_lease_pg(const backend *b)
+{
+    store *a = NULL, *c = NULL;
+    store_settings set;
+    store_job j;
+    char path[600], err[256], id[65];
+    int requeued = -1, failed = -1, outcome, flag = 0;
+
+    CHECK(fresh_db(b, "lease", path, sizeof path) == 0, "fresh database lease");
+    store_default_settings(&set);
+    set.path = path;
+    set.owner = "replica-a";
+    set.lease_s = 30;
+    CHECK(store_open_with(&a, &set, NULL, err, sizeof err) == STORE_OK, "open a: %s", err);
+    set.owner = "replica-c";
+    CHECK(store_open_with(&c, &set, NULL, err, sizeof err) == STORE_OK, "open c: %s", err);
+    if (a == NULL || c == NULL) {
+        store_close(a);
+        store_close(c);
+        return;
+    }
+    CHECK(!strcmp(store_owner(a), "replica-a"), "owner from the settings");
+    make_id(8100, id);
+    CHECK(submit(a, 8100, 1000, &outcome, NULL) == STORE_OK, "submit");
+    CHECK(store_claim_next(a, 1000, &j) == STORE_OK && j.lease_until == 1030 &&
+              !strcmp(j.owner, "replica-a") && j.attempts == 1, "a claims until 1030");
+    store_job_clear(&j);
+    CHECK(store_requeue_expired(c, 1020, 3, &requeued, &failed) == STORE_OK && requeued == 0 &&
+              failed == 0, "not expired at 1020");
+    CHECK(store_renew_lease(a, id, "replica-a", 1025, 30) == STORE_OK, "a renews at 1025");
+    CHECK(store_get(c, id, 0, &j) == STORE_OK && j.lease_until == 1055, "lease until 1055: %.1f",
+          j.lease_until);
+    store_job_clear(&j);
+    CHECK(store_renew_lease(c, id, "replica-c", 1026, 30) == STORE_CONFLICT,
+          "c cannot renew a's job");
+    CHECK(store_requeue_expired(c, 1050, 3, &requeued, &failed) == STORE_OK && requeued == 0,
+          "renewed: not expired at 1050");
+    /* a stops renewing (its replica died): c puts the job back at 1060 */
+    CHECK(store_cancel(c, id, 1058, NULL) == STORE_OK, "a cancel is asked meanwhile");
+    CHECK(store_requeue_expired(c, 1060, 3, &requeued, &failed) == STORE_OK && requeued == 1 &&
+              failed == 0, "expired at 1060: requeued %d failed %d", requeued, failed);
+    CHECK(store_get(c, id, 0, &j) == STORE_OK && j.state == STORE_QUEUED && j.owner[0] == '\0' &&
+              j.lease_until == 0 && j.started_at == 0 && j.attempts == 1 && j.cancel_requested,
+          "queued again, attempts and cancel request kept (state %s)", store_state_name(j.state));
+    store_job_clear(&j);
+    CHECK(store_renew_lease(a, id, "replica-a", 1061, 30) == STORE_CONFLICT,
+          "a's late heartbeat: lease lost");
+    CHECK(store_claim_next(c, 1070, &j) == STORE_OK && !strcmp(j.owner, "replica-c") &&
+              j.attempts == 2 && j.cancel_requested, "c claims it, with the cancel request");
+    store_job_clear(&j);
+    CHECK(store_finish(a, id, STORE_DONE, 1071, 11, NULL, "{}", 2, NULL, 0) == STORE_CONFLICT,
+          "a's late finish is refused");
+    CHECK(store_requeue(a, id) == STORE_CONFLICT, "a cannot requeue c's job");
+    CHECK(store_cancel_requested(c, id, &flag) == STORE_OK && flag == 1, "c sees the cancel");
+    CHECK(store_finish(c, id, STORE_CANCELED, 1072, 0, NULL, NULL, 0, NULL, 0) == STORE_OK,
+          "c finishes it canceled");
+
+    /* a poison job: three claims whose worker dies; the third expiry fails it */
+    make_id(8200, id);
+    CHECK(submit(a, 8200, 2000, &outcome, NULL) == STORE_OK && outcome == 1, "submit poison");
+    for (int k = 1; k <= 3; k++) {
+        double t0 = 2000 + 100.0 * k;
+        CHECK(store_claim_next(k % 2 ? a : c, t0, &j) == STORE_OK && !strcmp(j.id, id) &&
+                  j.attempts == k, "claim %d (attempts %d)", k, j.attempts);
+        store_job_clear(&j);
+        CHECK(store_requeue_expired(k % 2 ? c : a, t0 + 31, 3, &requeued, &failed) == STORE_OK &&
+                  requeued == (k < 3) && failed == (k == 3),
+              "expiry %d: requeued %d failed %d", k, requeued, failed);
+    }
+    CHECK(store_get(a, id, 0, &j) == STORE_OK && j.state == STORE_FAILED && j.finished_at == 2331 &&
+              j.error && strstr(j.error, "{\"type\":\"interrupted\",") == j.error &&
+              strstr(j.error, "claimed 3 times"), "failed as interrupted: %s",
+          j.error ? j.error : "(null)");
+    store_job_clear(&j);
+    CHECK(store_claim_next(a, 2400, &j) == STORE_NOT_FOUND, "not claimed again");
+    CHECK(submit(c, 8200, 2500, &outcome, &j) == STORE_OK && outcome == 2 &&
+              j.state == STORE_QUEUED && j.attempts == 0 && j.error == NULL,
+          "resubmitted: outcome %d", outcome);
+    store_job_clear(&j);
+    store_close(a);
+    store_close(c);
+}
+
+/* Retention on PostgreSQL: by age, then by size; never unfinished jobs. */
+static void test_prune_pg(const backend *b)
+{
+    store *s = NULL;
+    store_job j;
+    char path[600], err[256], id[65], *res = malloc(20000);
+    long long removed = -1, live = 0, file = 0, live2 = 0, counts[STORE_N_STATES];
+    int outcome;
+
+    CHECK(fresh_db(b, "prune", path, sizeof path) == 0, "fresh database prune");
+    CHECK(store_open(&s, path, NULL, err, sizeof err) == STORE_OK, "open: %s", err);
+    if (s == NULL || res == NULL) {
+        free(res);
+        store_close(s);
+        return;
+    }
+    unsigned x = 2463534242u;
+    for (int i = 0; i < 20000; i++) {   /* pseudo-random: pglz cannot shrink it */
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        res[i] = (char)('!' + x % 90);
+    }
+    /* ten jobs finished at 100 … 109, one queued, one running */
+    for (unsigned i = 0; i < 12; i++) {
+        CHECK(submit(s, 9500 + i, i, &outcome, NULL) == STORE_OK, "submit %u", i);
+        CHECK(store_claim_next(s, 50, &j) == STORE_OK, "claim %u", i);
+        store_job_clear(&j);
+        make_id(9500 + i, id);
+        if (i < 10)
+            CHECK(store_finish(s, id, STORE_DONE, 100 + i, 11, NULL, res, 20000, NULL, 0) ==
+                      STORE_OK, "finish %u", i);
+    }
+    CHECK(submit(s, 9600, 1, &outcome, NULL) == STORE_OK, "a queued one");
+    CHECK(store_size(s, &live, &file) == STORE_OK && live > 10 * 20000 && file > live,
+          "size: live %lld file %lld", live, file);
+    CHECK(store_prune(s, 1000, 1000 - 103.5, 0, &removed) == STORE_OK && removed == 4,
+          "by age: the 4 ended before 103.5, removed %lld", removed);
+    make_id(9503, id);
+    CHECK(store_get(s, id, 0, &j) == STORE_NOT_FOUND, "job ended at 103 gone");
+    make_id(9504, id);
+    CHECK(store_get(s, id, 0, &j) == STORE_OK, "job ended at 104 kept");
+    store_job_clear(&j);
+    CHECK(store_size(s, &live2, &file) == STORE_OK && live2 < live, "live shrank: %lld -> %lld",
+          live, live2);
+    /* keep about two results' worth: the oldest finished go first */
+    CHECK(store_prune(s, 1000, 0, live2 - (live2 - 3000) / 6 * 4, &removed) == STORE_OK &&
+              removed >= 3 && removed <= 5, "by size: removed %lld", removed);
+    make_id(9509, id);
+    CHECK(store_get(s, id, 0, &j) == STORE_OK, "the newest finished job kept");
+    store_job_clear(&j);
+    CHECK(store_prune(s, 1000, 0, 1, &removed) == STORE_OK, "size 1: everything finished");
+    CHECK(store_count(s, counts) == STORE_OK && counts[STORE_DONE] == 0 &&
+              counts[STORE_QUEUED] == 1 && counts[STORE_RUNNING] == 2,
+          "unfinished kept: %lld queued %lld running %lld done", counts[STORE_QUEUED],
+          counts[STORE_RUNNING], counts[STORE_DONE]);
+    free(res);
+    store_close(s);
+}
+
+typedef struct err_seen {
+    pthread_mutex_t lock;
+    int unavailable;
+    char text[256];
+} err_seen;
+
+static void on_error(void *ctx, const store_error *e)
+{
+    err_seen *x = ctx;
+
+    pthread_mutex_lock(&x->lock);
+    if (e->rc == STORE_UNAVAILABLE) {
+        x->unavailable++;
+        snprintf(x->text, sizeof x->text, "%s", e->text);
+    }
+    pthread_mutex_unlock(&x->lock);
+}
+
+/* The server restarts, then stops and comes back: the same handle reports
+ * STORE_UNAVAILABLE quickly while it is down and works again after. */
+static void test_restart(const backend *b)
+{
+    err_seen seen = {PTHREAD_MUTEX_INITIALIZER, 0, ""};
+    store_settings set;
+    store *s = NULL;
+    store_job j;
+    store_error e;
+    char path[600], err[256], id[65];
+    long long counts[STORE_N_STATES];
+    double t, worst = 0;
+    int outcome, rc, ok_after = 0;
+
+    CHECK(fresh_db(b, "restart", path, sizeof path) == 0, "fresh database restart");
+    store_default_settings(&set);
+    set.path = path;
+    set.on_error = on_error;
+    set.on_error_ctx = &seen;
+    CHECK(store_open_with(&s, &set, NULL, err, sizeof err) == STORE_OK, "open: %s", err);
+    if (s == NULL)
+        return;
+    CHECK(submit(s, 9100, 1, &outcome, NULL) == STORE_OK, "submit before");
+    make_id(9100, id);
+
+    /* pg_ctl restart: the pooled session is closed by the server; the next
+     * call notices it before sending and reconnects */
+    CHECK(pg_cluster_restart(b->cl) == 0, "pg_ctl restart");
+    CHECK((rc = store_get(s, id, 0, &j)) == STORE_OK && j.state == STORE_QUEUED,
+          "first call after a restart works: %s", store_rc_name(rc));
+    store_job_clear(&j);
+
+    /* stopped: every call fails with the unavailable kind, quickly */
+    CHECK(pg_cluster_stop(b->cl) == 0, "pg_ctl stop");
+    for (int i = 0; i < 5; i++) {
+        t = mono();
+        switch (i) {
+        case 0: rc = store_health(s); break;
+        case 1: rc = store_get(s, id, 0, &j); break;
+        case 2: rc = submit(s, 9101, 2, &outcome, NULL); break;
+        case 3: rc = store_claim_next(s, 3, &j); break;
+        default: rc = store_count(s, counts); break;
+        }
+        t = mono() - t;
+        worst = t > worst ? t : worst;
+        CHECK(rc == STORE_UNAVAILABLE, "call %d while stopped: %s", i, store_rc_name(rc));
+    }
+    CHECK(worst < 2.5, "each failed within %.3f s", worst);
+    CHECK(store_last_error(s, &e) == STORE_UNAVAILABLE && e.text[0], "last error: %s", e.text);
+    pthread_mutex_lock(&seen.lock);
+    CHECK(seen.unavailable >= 5 && seen.text[0], "callback saw %d: %s", seen.unavailable,
+          seen.text);
+    pthread_mutex_unlock(&seen.lock);
+    printf("while stopped: slowest call %.4f s; libpq said: %s\n", worst, e.text);
+
+    /* back: health recovers by itself, the same handle works */
+    CHECK(pg_cluster_resume(b->cl) == 0, "pg_ctl start again");
+    t = mono();
+    while (mono() - t < 20) {
+        if (store_health(s) == STORE_OK) {
+            ok_after = 1;
+            break;
+        }
+        nanosleep(&(struct timespec){0, 50000000}, NULL);
+    }
+    CHECK(ok_after, "healthy again after %.2f s", mono() - t);
+    printf("healthy again %.2f s after the server started\n", mono() - t);
+    CHECK(submit(s, 9101, 4, &outcome, NULL) == STORE_OK && outcome == 1, "submit after");
+    CHECK(store_claim_next(s, 5, &j) == STORE_OK && !strcmp(j.id, id), "claim after");
+    store_job_clear(&j);
+    CHECK(store_count(s, counts) == STORE_OK && counts[STORE_QUEUED] == 1 &&
+              counts[STORE_RUNNING] == 1, "counts after");
+    store_close(s);
+}
+
+/* ---- the two runs ----------------------------------------------------------- */
+
+/* The suite both backends pass; first is the fresh database's target. */
+static void run_shared(const backend *b, const char *path)
+{
+    store *s = NULL;
+    char err[256];
     int requeued = -1;
+
+    test_names();
+    CHECK(store_open(&s, path, &requeued, err, sizeof err) == STORE_OK && s != NULL,
+          "fresh open: %s", err);
+    CHECK(requeued == 0, "nothing to requeue on a fresh database");
+    if (s != NULL) {
+        test_lifecycle(b, s, path);
+        test_list(s);
+        store_close(s);
+        test_reopen(path);
+    }
+    test_concurrent(b);
+    test_cancel_seen(b);
+}
+
+static int run_sqlite(void)
+{
+    char tmpl[512], path[600];
+    const char *tmp = getenv("TMPDIR");
+    backend b = {0, tmpl, NULL};
 
     snprintf(tmpl, sizeof tmpl, "%s/test_store.XXXXXX", tmp && *tmp ? tmp : "/tmp");
     if (mkdtemp(tmpl) == NULL) {
@@ -565,23 +1199,66 @@ int main(void)
         return 1;
     }
     snprintf(path, sizeof path, "%s/jobs.db", tmpl);
-
-    test_names();
-    CHECK(store_open(&s, path, &requeued, err, sizeof err) == STORE_OK && s != NULL,
-          "fresh open: %s", err);
-    CHECK(requeued == 0, "nothing to requeue on a fresh database");
-    if (s != NULL) {
-        test_lifecycle(s, path);
-        test_list(s);
-        store_close(s);
-        test_reopen(path);
-    }
+    run_shared(&b, path);
     test_refused(tmpl);
-    test_concurrent(tmpl);
-
+    test_lease_sqlite(&b);
     remove_db(path);
     if (rmdir(tmpl) != 0)
         perror("rmdir");
-    printf("%d checks, %d failures\n", checks, failures);
-    return failures ? 1 : 0;
+    return 0;
+}
+
+static int run_pg(void)
+{
+    pg_cluster cl;
+    backend b = {1, NULL, &cl};
+    char why[512], path[600];
+    double t = mono();
+    int rc = pg_cluster_start(&cl, why, sizeof why);
+
+    if (rc == 77) {
+        printf("SKIP: %s\n", why);
+        pg_cluster_destroy(&cl);
+        return 77;
+    }
+    if (rc != 0) {
+        printf("FAIL: cannot start a PostgreSQL cluster: %s\n", why);
+        pg_cluster_destroy(&cl);
+        return 1;
+    }
+    printf("PostgreSQL cluster in %s on port %d (%s), started in %.2f s\n", cl.dir, cl.port,
+           cl.bindir, mono() - t);
+    if (fresh_db(&b, "jobs", path, sizeof path) != 0) {
+        printf("FAIL: createdb\n");
+        pg_cluster_destroy(&cl);
+        return 1;
+    }
+    run_shared(&b, path);
+    test_refused_pg(&b);
+    test_open_together(&b);
+    test_replicas(&b);
+    test_lease_pg(&b);
+    test_prune_pg(&b);
+    test_restart(&b);
+    pg_cluster_destroy(&cl);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    const char *which = argc > 1 ? argv[1] : "sqlite";
+    int rc;
+
+    if (strcmp(which, "sqlite") == 0) {
+        rc = run_sqlite();
+    } else if (strcmp(which, "postgresql") == 0) {
+        rc = run_pg();
+    } else {
+        fprintf(stderr, "usage: test_store [sqlite|postgresql]\n");
+        return 2;
+    }
+    if (rc != 0 && rc != 1)
+        return rc;   /* 77: skipped */
+    printf("%s: %d checks, %d failures\n", which, checks, failures);
+    return failures || rc ? 1 : 0;
 }

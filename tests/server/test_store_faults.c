@@ -1,7 +1,8 @@
 /*
  * test_store_faults.c — what an operator must be able to tell apart, on
  * real files in a mkdtemp directory (server/daemon/store.h):
- * - error kinds: names and sentences, the SQLite code → kind table, a real
+ * - error kinds: names and sentences, the SQLite code → kind table (and
+ *   PostgreSQL's SQLSTATE → kind table), a real
  *   BUSY (another connection's write lock) and a real FULL (a file size
  *   limit in a child process) with SQLite's text in store_last_error and
  *   the on_error callback;
@@ -16,6 +17,7 @@
  *   the file shrinks.
  */
 #include "store.h"
+#include "store_pg.h"       /* store_pg_kind, for the SQLSTATE table */
 #include "store_sqlite.h"   /* store_sqlite_kind, for the code table */
 
 #include <errno.h>
@@ -134,7 +136,7 @@ static void test_names(void)
              {STORE_BUSY, "busy", 1},      {STORE_CORRUPT, "corrupt", 1},
              {STORE_READONLY, "readonly", 1}, {STORE_IOERR, "ioerr", 1},
              {STORE_IN_USE, "in_use", 1},  {STORE_GONE, "gone", 1},
-             {STORE_INVALID, "invalid", 0}};
+             {STORE_INVALID, "invalid", 0}, {STORE_UNAVAILABLE, "unavailable", 1}};
 
     for (size_t i = 0; i < sizeof t / sizeof t[0]; i++) {
         CHECK(!strcmp(store_rc_name(t[i].rc), t[i].token), "token of %d: %s", t[i].rc,
@@ -142,11 +144,34 @@ static void test_names(void)
         CHECK(store_is_db_error(t[i].rc) == t[i].db, "is_db_error(%s)", t[i].token);
         CHECK(store_strerror(t[i].rc)[0] != '\0', "sentence of %s", t[i].token);
     }
-    CHECK(STORE_RC_MIN == STORE_INVALID, "STORE_RC_MIN is the lowest code");
+    CHECK(STORE_RC_MIN == STORE_UNAVAILABLE, "STORE_RC_MIN is the lowest code");
     CHECK(!strcmp(store_rc_name(1), "unknown") && !strcmp(store_rc_name(-99), "unknown"),
           "unknown token");
     CHECK(!strcmp(store_strerror(-99), "unknown store error"), "unknown sentence");
     CHECK(strstr(store_strerror(STORE_FULL), "full") != NULL, "FULL sentence");
+}
+
+/* PostgreSQL: SQLSTATE and a lost session → kind (store_pg_kind). */
+static void test_pg_kind_table(void)
+{
+    static const struct {
+        const char *state;
+        int bad, kind;
+    } t[] = {
+        {"57P01", 0, STORE_UNAVAILABLE}, {"08006", 0, STORE_UNAVAILABLE},
+        {"53300", 0, STORE_UNAVAILABLE}, {NULL, 1, STORE_UNAVAILABLE},
+        {"42P01", 1, STORE_UNAVAILABLE}, {"53100", 0, STORE_FULL},
+        {"25006", 0, STORE_READONLY},    {"42501", 0, STORE_READONLY},
+        {"55P03", 0, STORE_BUSY},        {"57014", 0, STORE_BUSY},
+        {"40P01", 0, STORE_BUSY},        {"XX001", 0, STORE_CORRUPT},
+        {"58030", 0, STORE_IOERR},       {"23505", 0, STORE_ERROR},
+        {"", 0, STORE_ERROR},            {NULL, 0, STORE_ERROR},
+    };
+
+    for (size_t i = 0; i < sizeof t / sizeof t[0]; i++)
+        CHECK(store_pg_kind(t[i].state, t[i].bad) == t[i].kind, "SQLSTATE %s bad %d → %s, got %s",
+              t[i].state ? t[i].state : "(none)", t[i].bad, store_rc_name(t[i].kind),
+              store_rc_name(store_pg_kind(t[i].state, t[i].bad)));
 }
 
 static void test_code_table(void)
@@ -664,6 +689,7 @@ int main(void)
     }
     test_names();
     test_code_table();
+    test_pg_kind_table();
     test_invalid(tmpl);
     test_busy(tmpl);
     test_full(tmpl);
