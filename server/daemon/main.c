@@ -62,6 +62,8 @@ enum {
     F_REQUEST_DEADLINE,
     F_RETAIN_AGE,
     F_RETAIN_BYTES,
+    F_REPLICA_ID,
+    F_LEASE,
     F_SHUTDOWN_GRACE,
     F_LOG_FORMAT,
     F_N
@@ -78,7 +80,8 @@ typedef struct main_flag {
 static const main_flag main_flags[F_N] = {
     {"listen", "SPINMODAL_LISTEN", "HOST:PORT", "127.0.0.1:8080",
      "address to listen on; [IPv6]:PORT; port 0 = any free port"},
-    {"db", "SPINMODAL_DB", "PATH", "./spinmodal.db", "SQLite database of the jobs"},
+    {"db", "SPINMODAL_DB", "PATH|URI", "./spinmodal.db",
+     "SQLite database file, or postgresql://user@host/db to share one queue between replicas"},
     {"workers", "SPINMODAL_WORKERS", "N", "online cores", "solver threads (1-1024)"},
     {"queue-max", "SPINMODAL_QUEUE_MAX", "N", "1000", "queued jobs before POST answers 429"},
     {"max-body", "SPINMODAL_MAX_BODY", "BYTES", "1048576", "largest request body (413 above)"},
@@ -103,6 +106,10 @@ static const main_flag main_flags[F_N] = {
      "finished jobs older than this are removed (0 = keep by age)"},
     {"retain-bytes", "SPINMODAL_RETAIN_BYTES", "BYTES", "1073741824 (1 GiB)",
      "oldest finished jobs are removed above this much live data (0 = no bound)"},
+    {"replica-id", "SPINMODAL_REPLICA_ID", "ID", "host:pid:random",
+     "PostgreSQL: the owner id this replica stamps on the jobs it claims (unique per replica)"},
+    {"lease", "SPINMODAL_LEASE", "S", "30",
+     "PostgreSQL: seconds a claimed job stays this replica's without a heartbeat"},
     {"shutdown-grace", "SPINMODAL_SHUTDOWN_GRACE", "S", "10",
      "seconds running jobs get to finish on SIGTERM"},
     {"log-format", "SPINMODAL_LOG_FORMAT", "text|json", "text", "log lines on stderr"},
@@ -118,6 +125,8 @@ typedef struct main_opts {
     double job_timeout;      /* s, > 0 */
     double shutdown_grace;   /* s, >= 0 */
     double retain_age;       /* s, 0 = no age bound */
+    const char *replica_id;  /* NULL = generated */
+    double lease;            /* s, PostgreSQL claims */
     long long retain_bytes;  /* bytes, 0 = no size bound */
     const char *token_file;  /* NULL = no auth */
     int auth_reads;          /* 1: reads need the token too */
@@ -308,6 +317,13 @@ static int main_set(main_opts *o, int f, const char *v, const char **want)
     case F_REQUEST_DEADLINE:
         *want = "a number of seconds from 1 to 3600";
         return main_seconds(v, 1.0, 3600.0, &o->request_deadline);
+    case F_REPLICA_ID:
+        *want = "1 to 63 printable characters";
+        o->replica_id = v;
+        return main_printable(v) && strlen(v) < 64 ? 0 : -1;
+    case F_LEASE:
+        *want = "a number of seconds from 3 to 3600";
+        return main_seconds(v, 3.0, 3600.0, &o->lease);
     case F_RETAIN_AGE:
         *want = "a number of seconds from 0 (keep) to 3153600000 (100 years)";
         return main_seconds(v, 0.0, 3153600000.0, &o->retain_age);
@@ -351,6 +367,7 @@ static void main_defaults(main_opts *o)
     o->request_deadline = 30.0;
     o->shutdown_grace = 10.0;
     o->retain_age = 2592000.0;
+    o->lease = 30.0;
     o->retain_bytes = 1073741824LL;
     o->format = LOG_TEXT;
 }
@@ -506,6 +523,12 @@ static void main_fail(const char *what, const char *detail)
 }
 
 /* Open the store and the metrics; 0 or EXIT_START. */
+/* 1 when the --db value is a PostgreSQL URI (it may hold a password: never logged). */
+static int main_is_uri(const char *db)
+{
+    return strncmp(db, "postgresql://", 13) == 0 || strncmp(db, "postgres://", 11) == 0;
+}
+
 /*
  * The store's error callback (on the failing thread, at the failure): log
  * the kind and SQLite's own text, count it by kind.  Never calls the store.
@@ -516,7 +539,8 @@ static void main_store_error(void *ctx, const store_error *e)
 
     snprintf(code, sizeof(code), "%d", e->backend_rc);
     log_event("error", "store_error", "op", e->op, "kind", store_rc_name(e->rc), "code", code,
-              "detail", e->text, (const char *)NULL);
+              "sqlstate", e->sqlstate[0] ? e->sqlstate : NULL, "detail", e->text,
+              (const char *)NULL);
     metrics_store_error(ctx, e->rc);
 }
 
@@ -534,17 +558,21 @@ static int main_open(const main_opts *o, main_daemon *d)
     err[0] = '\0';
     store_default_settings(&set);
     set.path = o->db;
+    set.owner = o->replica_id;
+    set.lease_s = o->lease;
     set.on_error = main_store_error;
     set.on_error_ctx = d->mx;
     rc = store_open_with(&d->st, &set, &requeued, err, sizeof(err));
     if (rc != STORE_OK) {
-        log_event("error", "store_open_failed", "kind", store_rc_name(rc), "db", o->db,
-                  "detail", err[0] ? err : store_strerror(rc), (const char *)NULL);
-        main_fail("cannot open the database", err[0] ? err : o->db);
+        /* err names the file, or host:port/database of a URI (never its password) */
+        log_event("error", "store_open_failed", "kind", store_rc_name(rc), "detail",
+                  err[0] ? err : store_strerror(rc), (const char *)NULL);
+        main_fail("cannot open the database", err[0] ? err : store_strerror(rc));
         return EXIT_START;
     }
     snprintf(n, sizeof(n), "%d", requeued);
-    log_event("info", "recovered", "jobs", n, "db", o->db, (const char *)NULL);
+    log_event("info", "recovered", "jobs", n, "backend", store_backend_name(d->st), "owner",
+              store_owner(d->st), "db", main_is_uri(o->db) ? NULL : o->db, (const char *)NULL);
     return 0;
 }
 
