@@ -108,6 +108,24 @@ static void check(const char *name, sm_options *o, double omega)
             }
             printf("%s: negative eigenvalues dense %d tree %d\n", name, neg, t.neg);
             TU_CHECK(neg == t.neg, "%s: inertia", name);
+            /* the eigen-analysis: the same modes, or the dense path's turn when K* is indefinite */
+            sm_eig_out ed, et;
+            int fb = -1, modes = n >= 40 ? 4 : 1;
+            TU_CHECK(eig_solve(n, &M, &C, &K, 1, modes, &ed) == SM_OK, "%s: dense eig", name);
+            TU_CHECK(eig_solve_tree(m, &t, 1, modes, &et, &fb) == SM_OK, "%s: tree eig", name);
+            if (neg > 0 || 4 * modes > n) {
+                TU_CHECK(fb == 1 && et.n_modes == 0 && !et.wim, "%s: indefinite K* or too few coordinates: dense "
+                         "fallback, nothing returned", name);
+            } else {
+                TU_CHECK(fb == 0 && et.n_modes == ed.n_modes, "%s: tree eig converged (%d modes)", name, et.n_modes);
+                for (int j = 0; !fb && j < et.n_modes && j < ed.n_modes; j++) {
+                    double dw = fabs(et.wim[j] - ed.wim[j]) / ed.wim[j];
+                    printf("%s: mode %d w %.12g tree %.12g rel %.1e\n", name, j, ed.wim[j], et.wim[j], dw);
+                    TU_CHECK(dw < 1e-9, "%s: mode %d frequency", name, j);
+                }
+            }
+            eig_out_free(&ed);
+            eig_out_free(&et);
         } else {
             LAPACKE_dgetrf(LAPACK_COL_MAJOR, n, n, X.a, n, ip);
             int sign = 1;
