@@ -668,9 +668,19 @@ done:
 
 /* ------------------------------------------------ tree form: shift-invert Arnoldi (tree.c) */
 
-/* Relative residual that accepts a mode, the largest Krylov basis, and the basis sizes at which
- * the projection is tried first and then every TREE_EIG_STEP vectors. */
+/* Relative residual that accepts the modes; or, at the round-off floor of large models (the
+ * solves with K* carry ~cond(K*) eps: residuals stall near 1e-10 at 768 elements), a residual
+ * below EIG_TREE_FLOOR with frequencies that moved by less than EIG_TREE_STALL (relative) since
+ * the previous, smaller basis (Ritz values of a Rayleigh-Ritz step only improve).  The largest
+ * Krylov basis, and the basis sizes at which the projection is tried first and then every
+ * EIG_TREE_STEP vectors. */
 #define EIG_TREE_TOL 1e-11
+#define EIG_TREE_FLOOR 1e-9
+#define EIG_TREE_STALL 1e-10
+/* Past EIG_TREE_LATE vectors (the strict tests met nothing: 3072 elements, where K* x itself
+ * carries ~cond(K*) eps and the frequencies wander by ~2e-9 between bases), the noise-limited
+ * acceptance: residual below 1e-7 and frequencies steady to 1e-8. */
+#define EIG_TREE_LATE 48
 #define EIG_TREE_MAX_BASIS 240
 #define EIG_TREE_STEP 8
 
@@ -687,7 +697,22 @@ static int eig_tree_op(const sm_model *m, tree_ws *t, int coriolis, const double
     for (int i = 0; i < n; i++)
         w[i] = -w[i];
     memcpy(w + n, v, (size_t)n * sizeof(double));
-    return tree_solve(m, t, w); /* w_x = -K^-1 (C x + M y) */
+    /* w_x = -K^-1 (C x + M y), with one step of iterative refinement: the block solve is
+     * backward stable, but K* is graded (cond ~1e7 at 1536 elements) and the refined solution
+     * keeps the Ritz frequencies steady to ~1e-12 instead of ~1e-9 */
+    double *b = tmp + n;
+    memcpy(b, w, (size_t)n * sizeof(double));
+    int rc = tree_solve(m, t, w);
+    if (rc < 0)
+        return rc;
+    tree_apply(m, t, TREE_K, w, tmp);
+    for (int i = 0; i < n; i++)
+        tmp[i] = b[i] - tmp[i];
+    if ((rc = tree_solve(m, t, tmp)) < 0)
+        return rc;
+    for (int i = 0; i < n; i++)
+        w[i] += tmp[i];
+    return SM_OK;
 }
 
 /* Orthogonalise w (len) against the nq columns of Q (ld len) twice (CGS2); returns ||w|| after. */
@@ -879,7 +904,9 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, sm_ei
     double *Q = dm_vec((size_t)N2 * (pmax + 1)), *V = dm_vec((size_t)n * (pmax + 1));
     double *MV = dm_vec((size_t)n * (pmax + 1)), *CV = dm_vec((size_t)n * (pmax + 1));
     double *KV = dm_vec((size_t)n * (pmax + 1)), *tmp = dm_vec(6 * (size_t)n), *h = dm_vec((size_t)pmax + 2);
-    if (!Q || !V || !MV || !CV || !KV || !tmp || !h)
+    double *prev = dm_vec((size_t)modes);
+    int have_prev = 0;
+    if (!Q || !V || !MV || !CV || !KV || !tmp || !h || !prev)
         goto done;
     for (int i = 0; i < n; i++) /* a start vector with every component */
         Q[i] = 1.0 + 0.5 * sin(0.37 * i + 0.1);
@@ -916,10 +943,20 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, sm_ei
                 tree_apply(m, t, TREE_C, v, CV + (size_t)nv * n);
             nv++;
         }
-        double res;
+        double res, moved = INFINITY;
         if ((rc = eig_tree_project(m, t, coriolis, modes, nv, V, MV, CV, KV, tmp, out, &res)) < 0)
             goto done;
-        if (res <= EIG_TREE_TOL) {
+        if (out->wim) {
+            if (have_prev) {
+                moved = 0;
+                for (int j = 0; j < modes; j++)
+                    moved = fmax(moved, fabs(out->wim[j] - prev[j]) / fabs(out->wim[j]));
+            }
+            memcpy(prev, out->wim, (size_t)modes * sizeof(double));
+            have_prev = 1;
+        }
+        if (res <= EIG_TREE_TOL || (res <= EIG_TREE_FLOOR && moved <= EIG_TREE_STALL) ||
+            (p >= EIG_TREE_LATE && res <= 1e-7 && moved <= 1e-8)) {
             out->negative = t->neg;
             *fallback = 0;
             break;
@@ -941,5 +978,6 @@ done:
     free(KV);
     free(tmp);
     free(h);
+    free(prev);
     return rc;
 }
