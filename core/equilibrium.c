@@ -29,6 +29,8 @@
 #define EQ_MAX_STRAIN 0.01
 
 typedef struct eq_ws {
+    int tree;                /* 1: tangent in the tree form (t, light kin), else dense Kt */
+    tree_ws t;
     sm_kin kin;
     double *F, *g, *dq, *qt, *q0, *qp, *work;
     double *P;               /* n_elems axial forces */
@@ -54,6 +56,7 @@ static void eq_ws_free(eq_ws *w)
     dm_free(&w->M);
     dm_free(&w->H);
     dm_free(&w->W);
+    tree_free(&w->t);
 }
 
 static int eq_ws_alloc(const sm_model *m, eq_ws *w)
@@ -71,6 +74,15 @@ static int eq_ws_alloc(const sm_model *m, eq_ws *w)
     w->work = dm_vec((size_t)(4 * mx + n));
     w->ipiv = malloc((size_t)n * sizeof(int));
     w->P = dm_vec((size_t)m->n_elems);
+    w->tree = tree_use(m);
+    if (w->tree) {
+        if (!w->P || !w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp || !w->work ||
+            frames_kin_alloc_light(m, &w->kin) || tree_alloc(m, &w->t)) {
+            eq_ws_free(w);
+            return SM_NOMEM;
+        }
+        return SM_OK;
+    }
     if (!w->P || !w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp || !w->work || !w->ipiv ||
         frames_kin_alloc(m, &w->kin) || dm_alloc(&w->Kt, n, n) || dm_alloc(&w->M, n, n) ||
         dm_alloc(&w->H, n, n) || dm_alloc(&w->W, n, 2 * m->n_mp)) {
@@ -80,12 +92,21 @@ static int eq_ws_alloc(const sm_model *m, eq_ws *w)
     return SM_OK;
 }
 
+/* g = sum m J' r at the kinematics in w->kin. */
+static void eq_centrifugal(const sm_model *m, eq_ws *w)
+{
+    if (w->tree)
+        tree_centrifugal(m, &w->kin, &w->t, w->g);
+    else
+        frames_centrifugal(m, &w->kin, w->g);
+}
+
 /* F(q) at s = Omega^2; leaves the kinematics of q in w->kin.  Returns ||F||. */
 static double eq_residual(const sm_model *m, const double *q, double s, eq_ws *w)
 {
     int n = m->n;
     frames_eval(m, q, &w->kin);
-    frames_centrifugal(m, &w->kin, w->g);
+    eq_centrifugal(m, w);
     memset(w->F, 0, (size_t)n * sizeof(double));
     lin_elastic_force(m, q, w->F);
     if (m->opt.geometric_stiffening)
@@ -101,13 +122,19 @@ static double eq_residual(const sm_model *m, const double *q, double s, eq_ws *w
 static int eq_tangent(const sm_model *m, const double *q, double s, eq_ws *w)
 {
     int n = m->n;
+    if (w->tree) {
+        tree_assemble(m, q, &w->kin, s, 0, 0, &w->t);
+        return tree_factor(m, &w->t, 0);
+    }
     lin_tangent(m, q, &w->kin, s, 0, &w->Kt, &w->M, &w->H, &w->W, w->work);
     return dm_lapack_status(LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, n, n, w->Kt.a, n, w->ipiv), SM_SINGULAR);
 }
 
 /* x = Kt^-1 x with the LU in w.  Returns SM_OK or SM_LAPACK_FAILED. */
-static int eq_lu_solve(eq_ws *w, int n, double *x)
+static int eq_lu_solve(const sm_model *m, eq_ws *w, int n, double *x)
 {
+    if (w->tree)
+        return tree_solve(m, &w->t, x);
     return dm_lapack_status(LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', n, 1, w->Kt.a, n, w->ipiv, x, n),
                             SM_LAPACK_FAILED);
 }
@@ -116,6 +143,8 @@ static int eq_lu_solve(eq_ws *w, int n, double *x)
  * states means a critical point (limit or bifurcation) lies between them. */
 static int eq_det_sign(const eq_ws *w, int n)
 {
+    if (w->tree)
+        return w->t.det_sign;
     int sign = 1;
     for (int i = 0; i < n; i++) {
         double u = w->Kt.a[(size_t)i * n + i];
@@ -170,7 +199,7 @@ static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progre
         if (have_lu) { /* chord step */
             for (int i = 0; i < n; i++)
                 w->dq[i] = -w->F[i];
-            if ((rc = eq_lu_solve(w, n, w->dq)) < 0)
+            if ((rc = eq_lu_solve(m, w, n, w->dq)) < 0)
                 return rc;
             step = dm_norm(w->dq, n);
             for (int i = 0; i < n; i++)
@@ -187,7 +216,7 @@ static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progre
             have_lu = fresh = 1;
             for (int i = 0; i < n; i++)
                 w->dq[i] = -w->F[i];
-            if ((rc = eq_lu_solve(w, n, w->dq)) < 0)
+            if ((rc = eq_lu_solve(m, w, n, w->dq)) < 0)
                 return rc;
             step = dm_norm(w->dq, n);
             for (int tries = 0; tries < 8; tries++) {
@@ -262,11 +291,11 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
         /* predictor: Kt dq = g ds */
         memcpy(w.q0, q, (size_t)n * sizeof(double));
         frames_eval(m, q, &w.kin);
-        frames_centrifugal(m, &w.kin, w.g);
+        eq_centrifugal(m, &w);
         memcpy(w.qp, q, (size_t)n * sizeof(double));
         if (have_lu) {
             memcpy(w.dq, w.g, (size_t)n * sizeof(double));
-            if ((rc = eq_lu_solve(&w, n, w.dq)) < 0)
+            if ((rc = eq_lu_solve(m, &w, n, w.dq)) < 0)
                 goto fail;
             for (int i = 0; i < n; i++)
                 w.qp[i] += (sn - s) * w.dq[i];

@@ -23,6 +23,24 @@
 #include <stdlib.h>
 #include <string.h>
 
+int frames_kin_alloc_light(const sm_model *m, sm_kin *k)
+{
+    memset(k, 0, sizeof *k);
+    k->n = m->n;
+    k->theta = dm_vec((size_t)m->n_subs);
+    k->R = dm_vec(2 * (size_t)m->n_subs);
+    k->rn = dm_vec(3 * (size_t)m->n_nodes);
+    k->wn = dm_vec(2 * (size_t)m->n_nodes);
+    k->rp = dm_vec(2 * (size_t)m->n_mp);
+    k->wp = dm_vec(2 * (size_t)m->n_mp);
+    k->fext = dm_vec(2 * (size_t)m->n_nodes);
+    if (!k->theta || !k->R || !k->rn || !k->wn || !k->rp || !k->wp || !k->fext) {
+        frames_kin_free(k);
+        return SM_NOMEM;
+    }
+    return SM_OK;
+}
+
 int frames_kin_alloc(const sm_model *m, sm_kin *k)
 {
     memset(k, 0, sizeof *k);
@@ -79,6 +97,16 @@ static void frames_point(const sm_sub *b, const sm_kin *k, int s, const double *
     /* r = R + A w */
     r[0] = k->R[2 * s] + c * w[0] - si * w[1];
     r[1] = k->R[2 * s + 1] + si * w[0] + c * w[1];
+    (void)lim;
+    if (!k->Jn.a) { /* light kinematics (frames_kin_alloc_light): positions only */
+        if (phi) {
+            double p = th - b->theta0;
+            for (int j = 0; j < mm; j++)
+                p += Nphi[(size_t)ldn * j] * qs[j];
+            *phi = p;
+        }
+        return;
+    }
     /* J = J_R + (A' w) J_theta + A N E_s */
     double aw0 = -si * w[0] - c * w[1], aw1 = c * w[0] - si * w[1];
     const double *jrx = &DM(&k->JR, 0, 2 * s), *jry = &DM(&k->JR, 0, 2 * s + 1);
@@ -92,7 +120,6 @@ static void frames_point(const sm_sub *b, const sm_kin *k, int s, const double *
         jx[q0 + j] = c * n0 - si * n1;
         jy[q0 + j] = si * n0 + c * n1;
     }
-    (void)lim;
     if (jphi) {
         double p = th - b->theta0;
         for (int j = 0; j < q0; j++)
@@ -105,13 +132,16 @@ static void frames_point(const sm_sub *b, const sm_kin *k, int s, const double *
     }
 }
 
-/** Evaluate frames, node and mass-point positions and Jacobians at q. */
+/** Evaluate frames, node and mass-point positions and (unless k is light) Jacobians at q. */
 void frames_eval(const sm_model *m, const double *q, sm_kin *k)
 {
-    dm_zero(&k->Jth);
-    dm_zero(&k->JR);
-    dm_zero(&k->Jn);
-    dm_zero(&k->Jp);
+    int jac = k->Jn.a != NULL;
+    if (jac) {
+        dm_zero(&k->Jth);
+        dm_zero(&k->JR);
+        dm_zero(&k->Jn);
+        dm_zero(&k->Jp);
+    }
     const sm_node *c0 = &m->nodes[m->clamp_node];
     k->rn[3 * m->clamp_node] = c0->x;
     k->rn[3 * m->clamp_node + 1] = c0->y;
@@ -132,19 +162,21 @@ void frames_eval(const sm_model *m, const double *q, sm_kin *k)
             k->theta[s] = th;
             k->R[2 * s] = k->rn[3 * e];
             k->R[2 * s + 1] = k->rn[3 * e + 1];
-            int lim = p->q0 + p->m;
-            memcpy(&DM(&k->Jth, 0, s), &DM(&k->Jth, 0, b->parent), (size_t)lim * sizeof(double));
-            for (int j = 0; j < p->m; j++)
-                DM(&k->Jth, p->q0 + j, s) += DM(&p->N, 3 * a + 2, j);
-            memcpy(&DM(&k->JR, 0, 2 * s), &DM(&k->Jn, 0, 3 * e), (size_t)lim * sizeof(double));
-            memcpy(&DM(&k->JR, 0, 2 * s + 1), &DM(&k->Jn, 0, 3 * e + 1), (size_t)lim * sizeof(double));
+            if (jac) {
+                int lim = p->q0 + p->m;
+                memcpy(&DM(&k->Jth, 0, s), &DM(&k->Jth, 0, b->parent), (size_t)lim * sizeof(double));
+                for (int j = 0; j < p->m; j++)
+                    DM(&k->Jth, p->q0 + j, s) += DM(&p->N, 3 * a + 2, j);
+                memcpy(&DM(&k->JR, 0, 2 * s), &DM(&k->Jn, 0, 3 * e), (size_t)lim * sizeof(double));
+                memcpy(&DM(&k->JR, 0, 2 * s + 1), &DM(&k->Jn, 0, 3 * e + 1), (size_t)lim * sizeof(double));
+            }
         }
         for (int i = 0; i < b->nfree; i++) {
             int nd = b->free_nodes[i];
             const double *N = b->N.a + 3 * i;
-            frames_point(b, k, s, q, b->ubar + 2 * i, N, b->N.rows, N + 2,
-                         k->rn + 3 * nd, k->wn + 2 * nd, &DM(&k->Jn, 0, 3 * nd),
-                         &DM(&k->Jn, 0, 3 * nd + 1), &DM(&k->Jn, 0, 3 * nd + 2), k->rn + 3 * nd + 2);
+            frames_point(b, k, s, q, b->ubar + 2 * i, N, b->N.rows, N + 2, k->rn + 3 * nd, k->wn + 2 * nd,
+                         jac ? &DM(&k->Jn, 0, 3 * nd) : NULL, jac ? &DM(&k->Jn, 0, 3 * nd + 1) : NULL,
+                         jac ? &DM(&k->Jn, 0, 3 * nd + 2) : NULL, k->rn + 3 * nd + 2);
         }
     }
     for (int p = 0; p < m->n_mp; p++) {
@@ -155,12 +187,14 @@ void frames_eval(const sm_model *m, const double *q, sm_kin *k)
             k->rp[2 * p + 1] = k->rn[3 * nd + 1];
             k->wp[2 * p] = k->wn[2 * nd];
             k->wp[2 * p + 1] = k->wn[2 * nd + 1];
-            memcpy(&DM(&k->Jp, 0, 2 * p), &DM(&k->Jn, 0, 3 * nd), (size_t)lim * sizeof(double));
-            memcpy(&DM(&k->Jp, 0, 2 * p + 1), &DM(&k->Jn, 0, 3 * nd + 1), (size_t)lim * sizeof(double));
+            if (jac) {
+                memcpy(&DM(&k->Jp, 0, 2 * p), &DM(&k->Jn, 0, 3 * nd), (size_t)lim * sizeof(double));
+                memcpy(&DM(&k->Jp, 0, 2 * p + 1), &DM(&k->Jn, 0, 3 * nd + 1), (size_t)lim * sizeof(double));
+            }
         } else {
-            frames_point(&m->subs[mp->sub], k, mp->sub, q, mp->ub, mp->N, mp->ldn, NULL,
-                         k->rp + 2 * p, k->wp + 2 * p, &DM(&k->Jp, 0, 2 * p),
-                         &DM(&k->Jp, 0, 2 * p + 1), NULL, NULL);
+            frames_point(&m->subs[mp->sub], k, mp->sub, q, mp->ub, mp->N, mp->ldn, NULL, k->rp + 2 * p,
+                         k->wp + 2 * p, jac ? &DM(&k->Jp, 0, 2 * p) : NULL,
+                         jac ? &DM(&k->Jp, 0, 2 * p + 1) : NULL, NULL, NULL);
         }
     }
 }

@@ -161,6 +161,9 @@ typedef struct sm_kin {
 /** Allocate the arrays of *k (owned by k, frames_kin_free) for the sizes of m.
  *  Returns SM_OK or SM_NOMEM (then *k is freed and zeroed). */
 int frames_kin_alloc(const sm_model *m, sm_kin *k);
+/** Like frames_kin_alloc without the dense Jacobians (Jth, JR, Jn, Jp, Jtha stay empty): O(size)
+ *  memory; frames_eval then computes positions only (tree.c works on this). */
+int frames_kin_alloc_light(const sm_model *m, sm_kin *k);
 /** Free the arrays of *k and zero it; safe on a zeroed or freed sm_kin. */
 void frames_kin_free(sm_kin *k);
 /** Kinematics at q (n coordinates): frame angles and origins through the chain (eq. 36), node
@@ -181,6 +184,10 @@ void lin_geometric_force(const sm_model *m, const double *q, double *fg);
 /** Kt += d f_g/dq at q; frozen != 0: P_e held at P_e(q) (the paper's K*, symmetric), else the full
  *  derivative (Newton).  work: >= 4 max m_s doubles. */
 void lin_geometric_tangent(const sm_model *m, const double *q, int frozen, dmat *Kt, double *work);
+/** A += d f_g,s/dq_s of substructure s alone, m_s x m_s with leading dimension lda (the diagonal
+ *  block of lin_geometric_tangent); frozen as there.  work: >= 4 max m_s doubles. */
+void lin_geometric_tangent_sub(const sm_model *m, int s, const double *q, int frozen, double *A, int lda,
+                               double *work);
 /** P[e] = d_e . q_s, the axial force of every FE element (eq. 24), N; P: n_elems. */
 void lin_axial_forces(const sm_model *m, const double *q, double *P);
 /** f += K q, K = blockdiag(N_s' Kbar_s N_s) (eq. 11); f: n. */
@@ -231,6 +238,58 @@ typedef struct sm_progress {
 int eq_solve(const sm_model *m, double *q, double s_from, double s_to,
              int from_rest, sm_progress *pr, sm_eq_out *out);
 
+/* --------------------------------------------------------------- tree.c */
+/* The linearised equations in block form along the frame tree (see the header of tree.c):
+ * local blocks on (dy_s, dq_s) per substructure, a leaves-first block factorisation, O(n)
+ * products and solves. */
+typedef struct tree_ws {
+    int S, n;           /* substructures, coordinates */
+    int max_m;          /* largest m_s */
+    int *mp_ptr;        /* S+1: mass points of s are mp_idx[mp_ptr[s] .. mp_ptr[s+1]) */
+    int *mp_idx;        /* n_mp mass point indices grouped by substructure */
+    size_t *loc_off;    /* S+1: offset of the (3+m_s)^2 local blocks of s in Kl, Ml, Cl */
+    size_t *fr_off;     /* S+1: offset of the (m_s+6)^2 front of s in F */
+    size_t *v_off;      /* S+1: offset of the m_s+6 vector of s in z and ipiv (x3 in X) */
+    double *Kl;         /* local K* (or Newton tangent) blocks, order (theta frame pose 3, q_s) */
+    double *Ml;         /* local M* blocks */
+    double *Cl;         /* local C* blocks without the factor 2 Omega */
+    double *F;          /* fronts: factors after tree_factor */
+    double *X;          /* (m_s+6) x 3 per s: F_s^-1 E_w */
+    int *ipiv;          /* pivots of the fronts */
+    double *lk;         /* 4 per s: cos, sin of the parent's angle and A' w_e (the link T_s) */
+    double *z;          /* sum (m_s+6): solve vector */
+    double *u, *v;      /* 3 S each: forward / adjoint recursion vectors */
+    double *work;       /* small scratch */
+    double omega;       /* Omega of the last tree_assemble (C* = 2 Omega Cl) */
+    int sym;            /* fronts factored by dsytrf (1) or dgetrf (0) */
+    int neg;            /* negative eigenvalues of the factored matrix (sym) */
+    int det_sign;       /* sign of its determinant (LU) */
+} tree_ws;
+
+enum { TREE_K = 0, TREE_M = 1, TREE_C = 2 };
+
+/** 1 when solves of m use the tree path: m->opt.solver, or by size for SM_SOLVER_AUTO. */
+int tree_use(const sm_model *m);
+/** Allocate *t for m (O(sum m_s^2)); SM_OK or SM_NOMEM (then *t is zeroed). */
+int tree_alloc(const sm_model *m, tree_ws *t);
+/** Free and zero *t; safe on a zeroed one. */
+void tree_free(tree_ws *t);
+/** g (n) = sum_p m_p J_p' r_p at the (light) kinematics k, as frames_centrifugal. */
+void tree_centrifugal(const sm_model *m, const sm_kin *k, tree_ws *t, double *g);
+/** Local blocks at q (kinematics k of q; k->fext is scratch) for s2 = Omega^2: Kl of the Newton
+ *  tangent (frozen 0) or of K* (frozen 1), Ml, and Cl when gyro.  Returns 1 when all are finite. */
+int tree_assemble(const sm_model *m, const double *q, sm_kin *k, double s2, int frozen, int gyro, tree_ws *t);
+/** Factor the block system of Kl (after tree_assemble): sym = 1 for K* (sets t->neg, the negative
+ *  eigenvalues of K*), 0 for the tangent (sets t->det_sign = sign det).  SM_OK, SM_SINGULAR (a
+ *  singular front), SM_NOMEM or SM_LAPACK_FAILED. */
+int tree_factor(const sm_model *m, tree_ws *t, int sym);
+/** x = K^-1 x (n) with the factors of tree_factor.  SM_OK or SM_LAPACK_FAILED. */
+int tree_solve(const sm_model *m, tree_ws *t, double *x);
+/** y = A x for A = K (TREE_K), M* (TREE_M) or C* (TREE_C) of the last tree_assemble; x, y: n. */
+void tree_apply(const sm_model *m, tree_ws *t, int which, const double *x, double *y);
+/** d (3 n_nodes) = nodal (dx, dy, dphi) = J_k x in the hub frame at the kinematics k. */
+void tree_nodal(const sm_model *m, const sm_kin *k, tree_ws *t, const double *x, double *d);
+
 /* -------------------------------------------------------------- eigen.c */
 /* Eigen-analysis output; arrays owned by the struct (eig_out_free). */
 typedef struct sm_eig_out {
@@ -253,6 +312,14 @@ typedef struct sm_eig_out {
  */
 int eig_solve(int n, const dmat *M, const dmat *C, const dmat *K, int coriolis,
               int modes, sm_eig_out *out);
+/**
+ * The same analysis on the tree form (tree_assemble with frozen = 1 and gyro = coriolis done):
+ * factors K*, and when K* is positive definite finds the lowest modes by shift-invert Arnoldi and
+ * a projection solved by eig_solve (see tree.c).  *fallback receives 1 when the dense path must be
+ * used instead (K* not positive definite, a singular front, no convergence); then *out is empty
+ * and the return is SM_OK.  Returns SM_OK, SM_NOMEM or SM_LAPACK_FAILED.
+ */
+int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, sm_eig_out *out, int *fallback);
 /** Free the arrays of *o and zero it; safe on a zeroed or freed sm_eig_out. */
 void eig_out_free(sm_eig_out *o);
 

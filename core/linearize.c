@@ -95,50 +95,59 @@ void lin_geometric_force(const sm_model *m, const double *q, double *f)
 }
 
 /**
- * Kt += d f_g / dq.  frozen != 0: P_e held at P_e(q) (K*, symmetric);
- * otherwise the full derivative, adding (T' G T q) d_e'.  work: >= 4*max m.
+ * A += d f_g,s / dq_s for substructure s alone (m_s x m_s, leading dimension
+ * lda).  frozen != 0: P_e held at P_e(q) (K*, symmetric); otherwise the full
+ * derivative, adding (T' G T q) d_e'.  work: >= 4*max m.
  */
-void lin_geometric_tangent(const sm_model *m, const double *q, int frozen, dmat *Kt, double *work)
+void lin_geometric_tangent_sub(const sm_model *m, int s, const double *q, int frozen, double *A, int lda,
+                               double *work)
 {
     static const int rows[4] = {1, 2, 4, 5};
-    for (int s = 0; s < m->n_subs; s++) {
-        const sm_sub *b = &m->subs[s];
-        const double *qs = q + b->q0;
-        int mm = b->m, q0 = b->q0;
-        double *V = work; /* 4 x mm: V = G Tb */
-        for (int j = 0; j < b->nel; j++) {
-            double tb[4];
-            double P = lin_element_state(b, j, qs, tb);
-            const double *g = b->gq + 16 * j, *d = b->d + (size_t)j * mm;
-            for (int c = 0; c < mm; c++)
-                for (int r = 0; r < 4; r++) {
-                    double t = 0;
-                    for (int p = 0; p < 4; p++)
-                        t += g[r + 4 * p] * DM(&b->T, 6 * j + rows[p], c);
-                    V[r + 4 * c] = t;
-                }
-            /* Kt_s += P Tb' V */
-            for (int jc = 0; jc < mm; jc++)
-                for (int ic = 0; ic < mm; ic++) {
-                    double t = 0;
-                    for (int r = 0; r < 4; r++)
-                        t += DM(&b->T, 6 * j + rows[r], ic) * V[r + 4 * jc];
-                    DM(Kt, q0 + ic, q0 + jc) += P * t;
-                }
-            if (!frozen) {
-                /* + (Tb' G tb) d' */
-                double gt[4];
+    const sm_sub *b = &m->subs[s];
+    const double *qs = q + b->q0;
+    int mm = b->m;
+    double *V = work; /* 4 x mm: V = G Tb */
+    for (int j = 0; j < b->nel; j++) {
+        double tb[4];
+        double P = lin_element_state(b, j, qs, tb);
+        const double *g = b->gq + 16 * j, *d = b->d + (size_t)j * mm;
+        for (int c = 0; c < mm; c++)
+            for (int r = 0; r < 4; r++) {
+                double t = 0;
+                for (int p = 0; p < 4; p++)
+                    t += g[r + 4 * p] * DM(&b->T, 6 * j + rows[p], c);
+                V[r + 4 * c] = t;
+            }
+        /* A += P Tb' V */
+        for (int jc = 0; jc < mm; jc++)
+            for (int ic = 0; ic < mm; ic++) {
+                double t = 0;
                 for (int r = 0; r < 4; r++)
-                    gt[r] = g[r] * tb[0] + g[r + 4] * tb[1] + g[r + 8] * tb[2] + g[r + 12] * tb[3];
-                for (int ic = 0; ic < mm; ic++) {
-                    double t = 0;
-                    for (int r = 0; r < 4; r++)
-                        t += DM(&b->T, 6 * j + rows[r], ic) * gt[r];
-                    for (int jc = 0; jc < mm; jc++)
-                        DM(Kt, q0 + ic, q0 + jc) += t * d[jc];
-                }
+                    t += DM(&b->T, 6 * j + rows[r], ic) * V[r + 4 * jc];
+                A[(size_t)jc * lda + ic] += P * t;
+            }
+        if (!frozen) {
+            /* + (Tb' G tb) d' */
+            double gt[4];
+            for (int r = 0; r < 4; r++)
+                gt[r] = g[r] * tb[0] + g[r + 4] * tb[1] + g[r + 8] * tb[2] + g[r + 12] * tb[3];
+            for (int ic = 0; ic < mm; ic++) {
+                double t = 0;
+                for (int r = 0; r < 4; r++)
+                    t += DM(&b->T, 6 * j + rows[r], ic) * gt[r];
+                for (int jc = 0; jc < mm; jc++)
+                    A[(size_t)jc * lda + ic] += t * d[jc];
             }
         }
+    }
+}
+
+/** Kt += d f_g / dq: the blocks of lin_geometric_tangent_sub on the diagonal. */
+void lin_geometric_tangent(const sm_model *m, const double *q, int frozen, dmat *Kt, double *work)
+{
+    for (int s = 0; s < m->n_subs; s++) {
+        const sm_sub *b = &m->subs[s];
+        lin_geometric_tangent_sub(m, s, q, frozen, &DM(Kt, b->q0, b->q0), Kt->rows, work);
     }
 }
 

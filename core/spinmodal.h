@@ -125,7 +125,18 @@ typedef struct sm_options {
     int min_increments;              /* increments in Omega^2 from rest, default 5 */
     int max_iterations;              /* Newton iterations per increment, default 40 */
     double tolerance;                /* ||dq|| <= tol*max(1,||q||), default 1e-10 */
+    /* Linear algebra (not part of the JSON request; results do not depend on it beyond
+     * round-off): SM_SOLVER_AUTO (default) picks by size; the others force a path (tests,
+     * benchmarks). */
+    int solver;                      /* sm_solver */
 } sm_options;
+
+/** Linear-algebra path of a solve (sm_options.solver). */
+typedef enum sm_solver {
+    SM_SOLVER_AUTO = 0,              /* dense for small models, tree-structured for large ones */
+    SM_SOLVER_DENSE,                 /* dense matrices in the modal coordinates, LAPACK */
+    SM_SOLVER_TREE                   /* block recursion along the frame tree + shift-invert Krylov */
+} sm_solver;
 
 /** Fill *o with the defaults of DESIGN.md section 3. */
 void sm_default_options(sm_options *o);

@@ -40,11 +40,14 @@ void sm_result_free(sm_result *r)
     free(r);
 }
 
-/* Linearised matrices at q: M*, C* (coriolis), K* = K + Kg(P frozen) - s (M* + H). */
+/* Linearised matrices at q: M*, C* (coriolis), K* = K + Kg(P frozen) - s (M* + H): dense n x n,
+ * or (tree != 0) the local blocks of tree.c with light kinematics (O(n) memory). */
 typedef struct sweep_lin {
+    int tree;           /* 1: tree form (t, light kin); 0: dense matrices */
     sm_kin kin;
     dmat M, C, K, H, W, X;
     double *work;
+    tree_ws t;
 } sweep_lin;
 
 static void sweep_lin_free(sweep_lin *L)
@@ -57,15 +60,24 @@ static void sweep_lin_free(sweep_lin *L)
     dm_free(&L->W);
     dm_free(&L->X);
     free(L->work);
+    tree_free(&L->t);
 }
 
-static int sweep_lin_alloc(const sm_model *m, sweep_lin *L)
+static int sweep_lin_alloc(const sm_model *m, sweep_lin *L, int tree)
 {
     int n = m->n, mx = 1;
     memset(L, 0, sizeof *L);
+    L->tree = tree;
     for (int s = 0; s < m->n_subs; s++)
         mx = m->subs[s].m > mx ? m->subs[s].m : mx;
     L->work = dm_vec((size_t)(4 * mx + n));
+    if (tree) {
+        if (!L->work || frames_kin_alloc_light(m, &L->kin) || tree_alloc(m, &L->t)) {
+            sweep_lin_free(L);
+            return SM_NOMEM;
+        }
+        return SM_OK;
+    }
     if (!L->work || frames_kin_alloc(m, &L->kin) || dm_alloc(&L->M, n, n) || dm_alloc(&L->C, n, n) ||
         dm_alloc(&L->K, n, n) || dm_alloc(&L->H, n, n) || dm_alloc(&L->W, n, 2 * m->n_mp) ||
         dm_alloc(&L->X, n, n)) {
@@ -75,42 +87,54 @@ static int sweep_lin_alloc(const sm_model *m, sweep_lin *L)
     return SM_OK;
 }
 
-static void sweep_linearize(const sm_model *m, const double *q, double omega, sweep_lin *L)
+/* Linearise at q; returns 1 when the tree blocks are finite (always 1 for the dense form,
+ * whose finiteness sweep_eigen_failed checks). */
+static int sweep_linearize(const sm_model *m, const double *q, double omega, sweep_lin *L)
 {
     int n = m->n;
     double s = omega * omega;
     frames_eval(m, q, &L->kin);
+    if (L->tree)
+        return tree_assemble(m, q, &L->kin, s, 1, m->opt.coriolis, &L->t); /* K*, P frozen; M*; C* */
     lin_tangent(m, q, &L->kin, s, 1, &L->K, &L->M, &L->H, &L->W, L->work); /* K*, P frozen; M* */
     if (m->opt.coriolis)
         lin_gyro(m, &L->kin, omega, &L->C, &L->W, &L->X);
     for (int j = 0; j < n; j++) /* symmetric up to round-off: make it exact */
         for (int i = 0; i < j; i++)
             DM(&L->K, i, j) = DM(&L->K, j, i) = 0.5 * (DM(&L->K, i, j) + DM(&L->K, j, i));
+    return 1;
 }
 
 /* Nodal shapes (dx, dy, dphi) = J_k x in the hub frame; largest translation = 1. */
-static void sweep_shapes(const sm_model *m, const sm_kin *k, const sm_eig_out *e, double *sr, double *si)
+static void sweep_shapes(const sm_model *m, sweep_lin *L, const sm_eig_out *e, double *sr, double *si)
 {
     int n = m->n, nn = m->n_nodes;
+    const sm_kin *k = &L->kin;
     for (int j = 0; j < e->n_modes; j++) {
         const double *xr = e->xre + (size_t)j * n, *xi = e->xim + (size_t)j * n;
         double *yr = sr + (size_t)j * 3 * nn, *yi = si + (size_t)j * 3 * nn;
-        double best = -1;
-        double complex piv = 1;
-        for (int c = 0; c < 3 * nn; c++) {
-            const double *jc = &DM(&k->Jn, 0, c);
-            double a = 0, b = 0;
-            for (int i = 0; i < n; i++) {
-                a += jc[i] * xr[i];
-                b += jc[i] * xi[i];
-            }
-            yr[c] = a;
-            yi[c] = b;
-            if (c % 3 != 2 && hypot(a, b) > best) {
-                best = hypot(a, b);
-                piv = a + I * b;
+        if (L->tree) {
+            tree_nodal(m, k, &L->t, xr, yr);
+            tree_nodal(m, k, &L->t, xi, yi);
+        } else {
+            for (int c = 0; c < 3 * nn; c++) {
+                const double *jc = &DM(&k->Jn, 0, c);
+                double a = 0, b = 0;
+                for (int i = 0; i < n; i++) {
+                    a += jc[i] * xr[i];
+                    b += jc[i] * xi[i];
+                }
+                yr[c] = a;
+                yi[c] = b;
             }
         }
+        double best = -1;
+        double complex piv = 1;
+        for (int c = 0; c < 3 * nn; c++)
+            if (c % 3 != 2 && hypot(yr[c], yi[c]) > best) {
+                best = hypot(yr[c], yi[c]);
+                piv = yr[c] + I * yi[c];
+            }
         if (!(best > 0))
             continue;
         for (int c = 0; c < 3 * nn; c++) {
@@ -230,20 +254,57 @@ static int sweep_eigen_failed(sm_case *c, int rc, int finite)
     return SM_OK;
 }
 
+/*
+ * Linearisation and eigen-analysis at q into e, with the form of L; the tree form
+ * falls back to the dense one (allocated here into *D, *use pointing at it) when
+ * eig_solve_tree asks for it.  *finite: 0 when the matrices have non-finite entries.
+ * Returns the status of the eigen-analysis (SM_NOMEM also for the fallback's allocation).
+ */
+static int sweep_eigen(const sm_model *m, const double *q, sweep_lin *L, sweep_lin *D, sweep_lin **use,
+                       sm_case *c, sm_eig_out *e, int *finite)
+{
+    int rc, fallback = 1;
+    double t0 = sweep_ms(), t1;
+    *use = L;
+    *finite = 1;
+    memset(e, 0, sizeof *e);
+    if (L->tree) {
+        int fin = sweep_linearize(m, q, c->omega, L);
+        t1 = sweep_ms();
+        c->t_linearize = t1 - t0;
+        if (fin && (rc = eig_solve_tree(m, &L->t, m->opt.coriolis, m->opt.modes, e, &fallback)) < 0)
+            return rc;
+        c->t_eigen = sweep_ms() - t1;
+        if (!fallback)
+            return SM_OK;
+        if ((rc = sweep_lin_alloc(m, D, 0)) < 0) /* the dense path decides */
+            return rc;
+        *use = D;
+        t0 = sweep_ms();
+    }
+    sweep_linearize(m, q, c->omega, *use);
+    t1 = sweep_ms();
+    rc = eig_solve(m->n, &(*use)->M, &(*use)->C, &(*use)->K, m->opt.coriolis, m->opt.modes, e);
+    c->t_linearize += t1 - t0;
+    c->t_eigen += sweep_ms() - t1;
+    if (rc < 0)
+        *finite = dm_finite(&(*use)->K) && dm_finite(&(*use)->M) && dm_finite(&(*use)->C);
+    return rc;
+}
+
 /* Modes of case c at the equilibrium q.  An eigen-analysis failure is
  * reported on the case (sweep_eigen_failed); returns SM_OK or SM_NOMEM. */
 static int sweep_modes(const sm_model *m, const double *q, sweep_lin *L, sm_case *c)
 {
     sm_eig_out e;
-    double t0 = sweep_ms();
-    sweep_linearize(m, q, c->omega, L);
-    double t1 = sweep_ms();
-    int rc = eig_solve(m->n, &L->M, &L->C, &L->K, m->opt.coriolis, m->opt.modes, &e);
-    double t2 = sweep_ms();
-    c->t_linearize = t1 - t0;
-    c->t_eigen = t2 - t1;
-    if (rc < 0)
-        return sweep_eigen_failed(c, rc, dm_finite(&L->K) && dm_finite(&L->M) && dm_finite(&L->C));
+    sweep_lin D, *use = L;
+    int finite = 1;
+    memset(&D, 0, sizeof D);
+    int rc = sweep_eigen(m, q, L, &D, &use, c, &e, &finite);
+    if (rc < 0) {
+        sweep_lin_free(&D);
+        return sweep_eigen_failed(c, rc, finite);
+    }
     int k = e.n_modes, nn = m->n_nodes;
     c->n_modes = k;
     c->frequency = dm_vec((size_t)k);
@@ -256,6 +317,7 @@ static int sweep_modes(const sm_model *m, const double *q, sweep_lin *L, sm_case
     if (!c->frequency || !c->eig_re || !c->eig_im || !c->mac_to_previous || !c->previous_index ||
         !c->shape_re || !c->shape_im) {
         eig_out_free(&e);
+        sweep_lin_free(&D);
         return SM_NOMEM;
     }
     for (int j = 0; j < k; j++) {
@@ -263,13 +325,14 @@ static int sweep_modes(const sm_model *m, const double *q, sweep_lin *L, sm_case
         c->eig_im[j] = e.wim[j];
         c->frequency[j] = fabs(e.wim[j]);
     }
-    sweep_shapes(m, &L->kin, &e, c->shape_re, c->shape_im);
+    sweep_shapes(m, use, &e, c->shape_re, c->shape_im);
     c->negative_eigenvalues = e.negative;
     c->max_real_part = e.max_re;
     double scale = k ? hypot(e.wre[k - 1], e.wim[k - 1]) : 1;
     c->stable = e.negative == 0 && !(e.max_re > 1e-8 * fmax(scale, 1e-3));
     c->status = c->stable ? SM_CASE_SOLVED : SM_CASE_UNSTABLE;
     eig_out_free(&e);
+    sweep_lin_free(&D);
     return SM_OK;
 }
 
@@ -323,7 +386,7 @@ int sm_solve(const sm_model *m, const double *omegas, int n_omegas, sm_progress_
     if (!r->cases)
         goto fail;
     r->n_cases = n_omegas;
-    if ((rc = sweep_lin_alloc(m, &L)) < 0)
+    if ((rc = sweep_lin_alloc(m, &L, tree_use(m))) < 0)
         goto fail;
     have_lin = 1;
     for (int i = 0; i < n_omegas; i++) {

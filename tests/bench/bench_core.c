@@ -160,9 +160,49 @@ done:
     return rc;
 }
 
+/*
+ * Growth series (issue 14): the planar beta = 90 deg beam with e elements per member, per-element
+ * frames, Omega = 20, Coriolis on, no mode shapes, one speed from rest; sm_model_new + sm_solve
+ * wall time with the given solver.  One process per point, so that /usr/bin/time -v measures the
+ * whole process (tests/bench/growth.sh).  Prints "elements coordinates ms w1 w2 w3".
+ */
+static int bench_growth_one(int elements, int solver)
+{
+    static const double joint_xy[] = {0, 0, 5, 0, 5, 5};
+    static const sm_section sec[] = {{7e10, 4e-4, 2e-7, 1.2}};
+    sm_member mem[2] = {{0, 1, 0, elements / 2}, {1, 2, 0, elements - elements / 2}};
+    sm_structure st = {3, joint_xy, 1, sec, 2, mem, 0, NULL, 0};
+    sm_options o;
+    sm_model *m = NULL;
+    sm_result *r = NULL;
+    sm_diag d;
+    double w = 20.0, t0 = bench_now_ms();
+    sm_default_options(&o);
+    o.mode_shapes = 0;
+    o.solver = solver;
+    int rc = sm_model_new(&m, &st, &o, &d);
+    if (rc == SM_OK)
+        rc = sm_solve(m, &w, 1, NULL, NULL, &r, &d);
+    double ms = bench_now_ms() - t0;
+    if (rc < 0) {
+        fprintf(stderr, "growth %d: %s: %s\n", elements, sm_strerror(rc), d.message);
+    } else {
+        sm_model_info info;
+        sm_model_get_info(m, &info);
+        printf("%d %d %.2f", elements, info.coordinates, ms);
+        for (int i = 0; i < r->cases[0].n_modes && i < 3; i++)
+            printf(" %.12g", r->cases[0].frequency[i]);
+        printf("\n");
+    }
+    sm_result_free(r);
+    sm_model_free(m);
+    return rc < 0 ? 1 : 0;
+}
+
 static void bench_usage(FILE *f)
 {
     fprintf(f, "usage: bench_core [--min-reps N] [--max-reps N] [--seconds S] [a|b|c ...]\n"
+               "       bench_core --growth ELEMENTS auto|dense|tree   (one solve; see growth.sh)\n"
                "  times sm_model_new + sm_solve for the angled beam (beta 90 deg), median of\n"
                "  repetitions; defaults: --min-reps 5 --max-reps 200 --seconds 2 (per case)\n");
 }
@@ -189,6 +229,11 @@ int main(int argc, char **argv)
     double seconds = 2.0;
     int run[3] = {0, 0, 0}, any = 0;
 
+    if (argc == 4 && !strcmp(argv[1], "--growth")) {
+        int solver = !strcmp(argv[3], "dense") ? SM_SOLVER_DENSE : !strcmp(argv[3], "tree") ? SM_SOLVER_TREE
+                                                                                            : SM_SOLVER_AUTO;
+        return bench_growth_one(atoi(argv[2]), solver);
+    }
     for (i = 1; i < argc; i++) {
         if (!strcmp(argv[i], "--min-reps") && i + 1 < argc)
             min_reps = atoi(argv[++i]);
