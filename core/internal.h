@@ -270,6 +270,13 @@ enum { TREE_K = 0, TREE_M = 1, TREE_C = 2 };
 
 /** 1 when solves of m use the tree path: m->opt.solver, or by size for SM_SOLVER_AUTO. */
 int tree_use(const sm_model *m);
+
+/**
+ * The choice of tree_use from sizes alone (for sm_structure_check, before any
+ * basis exists): solver is sm_options.solver, n the coordinates, max_m the
+ * largest frame's coordinates, modes the modes requested.
+ */
+int tree_choose(int solver, int n, int max_m, int modes);
 /** Allocate *t for m (O(sum m_s^2)); SM_OK or SM_NOMEM (then *t is zeroed). */
 int tree_alloc(const sm_model *m, tree_ws *t);
 /** Free and zero *t; safe on a zeroed one. */

@@ -147,6 +147,8 @@ int sm_structure_check(const sm_structure *st, const sm_options *opt, sm_model_i
             if (k > info->max_frame_coordinates)
                 info->max_frame_coordinates = k;
         }
+        info->structured = tree_choose(m->opt.solver, info->coordinates,
+                                       info->max_frame_coordinates, m->opt.modes);
     }
     sm_model_free(m);
     return SM_OK;
@@ -159,6 +161,7 @@ void sm_model_get_info(const sm_model *m, sm_model_info *info)
     for (int s = 0; s < m->n_subs; s++)
         if (m->subs[s].m > info->max_frame_coordinates)
             info->max_frame_coordinates = m->subs[s].m;
+    info->structured = tree_use(m);
 }
 
 int sm_model_joint_node(const sm_model *m, int joint)

@@ -29,7 +29,7 @@
 extern "C" {
 #endif
 
-#define SM_VERSION "0.2.0"
+#define SM_VERSION "0.3.0"
 
 /* One status table for the whole project (X-macro: name, value, text). */
 #define SM_STATUS_MAP(X)                                                       \
@@ -193,6 +193,9 @@ typedef struct sm_model_info {
     int max_frame_nodes; /* largest number of FE nodes in one substructure (its component-mode
                             problem has ~3x that many DOF); free nodes: the frame's root node,
                             clamped in its basis, is not counted, so the DOF are exactly 3x */
+    int structured;     /* 1 when the solves take the tree-structured path (cost ~ linear in
+                           the size; sm_options.solver, or the automatic choice by size),
+                           0 for the dense path (cost ~ coordinates^3) */
 } sm_model_info;
 
 /** Sizes of the model m (borrowed) into *info. */

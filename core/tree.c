@@ -74,16 +74,21 @@
 #define TREE_EIG_TOL 1e-11
 #define TREE_EIG_MAX_BASIS 240
 
+int tree_choose(int solver, int n, int max_m, int modes)
+{
+    if (solver == SM_SOLVER_DENSE)
+        return 0;
+    if (solver == SM_SOLVER_TREE)
+        return 1;
+    return n >= TREE_AUTO_MIN_N && max_m <= TREE_MAX_FRAME_M && 8 * modes <= n;
+}
+
 int tree_use(const sm_model *m)
 {
-    if (m->opt.solver == SM_SOLVER_DENSE)
-        return 0;
-    if (m->opt.solver == SM_SOLVER_TREE)
-        return 1;
     int mx = 0;
     for (int s = 0; s < m->n_subs; s++)
         mx = m->subs[s].m > mx ? m->subs[s].m : mx;
-    return m->n >= TREE_AUTO_MIN_N && mx <= TREE_MAX_FRAME_M && 8 * m->opt.modes <= m->n;
+    return tree_choose(m->opt.solver, m->n, mx, m->opt.modes);
 }
 
 void tree_free(tree_ws *t)

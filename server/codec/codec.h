@@ -43,8 +43,9 @@ typedef struct codec_limits {
     int max_modes;            /* analysis.modes, default 200 */
     long max_shape_values;    /* numbers in the mode shapes of a result (speeds x modes x
                                  nodes x 3, x 2 with Coriolis), default 4e6 (~90 MB JSON) */
-    int max_coordinates;      /* modal coordinates of the model (the size of the dense Newton
-                                 and eigen problems: cost ~ n^3), default 4000 */
+    int max_coordinates;      /* modal coordinates of a model solved by the dense path (cost
+                                 ~ n^3; models the tree-structured path takes are bounded by
+                                 max_elements only), default 4000 */
     int max_frame_dofs;       /* degrees of freedom of one substructure's component-mode
                                  problem (3 x its free nodes; cost ~ dofs^3 each), default 1200
                                  (~3 s on one core) */

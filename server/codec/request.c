@@ -234,14 +234,16 @@ static int req_check_model(codec_request *r, const codec_limits *lim, codec_erro
                          dofs, r->info.max_frame_nodes, lim->max_frame_dofs,
                          lim->max_frame_dofs / 3) == SM_NOMEM)
         return SM_NOMEM;
-    if (r->info.coordinates > lim->max_coordinates &&
+    if (!r->info.structured && r->info.coordinates > lim->max_coordinates &&
         codec_errors_add(errs, "/structure",
                          "the model would have %d modal coordinates, more than the limit of %d "
-                         "(the dense Newton and eigen problems cost ~n^3): use fewer elements, "
-                         "or fewer frames with \"modes_per_frame\"",
+                         "for the dense solvers (cost ~n^3; frames of more than 40 coordinates "
+                         "or many modes requested need them): use per-element frames or small "
+                         "frames, fewer elements, or \"modes_per_frame\"",
                          r->info.coordinates, lim->max_coordinates) == SM_NOMEM)
         return SM_NOMEM;
-    return dofs > lim->max_frame_dofs || r->info.coordinates > lim->max_coordinates
+    return dofs > lim->max_frame_dofs ||
+                   (!r->info.structured && r->info.coordinates > lim->max_coordinates)
                ? SM_INVALID_INPUT
                : SM_OK;
 }
