@@ -22,6 +22,12 @@
 #include "codec.h"
 #include "spinmodal.h"
 
+/* OpenBLAS: the program chooses its BLAS threads (weak: a reference BLAS links too). */
+extern void openblas_set_num_threads(int n) __attribute__((weak));
+
+/* Dense models at least this large (coordinates) keep OpenBLAS's default threads. */
+#define CLI_BLAS_THREADED_FROM 1000
+
 enum {
     CLI_OK = 0,
     CLI_FAILED = 1,
@@ -173,12 +179,30 @@ static int cli_output(const cli_args *a, const codec_run_out *out)
     return out->outcome == CODEC_RUN_PARTIAL ? CLI_NO_EQUILIBRIUM : CLI_OK;
 }
 
+/*
+ * BLAS threads for this solve, chosen by the program (issue: threads
+ * fighting over small matrices made a 48-element solve 6x slower on a busy
+ * machine): one thread unless the model takes the dense path with at least
+ * CLI_BLAS_THREADED_FROM coordinates, where threaded factorisations pay.  An
+ * explicit OPENBLAS_NUM_THREADS in the environment is left alone.
+ */
+static void cli_blas_threads(const codec_request *req)
+{
+    const sm_model_info *info = codec_request_model_info(req);
+
+    if (!openblas_set_num_threads || getenv("OPENBLAS_NUM_THREADS"))
+        return;
+    if (info->structured || info->coordinates < CLI_BLAS_THREADED_FROM)
+        openblas_set_num_threads(1);
+}
+
 /* Solve a validated request through the codec's pipeline and print; returns an exit code. */
 static int cli_solve(const cli_args *a, const codec_request *req, codec_errors *errs)
 {
     codec_run_out out;
     int rc;
 
+    cli_blas_threads(req);
     switch (codec_run(req, a->csv ? CODEC_RUN_CSV : CODEC_RUN_JSON, NULL, NULL, errs, &out)) {
     case CODEC_RUN_DONE:
     case CODEC_RUN_PARTIAL:
