@@ -5,8 +5,16 @@
  * the caller answers, and workers claim the oldest queued job from it
  * (store_claim_next), so a restart or a second process sees the same
  * queue.  This module keeps the in-memory half:
- *   - `queued`, the number of queued jobs, for the 429 bound (initialised
- *     from the store, +1 per accepted submission, -1 per claim or cancel);
+ *   - `queued`, the number of queued jobs, for the 429 bound and the
+ *     queue-depth gauge only (initialised from the store, +1 per accepted
+ *     submission or requeue, -1 per claim or cancel; resynchronised with the
+ *     store when a claim finds nothing, unless a change raced the count);
+ *   - `posted`, bumped after every commit that makes a job queued: an idle
+ *     worker sleeps only while it is unchanged since before its last empty
+ *     claim (and at most JOBS_IDLE_POLL s, for jobs of another process), and
+ *     after a successful claim it claims again at once.  Whether a worker
+ *     sleeps never depends on `queued`: an approximate count must not be
+ *     able to strand committed jobs;
  *   - one slot per worker with the running job's id, live progress and its
  *     cancel flag, read by the core's progress callback after every Newton
  *     iteration and every speed (cancel, time limit, shutdown);
@@ -61,6 +69,9 @@ struct jobs {
     pthread_cond_t work_cv;    /* workers: a job was queued, or stopping */
     pthread_cond_t done_cv;    /* waiters: a job finished (gen changed), or stopping */
     int queued;
+    unsigned long long posted; /* bumped after each commit that makes a job queued */
+    unsigned long long qver;   /* bumped on each change of `queued` (see jobs_resync) */
+    int reserving;             /* submissions between their reservation and their commit */
     int stopping;              /* no new submissions, workers leave their loop */
     int stop_now;              /* running jobs stop and go back to the queue */
     int alive, busy;
@@ -123,6 +134,15 @@ static void jobs_bump(jobs *j)
     j->gen++;
     pthread_cond_broadcast(&j->done_cv);
     pthread_mutex_unlock(&j->lock);
+}
+
+/* A job became queued in the store (committed): count it, wake an idle worker.  Lock held. */
+static void jobs_posted_locked(jobs *j)
+{
+    j->queued++;
+    j->qver++;
+    j->posted++;
+    pthread_cond_signal(&j->work_cv);
 }
 
 static int jobs_map_store(int rc)
@@ -324,7 +344,7 @@ static store_state jobs_record_fallback(jobs *j, const char *id, int why)
     jobs_store_health(j, rc);
     if (rc == STORE_OK) {
         pthread_mutex_lock(&j->lock);
-        j->queued++;
+        jobs_posted_locked(j);
         pthread_mutex_unlock(&j->lock);
         return STORE_QUEUED;
     }
@@ -370,7 +390,7 @@ static void jobs_record(jobs *j, const store_job *job, const jobs_outcome_rec *r
         jobs_store_health(j, rc);
         if (rc == STORE_OK) {
             pthread_mutex_lock(&j->lock);
-            j->queued++;
+            jobs_posted_locked(j);
             pthread_mutex_unlock(&j->lock);
         } else if (rc != STORE_CONFLICT && rc != STORE_NOT_FOUND) {
             jobs_add_unrecorded(j, job->id);
@@ -420,6 +440,7 @@ static int jobs_claim(jobs *j, jobs_slot *slot, store_job *job)
         slot->started = log_now();
         if (j->queued > 0)
             j->queued--;
+        j->qver++;
         j->busy++;
         pthread_mutex_unlock(&j->lock);
     }
@@ -455,6 +476,34 @@ static void jobs_handle(jobs *j, jobs_slot *slot, store_job *job)
     free(rec.csv);
 }
 
+/*
+ * A claim found nothing: set `queued` to the store's count (another process
+ * may have changed the queue).  The count is taken outside the lock, so it is
+ * only applied when no submission was between its reservation and its commit
+ * and no change of `queued` (reservation, commit, claim, cancel, requeue)
+ * happened meanwhile: otherwise it would erase a reservation whose commit it
+ * did not see, or count a claim twice; the next empty claim tries again.
+ */
+static void jobs_resync(jobs *j)
+{
+    long long counts[STORE_N_STATES];
+    unsigned long long ver;
+    int busy, ok;
+
+    pthread_mutex_lock(&j->lock);
+    ver = j->qver;
+    busy = j->reserving > 0;
+    pthread_mutex_unlock(&j->lock);
+    if (busy)
+        return;
+    ok = store_count(j->st, counts) == STORE_OK;
+    pthread_mutex_lock(&j->lock);
+    if (ok && j->qver == ver && j->reserving == 0)
+        j->queued = (int)(counts[STORE_QUEUED] > 1000000000LL ? 1000000000LL
+                                                               : counts[STORE_QUEUED]);
+    pthread_mutex_unlock(&j->lock);
+}
+
 static void *jobs_worker_main(void *arg)
 {
     jobs_worker *w = arg;
@@ -462,23 +511,20 @@ static void *jobs_worker_main(void *arg)
     jobs_slot *slot = &j->slots[w->index];
     store_job job;
     struct timespec until;
+    unsigned long long seen;
     int got;
 
     memset(&job, 0, sizeof(job));
     for (;;) {
+        /* `seen` is read before the claim: a job committed after the claim's
+         * read of the store bumps `posted` after this, so the wait below
+         * returns at once instead of sleeping on a job it did not see */
         pthread_mutex_lock(&j->lock);
         if (j->stopping) {
             pthread_mutex_unlock(&j->lock);
             break;
         }
-        if (j->queued == 0) {
-            until = jobs_deadline(JOBS_IDLE_POLL);
-            pthread_cond_timedwait(&j->work_cv, &j->lock, &until);
-        }
-        if (j->stopping) {
-            pthread_mutex_unlock(&j->lock);
-            break;
-        }
+        seen = j->posted;
         pthread_mutex_unlock(&j->lock);
         jobs_retry_unrecorded(j);
         got = jobs_claim(j, slot, &job);
@@ -491,14 +537,13 @@ static void *jobs_worker_main(void *arg)
             continue;
         }
         if (got == 0) {
-            /* nothing to claim: resynchronise the count with the store so
-             * a stale count never makes the worker spin */
-            long long counts[STORE_N_STATES];
-            int ok = store_count(j->st, counts) == STORE_OK;
+            jobs_resync(j);
+            until = jobs_deadline(JOBS_IDLE_POLL);
             pthread_mutex_lock(&j->lock);
-            j->queued = ok ? (int)(counts[STORE_QUEUED] > 1000000000LL ? 1000000000LL
-                                                                      : counts[STORE_QUEUED])
-                           : 0;
+            while (j->posted == seen && !j->stopping) {
+                if (pthread_cond_timedwait(&j->work_cv, &j->lock, &until) == ETIMEDOUT)
+                    break;
+            }
             pthread_mutex_unlock(&j->lock);
             continue;
         }
@@ -654,15 +699,21 @@ int jobs_submit(jobs *j, const codec_request *req, jobs_outcome *outcome, store_
         return JOBS_FULL;
     }
     j->queued++;   /* reserve the place before the write */
+    j->qver++;
+    j->reserving++;
     pthread_mutex_unlock(&j->lock);
     codec_request_speeds(req, &speeds);
     rc = store_submit(j->st, id, codec_request_canonical_text(req),
                       strlen(codec_request_canonical_text(req)), speeds, log_now(), &created, jb);
     pthread_mutex_lock(&j->lock);
-    if (rc != STORE_OK || created == 0)
+    j->reserving--;
+    j->qver++;
+    if (rc != STORE_OK || created == 0) {
         j->queued--;   /* nothing new queued: give the place back */
-    else
+    } else {
+        j->posted++;   /* committed: the reserved place is the job's */
         pthread_cond_signal(&j->work_cv);
+    }
     pthread_mutex_unlock(&j->lock);
     store_job_clear(&tmp);
     if (rc != STORE_OK)
@@ -688,6 +739,7 @@ int jobs_cancel(jobs *j, const char *id, store_job *job)
         if (state == STORE_CANCELED) {          /* was queued */
             if (j->queued > 0)
                 j->queued--;
+            j->qver++;
         } else if ((slot = jobs_find_slot(j, id)) != NULL) {
             slot->cancel = 1;                    /* the callback stops it */
         }

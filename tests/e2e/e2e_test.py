@@ -805,6 +805,9 @@ def t_concurrent(sc):
         w1.append(c["modes"][0]["frequency_rad_s"] if c.get("modes") else None)
     el = time.monotonic() - t0
     check(all(w is not None for w in w1), "concurrent: all 50 jobs done with modes (%.1f s)" % el)
+    # ~0.3 s unloaded; a pool whose workers idle (5 s poll) while jobs are queued takes 5 s or more
+    check(el < ts.scaled(4.5), "concurrent: all 50 jobs done within %.1f s, no worker idle while jobs "
+          "are queued (%.1f s)" % (ts.scaled(4.5), el))
     if all(w is not None for w in w1):
         check(all(b > a for a, b in zip(w1, w1[1:])), "concurrent: omega_1 increases with Omega (10 .. 19.8 rad/s)")
         check(abs(w1[7] - 5.293064363939) < 1e-6, "concurrent: omega_1 at 11.4 rad/s = 5.293064 (%.9f)" % w1[7])
