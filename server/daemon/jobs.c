@@ -25,7 +25,7 @@
  * jobs_cancel, so a DELETE arriving between the two is never lost.  No store
  * call is made while holding `lock`.
  */
-#include "jobs.h"
+#include "jobs_internal.h"
 
 #include <errno.h>
 #include <math.h>
@@ -41,54 +41,10 @@
  * Weak, so a reference BLAS without the symbol links too. */
 extern void openblas_set_num_threads(int n) __attribute__((weak));
 
-#define JOBS_MAX_ATTEMPTS 3   /* claims before a job that keeps dying is failed */
-#define JOBS_IDLE_POLL 5.0    /* s between store polls of an idle worker */
-#define JOBS_STORE_FAIL_MEMORY 30.0 /* s a failed write keeps /readyz false without a newer one */
-
-typedef struct jobs_slot {
-    char id[65];          /* running job, "" when idle */
-    int done, total;      /* speeds finished / requested */
-    int cancel;           /* 1: DELETE asked to stop */
-    int timed_out;        /* 1: the callback stopped it for the time limit */
-    double started;       /* log_now() at claim */
-} jobs_slot;
-
-typedef struct jobs_worker {
-    jobs *pool;
-    int index;
-    pthread_t thread;
-    int started;          /* 1 when pthread_create succeeded */
-} jobs_worker;
-
-struct jobs {
-    store *st;                 /* borrowed */
-    metrics *mx;               /* borrowed */
-    jobs_config cfg;
-    pthread_mutex_t lock;
-    pthread_mutex_t claim_lock;
-    pthread_cond_t work_cv;    /* workers: a job was queued, or stopping */
-    pthread_cond_t done_cv;    /* waiters: a job finished (gen changed), or stopping */
-    int queued;
-    unsigned long long posted; /* bumped after each commit that makes a job queued */
-    unsigned long long qver;   /* bumped on each change of `queued` (see jobs_resync) */
-    int reserving;             /* submissions between their reservation and their commit */
-    int stopping;              /* no new submissions, workers leave their loop */
-    int stop_now;              /* running jobs stop and go back to the queue */
-    int alive, busy;
-    unsigned long long gen;
-    jobs_slot *slots;          /* cfg.workers */
-    jobs_worker *workers;      /* cfg.workers */
-    /* jobs that ended while the store refused every write (full disk, read-only):
-     * they are `running` in the store with no worker; retried until recorded */
-    char (*unrecorded)[65];    /* ids, n_unrecorded of cap_unrecorded */
-    int n_unrecorded, cap_unrecorded;
-    double store_failed_at;    /* log_now() of the last failed write, 0 after a successful one */
-};
-
 /* ---------------------------------------------------------------- helpers */
 
 /* Absolute CLOCK_REALTIME deadline seconds from now, for timed waits. */
-static struct timespec jobs_deadline(double seconds)
+struct timespec jobs_deadline(double seconds)
 {
     struct timespec ts;
     double frac;
@@ -128,7 +84,7 @@ static jobs_slot *jobs_find_slot(jobs *j, const char *id)
 }
 
 /* Signal waiters that some job left queued/running. */
-static void jobs_bump(jobs *j)
+void jobs_bump(jobs *j)
 {
     pthread_mutex_lock(&j->lock);
     j->gen++;
@@ -186,7 +142,7 @@ static int jobs_progress_cb(void *user, int done, int total)
     c->slot->total = total;
     if (jobs_clock() - c->t0 > c->pool->cfg.job_timeout)
         c->slot->timed_out = 1;
-    stop = c->slot->cancel || c->slot->timed_out || c->pool->stop_now;
+    stop = c->slot->cancel || c->slot->timed_out || c->slot->lost || c->pool->stop_now;
     pthread_mutex_unlock(&c->pool->lock);
     return stop;
 }
@@ -206,8 +162,8 @@ static void jobs_stopped(jobs *j, jobs_slot *slot, int total, jobs_outcome_rec *
     int timed_out;
 
     pthread_mutex_lock(&j->lock);
-    timed_out = slot->timed_out;
-    rec->state = slot->cancel ? STORE_CANCELED : STORE_QUEUED;
+    timed_out = slot->timed_out && !slot->lost;
+    rec->state = slot->lost ? STORE_RUNNING : slot->cancel ? STORE_CANCELED : STORE_QUEUED;
     pthread_mutex_unlock(&j->lock);
     if (!timed_out)
         return;
@@ -385,6 +341,11 @@ static void jobs_record(jobs *j, const store_job *job, const jobs_outcome_rec *r
 
     snprintf(secs, sizeof(secs), "%.3f", rec->solve_seconds < 0 ? 0.0 : rec->solve_seconds);
     snprintf(speeds, sizeof(speeds), "%d/%d", rec->speeds_done, job->speeds_total);
+    if (rec->state == STORE_RUNNING) { /* lost: its lease expired and another replica runs it */
+        log_event("warn", "job_lost", "job", job->id, "speeds", speeds, "reason",
+                  "lease expired (another replica re-queued it); nothing recorded", (char *)NULL);
+        return;
+    }
     if (rec->state == STORE_QUEUED) {
         rc = store_requeue(j->st, job->id);
         jobs_store_health(j, rc);
@@ -538,7 +499,8 @@ static void *jobs_worker_main(void *arg)
         }
         if (got == 0) {
             jobs_resync(j);
-            until = jobs_deadline(JOBS_IDLE_POLL);
+            /* a shared store gets jobs from other replicas, which no signal announces */
+            until = jobs_deadline(j->cfg.shared ? JOBS_SHARED_POLL : JOBS_IDLE_POLL);
             pthread_mutex_lock(&j->lock);
             while (j->posted == seen && !j->stopping) {
                 if (pthread_cond_timedwait(&j->work_cv, &j->lock, &until) == ETIMEDOUT)
@@ -569,6 +531,7 @@ static void jobs_free(jobs *j)
 {
     if (!j)
         return;
+    pthread_cond_destroy(&j->heart_cv);
     pthread_cond_destroy(&j->work_cv);
     pthread_cond_destroy(&j->done_cv);
     pthread_mutex_destroy(&j->claim_lock);
@@ -608,7 +571,7 @@ int jobs_start(jobs **out, store *st, metrics *mx, const jobs_config *cfg)
     j->workers = calloc((size_t)j->cfg.workers, sizeof(*j->workers));
     if (!j->slots || !j->workers || pthread_mutex_init(&j->lock, NULL) ||
         pthread_mutex_init(&j->claim_lock, NULL) || pthread_cond_init(&j->work_cv, NULL) ||
-        pthread_cond_init(&j->done_cv, NULL)) {
+        pthread_cond_init(&j->done_cv, NULL) || pthread_cond_init(&j->heart_cv, NULL)) {
         free(j->slots);
         free(j->workers);
         free(j);
@@ -630,6 +593,15 @@ int jobs_start(jobs **out, store *st, metrics *mx, const jobs_config *cfg)
             return JOBS_NOMEM;
         }
         j->workers[i].started = 1;
+    }
+    if (j->cfg.shared) {
+        if (!(j->cfg.lease >= 3.0))
+            j->cfg.lease = 30.0;
+        if (pthread_create(&j->heart, NULL, jobs_heart_main, j)) {
+            jobs_stop(j, 0);
+            return JOBS_NOMEM;
+        }
+        j->heart_started = 1;
     }
     *out = j;
     return JOBS_OK;
@@ -655,6 +627,13 @@ void jobs_stop(jobs *j, double grace)
     for (i = 0; i < j->cfg.workers; i++)
         if (j->workers[i].started)
             pthread_join(j->workers[i].thread, NULL);
+    if (j->heart_started) {
+        pthread_mutex_lock(&j->lock);
+        j->heart_stop = 1;
+        pthread_cond_broadcast(&j->heart_cv);
+        pthread_mutex_unlock(&j->lock);
+        pthread_join(j->heart, NULL);
+    }
     jobs_free(j);
 }
 

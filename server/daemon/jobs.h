@@ -44,6 +44,11 @@ typedef struct jobs_config {
     int queue_max;          /* most queued jobs before JOBS_FULL, >= 1 */
     double job_timeout;     /* s of solve time before a job fails with "timeout", > 0 */
     codec_limits limits;    /* limits applied when a worker re-reads a stored request */
+    int shared;             /* 1: other replicas share the store (PostgreSQL): idle workers
+                               poll every 0.5 s, a heartbeat thread renews leases every
+                               lease/3, brings cancels from other replicas and re-queues
+                               jobs whose lease expired */
+    double lease;           /* s a claim holds without renewal (shared store), >= 3 */
 } jobs_config;
 
 typedef struct jobs jobs;   /* opaque */

@@ -622,6 +622,8 @@ static int main_serve(const main_opts *o, const char *token, main_daemon *d)
     jc.workers = (int)o->workers;
     jc.queue_max = (int)o->queue_max;
     jc.job_timeout = o->job_timeout;
+    jc.shared = strcmp(store_backend_name(d->st), "postgresql") == 0;
+    jc.lease = o->lease;
     jc.limits = hc.limits;
     rc = jobs_start(&d->j, d->st, d->mx, &jc);
     if (rc != JOBS_OK) {

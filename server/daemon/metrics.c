@@ -40,6 +40,7 @@ struct metrics {
     unsigned long long deadline_closed; /* connections closed by the request deadline */
     unsigned long long store_errors[-STORE_RC_MIN + 1]; /* failures by -store_rc */
     unsigned long long store_pruned;    /* finished jobs removed by retention */
+    unsigned long long lease_requeued, lease_failed; /* jobs of dead replicas */
     unsigned long long finished[STORE_N_STATES];
 };
 
@@ -143,6 +144,14 @@ void metrics_store_error(metrics *m, int rc)
         rc = STORE_ERROR;
     pthread_mutex_lock(&m->lock);
     m->store_errors[-rc]++;
+    pthread_mutex_unlock(&m->lock);
+}
+
+void metrics_lease_expired(metrics *m, int requeued, int failed)
+{
+    pthread_mutex_lock(&m->lock);
+    m->lease_requeued += (unsigned long long)(requeued > 0 ? requeued : 0);
+    m->lease_failed += (unsigned long long)(failed > 0 ? failed : 0);
     pthread_mutex_unlock(&m->lock);
 }
 
@@ -254,6 +263,12 @@ static void metrics_render_locked(const metrics *m, metrics_buf *b)
                       "# TYPE spinmodal_store_pruned_jobs_total counter\n"
                       "spinmodal_store_pruned_jobs_total %llu\n",
                    m->store_pruned);
+    metrics_printf(b, "# HELP spinmodal_lease_expiries_total Jobs of a replica that stopped "
+                      "renewing its lease (PostgreSQL), by what became of them.\n"
+                      "# TYPE spinmodal_lease_expiries_total counter\n"
+                      "spinmodal_lease_expiries_total{outcome=\"requeued\"} %llu\n"
+                      "spinmodal_lease_expiries_total{outcome=\"failed\"} %llu\n",
+                   m->lease_requeued, m->lease_failed);
     metrics_printf(b, "# HELP spinmodal_jobs_finished_total Jobs that ended, by final state.\n"
                       "# TYPE spinmodal_jobs_finished_total counter\n");
     for (i = STORE_DONE; i < STORE_N_STATES; i++)

@@ -44,6 +44,9 @@ void metrics_deadline_closed(metrics *m, int n);
 /** Count one failure of the store, by kind (store_rc_name: "full", "busy", "corrupt" ...). */
 void metrics_store_error(metrics *m, int rc);
 
+/** Count jobs of dead replicas: re-queued after their lease expired, or failed (attempts). */
+void metrics_lease_expired(metrics *m, int requeued, int failed);
+
 /** Count n finished jobs removed by the retention policy. */
 void metrics_store_pruned(metrics *m, long long n);
 

@@ -1,0 +1,80 @@
+/*
+ * jobs_internal.h — what jobs.c (the pool) and jobs_lease.c (replicas on a
+ * shared store) share; private to server/daemon/jobs*.c.
+ */
+#ifndef SPINMODAL_JOBS_INTERNAL_H
+#define SPINMODAL_JOBS_INTERNAL_H
+
+#include <pthread.h>
+#include <time.h>
+
+#include "jobs.h"
+
+#define JOBS_MAX_ATTEMPTS 3   /* claims before a job that keeps dying is failed */
+#define JOBS_IDLE_POLL 5.0    /* s between store polls of an idle worker */
+#define JOBS_SHARED_POLL 0.5  /* the same on a store shared by replicas (PostgreSQL) */
+#define JOBS_STORE_FAIL_MEMORY 30.0 /* s a failed write keeps /readyz false without a newer one */
+
+typedef struct jobs_slot {
+    char id[65];          /* running job, "" when idle */
+    int done, total;      /* speeds finished / requested */
+    int cancel;           /* 1: DELETE asked to stop */
+    int timed_out;        /* 1: the callback stopped it for the time limit */
+    int lost;             /* 1: another replica took the job (our lease expired): stop, record nothing */
+    double started;       /* log_now() at claim */
+} jobs_slot;
+
+typedef struct jobs_worker {
+    jobs *pool;
+    int index;
+    pthread_t thread;
+    int started;          /* 1 when pthread_create succeeded */
+} jobs_worker;
+
+struct jobs {
+    store *st;                 /* borrowed */
+    metrics *mx;               /* borrowed */
+    jobs_config cfg;
+    pthread_mutex_t lock;
+    pthread_mutex_t claim_lock;
+    pthread_cond_t work_cv;    /* workers: a job was queued, or stopping */
+    pthread_cond_t done_cv;    /* waiters: a job finished (gen changed), or stopping */
+    int queued;
+    unsigned long long posted; /* bumped after each commit that makes a job queued */
+    unsigned long long qver;   /* bumped on each change of `queued` (see jobs_resync) */
+    int reserving;             /* submissions between their reservation and their commit */
+    int stopping;              /* no new submissions, workers leave their loop */
+    int stop_now;              /* running jobs stop and go back to the queue */
+    int alive, busy;
+    unsigned long long gen;
+    jobs_slot *slots;          /* cfg.workers */
+    jobs_worker *workers;      /* cfg.workers */
+    /* jobs that ended while the store refused every write (full disk, read-only):
+     * they are `running` in the store with no worker; retried until recorded */
+    char (*unrecorded)[65];    /* ids, n_unrecorded of cap_unrecorded */
+    int n_unrecorded, cap_unrecorded;
+    double store_failed_at;    /* log_now() of the last failed write, 0 after a successful one */
+    /* shared store (PostgreSQL, cfg.shared): the heartbeat thread renews the leases of the
+     * running jobs, brings their cancels from other replicas, re-queues expired leases */
+    pthread_t heart;
+    int heart_started;
+    int heart_stop;            /* 1: the heartbeat thread leaves */
+    pthread_cond_t heart_cv;   /* wakes the heartbeat to stop */
+};
+
+
+/** Absolute CLOCK_REALTIME deadline seconds from now, for timed waits. */
+struct timespec jobs_deadline(double seconds);
+
+/** Signal waiters that some job left queued/running (gen++). */
+void jobs_bump(jobs *j);
+
+/**
+ * The heartbeat thread of a replica on a shared store (jobs_lease.c): every
+ * lease/3 it renews the leases of the running jobs, brings cancels asked
+ * through other replicas, and re-queues the jobs of dead replicas, until
+ * j->heart_stop.  arg is the pool.
+ */
+void *jobs_heart_main(void *arg);
+
+#endif /* SPINMODAL_JOBS_INTERNAL_H */
