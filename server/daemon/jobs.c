@@ -332,6 +332,37 @@ static void jobs_retry_unrecorded(jobs *j)
     }
 }
 
+/*
+ * store_finish of rec; a store that is only unreachable for a while
+ * (PostgreSQL restarting, BUSY) is retried with backoff for up to
+ * JOBS_FINISH_RETRY s, so a result computed during an outage is kept, not
+ * dropped; a stop cuts the retries short.  Returns the last store_rc.
+ */
+static int jobs_finish_retrying(jobs *j, const char *id, const jobs_outcome_rec *rec)
+{
+    double wait = 0.25, spent = 0.0;
+    struct timespec until;
+    int rc, stop;
+
+    for (;;) {
+        rc = store_finish(j->st, id, rec->state, log_now(), rec->speeds_done, rec->error,
+                          rec->result, rec->result ? strlen(rec->result) : 0, rec->csv,
+                          rec->csv_len);
+        if ((rc != STORE_UNAVAILABLE && rc != STORE_BUSY) || spent >= JOBS_FINISH_RETRY)
+            return rc;
+        until = jobs_deadline(wait);
+        pthread_mutex_lock(&j->lock);
+        if (!j->stop_now)
+            pthread_cond_timedwait(&j->work_cv, &j->lock, &until);
+        stop = j->stop_now;
+        pthread_mutex_unlock(&j->lock);
+        if (stop)
+            return rc;
+        spent += wait;
+        wait = wait * 2 > 5.0 ? 5.0 : wait * 2;
+    }
+}
+
 /* Record rec in the store, count and log it. */
 static void jobs_record(jobs *j, const store_job *job, const jobs_outcome_rec *rec)
 {
@@ -361,8 +392,7 @@ static void jobs_record(jobs *j, const store_job *job, const jobs_outcome_rec *r
                   (char *)NULL);
         return;
     }
-    rc = store_finish(j->st, job->id, rec->state, log_now(), rec->speeds_done, rec->error,
-                      rec->result, rec->result ? strlen(rec->result) : 0, rec->csv, rec->csv_len);
+    rc = jobs_finish_retrying(j, job->id, rec);
     jobs_store_health(j, rc);
     if (rc != STORE_OK && rc != STORE_CONFLICT && rc != STORE_NOT_FOUND)
         kept = jobs_record_fallback(j, job->id, rc);

@@ -13,6 +13,7 @@
 #define JOBS_MAX_ATTEMPTS 3   /* claims before a job that keeps dying is failed */
 #define JOBS_IDLE_POLL 5.0    /* s between store polls of an idle worker */
 #define JOBS_SHARED_POLL 0.5  /* the same on a store shared by replicas (PostgreSQL) */
+#define JOBS_FINISH_RETRY 60.0 /* s a result is offered again to an unreachable store */
 #define JOBS_STORE_FAIL_MEMORY 30.0 /* s a failed write keeps /readyz false without a newer one */
 
 typedef struct jobs_slot {
