@@ -34,6 +34,7 @@
 #include "http_internal.h"
 
 #include <errno.h>
+#include <limits.h>
 #include <netdb.h>
 #include <pthread.h>
 #include <stdarg.h>
@@ -118,7 +119,7 @@ static enum MHD_Result http_metrics(struct MHD_Connection *c, http_req *r)
     }
     if (store_size(r->h->st, &g.store_live_bytes, &g.store_file_bytes) != STORE_OK)
         g.store_live_bytes = g.store_file_bytes = -1;
-    g.queue_depth = s.queued;
+    g.queue_depth = counted ? (int)(counts[STORE_QUEUED] > INT_MAX ? INT_MAX : counts[STORE_QUEUED]) : s.queued;
     g.workers = s.workers;
     g.workers_busy = s.workers_busy;
     if (metrics_render(r->h->mx, &g, &text, &len))

@@ -679,10 +679,39 @@ int jobs_stopping(jobs *j)
 
 /* ------------------------------------------------------------ requests */
 
+/*
+ * Queued jobs of the whole shared store (all replicas) for the 429 bound: a
+ * store count at most JOBS_SHARED_COUNT_AGE s old (a count scans the table:
+ * not once per POST) plus this replica's submissions since; 0 on a store of
+ * this process alone (j->queued is exact there).
+ */
+static long long jobs_shared_queued(jobs *j)
+{
+    long long counts[STORE_N_STATES], q;
+    double now = log_now();
+
+    if (!j->cfg.shared)
+        return 0;
+    pthread_mutex_lock(&j->lock);
+    q = now - j->shared_at < JOBS_SHARED_COUNT_AGE ? j->shared_queued + j->shared_since : -1;
+    pthread_mutex_unlock(&j->lock);
+    if (q >= 0)
+        return q;
+    if (store_count(j->st, counts) != STORE_OK)
+        return 0; /* the submission's own write will report the store */
+    pthread_mutex_lock(&j->lock);
+    j->shared_queued = q = counts[STORE_QUEUED];
+    j->shared_since = 0;
+    j->shared_at = now;
+    pthread_mutex_unlock(&j->lock);
+    return q;
+}
+
 int jobs_submit(jobs *j, const codec_request *req, jobs_outcome *outcome, store_job *job)
 {
     char id[65];
     int speeds, created = 0, rc;
+    long long shared_queued;
     store_job tmp;
     store_job *jb = job ? job : &tmp;
 
@@ -702,12 +731,16 @@ int jobs_submit(jobs *j, const codec_request *req, jobs_outcome *outcome, store_
     store_job_clear(jb);
     if (rc != STORE_OK && rc != STORE_NOT_FOUND)
         return jobs_map_store(rc);
+    shared_queued = jobs_shared_queued(j);
     pthread_mutex_lock(&j->lock);
-    if (j->queued >= j->cfg.queue_max) {
+    /* a shared store: other replicas claim what this one queued, so only the
+     * store's count means anything (up to JOBS_SHARED_COUNT_AGE s old) */
+    if (j->cfg.shared ? shared_queued >= j->cfg.queue_max : j->queued >= j->cfg.queue_max) {
         pthread_mutex_unlock(&j->lock);
         return JOBS_FULL;
     }
     j->queued++;   /* reserve the place before the write */
+    j->shared_since++; /* counted with the shared queue until the next store count */
     j->qver++;
     j->reserving++;
     pthread_mutex_unlock(&j->lock);

@@ -13,6 +13,7 @@
 #define JOBS_MAX_ATTEMPTS 3   /* claims before a job that keeps dying is failed */
 #define JOBS_IDLE_POLL 5.0    /* s between store polls of an idle worker */
 #define JOBS_SHARED_POLL 0.5  /* the same on a store shared by replicas (PostgreSQL) */
+#define JOBS_SHARED_COUNT_AGE 1.0 /* s a shared queue count is reused for the 429 bound */
 #define JOBS_FINISH_RETRY 60.0 /* s a result is offered again to an unreachable store */
 #define JOBS_STORE_FAIL_MEMORY 30.0 /* s a failed write keeps /readyz false without a newer one */
 
@@ -60,6 +61,9 @@ struct jobs {
     pthread_t heart;
     int heart_started;
     int heart_stop;            /* 1: the heartbeat thread leaves */
+    long long shared_queued;   /* queued jobs of all replicas at shared_at (store_count) */
+    double shared_at;          /* log_now() of that count, 0 = never */
+    long long shared_since;    /* submissions of this replica since that count */
     pthread_cond_t heart_cv;   /* wakes the heartbeat to stop */
 };
 

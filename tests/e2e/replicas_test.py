@@ -13,7 +13,8 @@ three daemons on it (--db postgresql://…, --lease 3), then shows:
   3. a job canceled through another replica than the one running it stops;
   4. `?wait=` on another replica returns when the job finishes;
   5. a PostgreSQL restart mid-run is survived: /readyz goes 503 while it is
-     down and back to 200, and jobs submitted afterwards complete.
+     down and back to 200, and jobs submitted afterwards complete;
+  6. the 429 bound (--queue-max) counts the queue all replicas share.
 Without PostgreSQL server binaries it exits 77 (meson: skipped), saying why.
 Waits are upper bounds scaled by timescale.py; none decides a pass by time.
 """
@@ -274,6 +275,32 @@ def main():
         r = post(daemons[1], request(9.02), "?wait=%g" % timescale.wait_param(60))
         check(r.status == 200 and r.json().get("state") == "done",
               "a job submitted after the restart completes (%s)" % r.status)
+        for d in daemons:
+            check(d.stop() == 0, "%s stops cleanly" % d.name)
+        daemons = []
+
+        # 6. the queue bound (429) counts the shared queue, not one replica's submissions
+        for k in range(2):
+            d = Daemon(exe, tmp, ["--workers", "1", "--lease", "3", "--queue-max", "5"],
+                       db=pg.dsn(), name="bounded%d" % k)
+            d.start()
+            daemons.append(d)
+        x, y = daemons
+        slow = [post(x, request(3.01 + 0.01 * k, n_speeds=300, elements=96)).json()["id"]
+                for k in range(2)]
+        wait_until(lambda: all(state(x, j)["state"] == "running" for j in slow), 60)
+        time.sleep(1.2)  # the replica's count of the shared queue is up to 1 s old (DAEMON.md)
+        before = [l for l in x.get("/metrics").body.decode().splitlines()
+                  if l.startswith("spinmodal_jobs{")]
+        codes = [post(x, request(4.001 + 0.001 * k)).status for k in range(5)]
+        check(codes == [202] * 5, "5 jobs queued through one replica %s (store before: %s)"
+              % (codes, before))
+        r = post(y, request(4.0055))
+        check(r.status == 429 and r.headers.get("Retry-After"),
+              "the other replica answers 429 (+ Retry-After): the shared queue is full (%s)"
+              % r.status)
+        for j in slow:
+            x.request("DELETE", "/v1/analyses/" + j)
         for d in daemons:
             check(d.stop() == 0, "%s stops cleanly" % d.name)
         daemons = []
