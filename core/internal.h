@@ -330,4 +330,20 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, sm_ei
 /** Free the arrays of *o and zero it; safe on a zeroed or freed sm_eig_out. */
 void eig_out_free(sm_eig_out *o);
 
+/**
+ * Allocate o's arrays for k modes of n coordinates (eigen.c; eigen_tree.c
+ * uses it too).  Returns SM_OK or SM_NOMEM (o then holds what was allocated:
+ * eig_out_free).
+ */
+int eig_alloc_out(sm_eig_out *o, int n, int k);
+
+/* One root of a companion-form eigenproblem, sorted by key (eigen.c, eigen_tree.c). */
+typedef struct eig_root {
+    double re, im, key;  /* the root, and its sort key (ascending = lowest first) */
+    int col;             /* its eigenvector's column */
+} eig_root;
+
+/** qsort order of eig_root by key, ascending. */
+int eig_root_cmp(const void *a, const void *b);
+
 #endif

@@ -109,6 +109,9 @@ int store_pg_run(pg_conn *c, int k, int n, const char *const *vals, const int *l
 /* Run a command without parameters (BEGIN, COMMIT, …) on c; recorded. */
 int store_pg_exec(pg_conn *c, const char *sql);
 
+/* Roll back the session's open transaction (after a failed statement); best effort. */
+void store_pg_rollback(pg_conn *c);
+
 /* Record a failure of c that libpq did not see (a malformed row, memory). */
 int store_pg_fail_kind(pg_conn *c, int kind, const char *text);
 
