@@ -20,12 +20,18 @@ required=(
   libpq-dev                                # daemon: the store's PostgreSQL backend (DESIGN.md §6)
   postgresql                               # tests: server binaries for the throwaway cluster (15 on Debian 12)
   python3 python3-jsonschema               # schema validation tests
+  python3-yaml                             # tests/deploy: parses deploy/k8s and deploy/compose.yaml
   curl ca-certificates                     # clients, end-to-end tests
   nodejs npm chromium                      # web front end (clients/web) and its browser test (tests/web)
   clang libclang-rt-14-dev                 # CI fuzz step: libFuzzer (only Recommended by clang)
 )
 # Optional: nice to have, a failure to install them is only a warning.
-optional=(valgrind wrk)                    # wrk: tests/bench/bench_http.sh
+# wrk: tests/bench/bench_http.sh; nginx: tests/deploy (deploy/nginx/spinmodal.conf in
+# front of a real daemon; the test runs its own nginx, the package's service may be
+# disabled); podman: tests/deploy builds deploy/Dockerfile (needs the network for the
+# base images).  kubectl is used by tests/deploy when present but not installed here:
+# Debian 12's kubernetes-client (1.20) conflicts with other kubectl installs.
+optional=(valgrind wrk nginx podman)
 
 say() { printf 'install-deps: %s\n' "$*"; }
 

@@ -6,9 +6,10 @@ Usage: docs_test.py --source-root DIR --build-root DIR --spinmodal EXE --spinmod
 
 versions  one version everywhere: meson.build's project(version:) (--version, else read from
           meson.build) = SM_VERSION of core/spinmodal.h = `spinmodal --version` = `spinmodald
-          --version`; every X.Y.Z in README.md and deploy/* is that version (or a known
-          non-version, ALLOWED_OTHER_VERSIONS); every image tag spinmodald:TAG and every
-          default of SPINMODAL_VERSION in deploy/ is it too.
+          --version`; every X.Y.Z in README.md and deploy/ (subfolders too) is that version
+          (or a known non-version, ALLOWED_OTHER_VERSIONS); every image tag spinmodald:TAG
+          and every default of SPINMODAL_VERSION in deploy/ is it too; deploy/k8s/ names
+          the image tag in one place.
 readme    what README.md shows without a daemon: each "`CMD` prints (excerpt):" block is the
           output of CMD (numbers to the digits shown), each "`examples/X.json`:" block is that
           file, each inline `build/server/spinmodal …` command exits 0, the geometrically exact
@@ -213,7 +214,10 @@ def t_versions():
         first = (p.stdout or p.stderr).splitlines()[0] if (p.stdout or p.stderr) else ""
         check(p.returncode == 0 and re.match(r"^%s %s\b" % (name, re.escape(v)), first),
               "`%s --version` says %s %s (%r)" % (name, name, v, first))
-    files = ["README.md"] + ["deploy/" + f for f in sorted(os.listdir(os.path.join(SRC, "deploy")))]
+    files = ["README.md"]
+    for top, dirs, names in os.walk(os.path.join(SRC, "deploy")):   # deploy/, deploy/k8s/, deploy/nginx/ …
+        dirs.sort()
+        files += [os.path.relpath(os.path.join(top, f), SRC) for f in sorted(names)]
     tags, defaults = [], []
     for rel in files:
         text = read(rel)
@@ -237,6 +241,8 @@ def t_versions():
     for rel, n, d in defaults:
         check(d == v, "%s:%d: SPINMODAL_VERSION defaults to the version %s (%r)" % (rel, n, v, d))
     check(len(tags) >= 3, "image tags found in deploy/ and README.md (%d)" % len(tags))
+    k8s = [t for t in tags if t[0].startswith("deploy/k8s/")]
+    check(len(k8s) == 1, "deploy/k8s/ names the image spinmodald:TAG in one place (%s)" % k8s)
 
 
 # ================================================================ readme (no daemon)
