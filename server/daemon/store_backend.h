@@ -84,4 +84,11 @@ int store_note_error_state(store *s, int kind, const char *sqlstate, const char 
  * ENOSPC → STORE_FULL, EIO → STORE_IOERR, …; STORE_ERROR otherwise). */
 int store_errno_kind(int e);
 
+/** printf into err[errlen] (an open's message for the caller); err NULL or errlen 0: nothing. */
+void store_seterr(char *err, size_t errlen, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+
 #endif /* SPINMODAL_STORE_BACKEND_H */

@@ -74,20 +74,6 @@ static const char *const store_pg_migrations[] = {
 };
 #define STORE_PG_SCHEMA_VERSION ((int)(sizeof store_pg_migrations / sizeof store_pg_migrations[0]))
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 3, 4)))
-#endif
-static void seterr(char *err, size_t errlen, const char *fmt, ...)
-{
-    va_list ap;
-
-    if (err == NULL || errlen == 0)
-        return;
-    va_start(ap, fmt);
-    vsnprintf(err, errlen, fmt, ap);
-    va_end(ap);
-}
-
 /* "host:port/dbname" of a URI, without user or password, for messages. */
 static void describe(const char *dsn, char *out, size_t len)
 {
@@ -148,7 +134,7 @@ static int pg_inspect(pg_conn *c, const char *where, int *version, char *err, si
     rc = query_text(c, "SELECT (to_regclass('spinmodal_schema') IS NOT NULL)::int::text ||"
                        " (to_regclass('jobs') IS NOT NULL)::int::text", both, sizeof both);
     if (rc == STORE_OK && strcmp(both, "01") == 0) {
-        seterr(err, errlen, "PostgreSQL database %s has a table 'jobs' but is not a spinmodal "
+        store_seterr(err, errlen, "PostgreSQL database %s has a table 'jobs' but is not a spinmodal "
                "one (no spinmodal_schema table); give spinmodald its own database or schema",
                where);
         return STORE_ERROR;
@@ -159,12 +145,12 @@ static int pg_inspect(pg_conn *c, const char *where, int *version, char *err, si
         *version = atoi(v);
     }
     if (rc != STORE_OK) {
-        seterr(err, errlen, "cannot read PostgreSQL database %s: %s", where,
+        store_seterr(err, errlen, "cannot read PostgreSQL database %s: %s", where,
                last_text(c->owner, &e));
         return rc;
     }
     if (*version > STORE_PG_SCHEMA_VERSION) {
-        seterr(err, errlen, "database schema version %d is newer than this spinmodald (%d)",
+        store_seterr(err, errlen, "database schema version %d is newer than this spinmodald (%d)",
                *version, STORE_PG_SCHEMA_VERSION);
         return STORE_ERROR;
     }
@@ -202,7 +188,7 @@ static int pg_migrate(store_pg *q, pg_conn *c, const char *where, char *err, siz
     snprintf(sql, sizeof sql, "SELECT pg_advisory_lock(%d)::text", STORE_PG_LOCK_KEY);
     rc = query_text(c, sql, ignored, sizeof ignored);
     if (rc != STORE_OK) {
-        seterr(err, errlen, "cannot lock PostgreSQL database %s for the migrations: %s", where,
+        store_seterr(err, errlen, "cannot lock PostgreSQL database %s for the migrations: %s", where,
                last_text(c->owner, &e));
         return rc;
     }
@@ -210,14 +196,14 @@ static int pg_migrate(store_pg *q, pg_conn *c, const char *where, char *err, siz
     while (rc == STORE_OK && version < STORE_PG_SCHEMA_VERSION) {
         rc = pg_migrate_one(c, version);
         if (rc != STORE_OK)
-            seterr(err, errlen, "cannot migrate PostgreSQL database %s to schema version %d: %s",
+            store_seterr(err, errlen, "cannot migrate PostgreSQL database %s to schema version %d: %s",
                    where, version + 1, last_text(c->owner, &e));
         else
             version++;
     }
     snprintf(sql, sizeof sql, "SELECT pg_advisory_unlock(%d)::text", STORE_PG_LOCK_KEY);
     if (rc == STORE_OK && (rc = query_text(c, sql, ignored, sizeof ignored)) != STORE_OK)
-        seterr(err, errlen, "cannot unlock PostgreSQL database %s: %s", where,
+        store_seterr(err, errlen, "cannot unlock PostgreSQL database %s: %s", where,
                last_text(c->owner, &e));
     if (rc != STORE_OK)
         store_pg_disconnect(c);   /* ends the session, and its advisory lock */
@@ -240,7 +226,7 @@ static int pg_recover(store *s, pg_conn *c, const char *where, int *requeued, ch
     snprintf(t, sizeof t, "%.17g", (double)now.tv_sec + 1e-9 * (double)now.tv_nsec);
     rc = store_pg_run(c, PG_RECOVER, 1, v, NULL, NULL, &r);
     if (rc != STORE_OK) {
-        seterr(err, errlen, "cannot requeue the expired jobs of PostgreSQL database %s: %s",
+        store_seterr(err, errlen, "cannot requeue the expired jobs of PostgreSQL database %s: %s",
                where, last_text(s, &e));
         return rc;
     }
@@ -278,7 +264,7 @@ static int pg_open_db(store *s, const char *where, int *requeued, char *err, siz
     int rc = store_pg_acquire(s, "open", &c);
 
     if (rc != STORE_OK) {
-        seterr(err, errlen, "cannot connect to PostgreSQL database %s: %s", where,
+        store_seterr(err, errlen, "cannot connect to PostgreSQL database %s: %s", where,
                last_text(s, &e));
         return rc;
     }
@@ -299,7 +285,7 @@ int store_pg_open(store *s, const store_settings *set, int *requeued, char *err,
     s->impl = NULL;
     opts = PQconninfoParse(set->path, &perr);
     if (opts == NULL) {
-        seterr(err, errlen, "invalid PostgreSQL URI: %s",
+        store_seterr(err, errlen, "invalid PostgreSQL URI: %s",
                perr ? perr : "out of memory parsing it");
         if (perr)
             PQfreemem(perr);
@@ -310,13 +296,13 @@ int store_pg_open(store *s, const store_settings *set, int *requeued, char *err,
     q = calloc(1, sizeof *q);
     if (q == NULL || (q->dsn = strdup(set->path)) == NULL) {
         free(q);
-        seterr(err, errlen, "out of memory opening the database");
+        store_seterr(err, errlen, "out of memory opening the database");
         return STORE_NOMEM;
     }
     q->lock_timeout_ms = set->busy_timeout_ms > 0 ? set->busy_timeout_ms : 1;
     s->impl = q;
     if (pool_init(s, q) != 0) {
-        seterr(err, errlen, "cannot create the connection pool's locks");
+        store_seterr(err, errlen, "cannot create the connection pool's locks");
         rc = STORE_ERROR;
     } else {
         rc = pg_open_db(s, where, requeued, err, errlen);

@@ -74,20 +74,6 @@ static const char *const store_migrations[] = {
 };
 #define STORE_SCHEMA_VERSION ((int)(sizeof store_migrations / sizeof store_migrations[0]))
 
-#if defined(__GNUC__)
-__attribute__((format(printf, 3, 4)))
-#endif
-static void seterr(char *err, size_t errlen, const char *fmt, ...)
-{
-    va_list ap;
-
-    if (err == NULL || errlen == 0)
-        return;
-    va_start(ap, fmt);
-    vsnprintf(err, errlen, fmt, ap);
-    va_end(ap);
-}
-
 /* The kind of SQLite failure rc on c (its errno included). */
 static int conn_kind(store_conn *c, int rc)
 {
@@ -139,14 +125,14 @@ static int lock_take(store_file_lock *l, const char *db, char *err, size_t errle
     l->fd = -1;
     l->path = malloc(n);
     if (l->path == NULL) {
-        seterr(err, errlen, "out of memory opening the database");
+        store_seterr(err, errlen, "out of memory opening the database");
         return STORE_NOMEM;
     }
     snprintf(l->path, n, "%s.lock", db);
     l->fd = open(l->path, O_RDWR | O_CREAT | O_CLOEXEC | O_NOCTTY, 0644);
     if (l->fd < 0) {
         e = errno;
-        seterr(err, errlen, "cannot open database '%s': cannot create its lock file '%s': %s", db,
+        store_seterr(err, errlen, "cannot open database '%s': cannot create its lock file '%s': %s", db,
                l->path, strerror(e));
         return store_errno_kind(e);
     }
@@ -155,20 +141,20 @@ static int lock_take(store_file_lock *l, const char *db, char *err, size_t errle
         if (e == EAGAIN || e == EACCES) {
             long holder = lock_holder(l->fd);
             if (holder > 0)
-                seterr(err, errlen, "database '%s' is in use by another process (pid %ld holds "
+                store_seterr(err, errlen, "database '%s' is in use by another process (pid %ld holds "
                        "'%s'); stop it, or give this daemon another database", db, holder,
                        l->path);
             else
-                seterr(err, errlen, "database '%s' is in use by another process (it holds "
+                store_seterr(err, errlen, "database '%s' is in use by another process (it holds "
                        "'%s'); stop it, or give this daemon another database", db, l->path);
             return STORE_IN_USE;
         }
-        seterr(err, errlen, "cannot lock '%s' for database '%s': %s", l->path, db, strerror(e));
+        store_seterr(err, errlen, "cannot lock '%s' for database '%s': %s", l->path, db, strerror(e));
         return store_errno_kind(e);
     }
     if (fstat(l->fd, &st) != 0) {
         e = errno;
-        seterr(err, errlen, "cannot read lock file '%s': %s", l->path, strerror(e));
+        store_seterr(err, errlen, "cannot read lock file '%s': %s", l->path, strerror(e));
         return store_errno_kind(e);
     }
     l->dev = st.st_dev;
@@ -234,7 +220,7 @@ static int conn_open(store *s, store_conn *c, char *err, size_t errlen)
                          SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX, NULL);
     if (rc != SQLITE_OK) {
         kind = conn_kind(c, rc);
-        seterr(err, errlen, "cannot open database '%s': %s", q->path,
+        store_seterr(err, errlen, "cannot open database '%s': %s", q->path,
                c->db ? sqlite3_errmsg(c->db) : sqlite3_errstr(rc));
         goto fail;
     }
@@ -243,7 +229,7 @@ static int conn_open(store *s, store_conn *c, char *err, size_t errlen)
         /* SQLite falls back to read-only when the file cannot be written */
         rc = SQLITE_READONLY;
         kind = STORE_READONLY;
-        seterr(err, errlen, "cannot open database '%s' for writing (permissions or a read-only "
+        store_seterr(err, errlen, "cannot open database '%s' for writing (permissions or a read-only "
                "mount)", q->path);
         goto fail;
     }
@@ -254,11 +240,11 @@ static int conn_open(store *s, store_conn *c, char *err, size_t errlen)
     if (rc != SQLITE_OK) {
         kind = conn_kind(c, rc);
         if ((rc & 0xff) == SQLITE_NOTADB)
-            seterr(err, errlen, "'%s' is not a SQLite database", q->path);
+            store_seterr(err, errlen, "'%s' is not a SQLite database", q->path);
         else if (kind == STORE_CORRUPT)
-            seterr(err, errlen, "database '%s' is corrupt: %s", q->path, sqlite3_errmsg(c->db));
+            store_seterr(err, errlen, "database '%s' is corrupt: %s", q->path, sqlite3_errmsg(c->db));
         else
-            seterr(err, errlen, "cannot configure database '%s': %s", q->path,
+            store_seterr(err, errlen, "cannot configure database '%s': %s", q->path,
                    sqlite3_errmsg(c->db));
         goto fail;
     }
@@ -278,7 +264,7 @@ static int sq_identify(store_sqlite *q, char *err, size_t errlen)
 
     if (stat(q->path, &st) != 0) {
         int e = errno;
-        seterr(err, errlen, "cannot open database '%s': %s", q->path, strerror(e));
+        store_seterr(err, errlen, "cannot open database '%s': %s", q->path, strerror(e));
         return store_errno_kind(e) == STORE_OK ? STORE_ERROR : store_errno_kind(e);
     }
     q->db_dev = st.st_dev;
@@ -300,25 +286,25 @@ static int sq_inspect(store_conn *c, const char *path, int *fresh, char *err, si
     if (rc == SQLITE_OK)
         rc = conn_pragma(c, "SELECT count(*) FROM sqlite_schema", &objects, NULL, 0);
     if ((rc & 0xff) == SQLITE_NOTADB) {
-        seterr(err, errlen, "'%s' is not a SQLite database", path);
+        store_seterr(err, errlen, "'%s' is not a SQLite database", path);
         return STORE_CORRUPT;
     }
     if (rc != SQLITE_OK) {
-        seterr(err, errlen, "cannot read database '%s': %s", path, sqlite3_errmsg(c->db));
+        store_seterr(err, errlen, "cannot read database '%s': %s", path, sqlite3_errmsg(c->db));
         return conn_kind(c, rc);
     }
     if (app != 0 && app != STORE_SQLITE_APP_ID) {
-        seterr(err, errlen, "'%s' is a SQLite database of another application "
+        store_seterr(err, errlen, "'%s' is a SQLite database of another application "
                "(application_id %d)", path, app);
         return STORE_ERROR;
     }
     if (version > STORE_SCHEMA_VERSION) {
-        seterr(err, errlen, "database schema version %d is newer than this spinmodald (%d)",
+        store_seterr(err, errlen, "database schema version %d is newer than this spinmodald (%d)",
                version, STORE_SCHEMA_VERSION);
         return STORE_ERROR;
     }
     if (app == 0 && version == 0 && objects > 0) {
-        seterr(err, errlen, "'%s' is a SQLite database but not a spinmodal one", path);
+        store_seterr(err, errlen, "'%s' is a SQLite database but not a spinmodal one", path);
         return STORE_ERROR;
     }
     *fresh = app == 0 && version == 0 && objects == 0;
@@ -358,12 +344,12 @@ static int sq_quick_check(store_conn *c, const char *path, char *err, size_t err
     if (rc != SQLITE_DONE && rc != SQLITE_OK) {
         kind = conn_kind(c, rc);
         if (kind == STORE_CORRUPT)
-            seterr(err, errlen, "database '%s' is corrupt: %s", path, sqlite3_errmsg(c->db));
+            store_seterr(err, errlen, "database '%s' is corrupt: %s", path, sqlite3_errmsg(c->db));
         else
-            seterr(err, errlen, "cannot check database '%s': %s", path, sqlite3_errmsg(c->db));
+            store_seterr(err, errlen, "cannot check database '%s': %s", path, sqlite3_errmsg(c->db));
     } else if (!ok) {
         kind = STORE_CORRUPT;
-        seterr(err, errlen, "database '%s' is corrupt (PRAGMA quick_check: %s); restore it from "
+        store_seterr(err, errlen, "database '%s' is corrupt (PRAGMA quick_check: %s); restore it from "
                "a backup or move it away", path, found[0] ? found : "no answer");
     }
     (void)sqlite3_finalize(st);
@@ -382,12 +368,12 @@ static int sq_wal(store_conn *c, const char *path, int fresh, char *err, size_t 
     if (rc == SQLITE_OK)
         rc = conn_pragma(c, "PRAGMA journal_mode = WAL", NULL, mode, sizeof mode);
     if (rc != SQLITE_OK) {
-        seterr(err, errlen, "cannot switch database '%s' to WAL: %s", path,
+        store_seterr(err, errlen, "cannot switch database '%s' to WAL: %s", path,
                sqlite3_errmsg(c->db));
         return conn_kind(c, rc);
     }
     if (strcmp(mode, "wal") != 0) {
-        seterr(err, errlen, "database '%s' cannot use WAL (journal mode is '%s'); "
+        store_seterr(err, errlen, "database '%s' cannot use WAL (journal mode is '%s'); "
                "it must be a file on a local file system", path, mode);
         return STORE_ERROR;
     }
@@ -411,7 +397,7 @@ static int sq_migrate(store_sqlite *q, char *err, size_t errlen)
             goto fail;
         if (version > STORE_SCHEMA_VERSION) {
             store_sqlite_rollback(c);
-            seterr(err, errlen, "database schema version %d is newer than this spinmodald (%d)",
+            store_seterr(err, errlen, "database schema version %d is newer than this spinmodald (%d)",
                    version, STORE_SCHEMA_VERSION);
             return STORE_ERROR;
         }
@@ -433,7 +419,7 @@ static int sq_migrate(store_sqlite *q, char *err, size_t errlen)
     return STORE_OK;
 fail:
     kind = conn_kind(c, rc);
-    seterr(err, errlen, "cannot migrate database '%s' to schema version %d: %s", q->path,
+    store_seterr(err, errlen, "cannot migrate database '%s' to schema version %d: %s", q->path,
            version + 1, sqlite3_errmsg(c->db));
     store_sqlite_rollback(c);
     return kind;
@@ -458,7 +444,7 @@ static int sq_recover(store_sqlite *q, int *requeued, char *err, size_t errlen)
         rc = store_sqlite_exec(c, STMT_COMMIT);
     if (rc != SQLITE_OK) {
         kind = conn_kind(c, rc);
-        seterr(err, errlen, "cannot requeue the running jobs of '%s': %s", q->path,
+        store_seterr(err, errlen, "cannot requeue the running jobs of '%s': %s", q->path,
                sqlite3_errmsg(c->db));
         store_sqlite_rollback(c);
         return kind;
@@ -524,25 +510,25 @@ int store_sqlite_open(store *s, const store_settings *set, int *requeued, char *
 
     s->impl = NULL;
     if (strcmp(set->path, ":memory:") == 0) {
-        seterr(err, errlen, "database ':memory:' cannot use WAL (it lives in memory); it must be "
+        store_seterr(err, errlen, "database ':memory:' cannot use WAL (it lives in memory); it must be "
                "a file on a local file system");
         return STORE_ERROR;
     }
     if (sqlite3_threadsafe() == 0) {
-        seterr(err, errlen, "this SQLite library was built without thread support");
+        store_seterr(err, errlen, "this SQLite library was built without thread support");
         return STORE_ERROR;
     }
     q = calloc(1, sizeof *q);
     if (q == NULL || (q->path = strdup(set->path)) == NULL) {
         free(q);
-        seterr(err, errlen, "out of memory opening the database");
+        store_seterr(err, errlen, "out of memory opening the database");
         return STORE_NOMEM;
     }
     q->lock.fd = -1;
     q->busy_ms = set->busy_timeout_ms > 0 ? set->busy_timeout_ms : 0;
     s->impl = q;
     if (locks_init(q) != 0) {
-        seterr(err, errlen, "cannot create the database locks");
+        store_seterr(err, errlen, "cannot create the database locks");
         rc = STORE_ERROR;
         goto fail;
     }
