@@ -43,17 +43,10 @@ int frames_kin_alloc_light(const sm_model *m, sm_kin *k)
 
 int frames_kin_alloc(const sm_model *m, sm_kin *k)
 {
-    memset(k, 0, sizeof *k);
-    k->n = m->n;
-    k->theta = dm_vec((size_t)m->n_subs);
-    k->R = dm_vec(2 * (size_t)m->n_subs);
-    k->rn = dm_vec(3 * (size_t)m->n_nodes);
-    k->wn = dm_vec(2 * (size_t)m->n_nodes);
-    k->rp = dm_vec(2 * (size_t)m->n_mp);
-    k->wp = dm_vec(2 * (size_t)m->n_mp);
-    k->fext = dm_vec(2 * (size_t)m->n_nodes);
-    if (!k->theta || !k->R || !k->rn || !k->wn || !k->rp || !k->wp || !k->fext ||
-        dm_alloc(&k->Jth, m->n, m->n_subs) || dm_alloc(&k->Jtha, m->n, m->n_subs) ||
+    /* the light kinematics, then the dense Jacobians of the dense path */
+    if (frames_kin_alloc_light(m, k) != SM_OK)
+        return SM_NOMEM;
+    if (dm_alloc(&k->Jth, m->n, m->n_subs) || dm_alloc(&k->Jtha, m->n, m->n_subs) ||
         dm_alloc(&k->JR, m->n, 2 * m->n_subs) ||
         dm_alloc(&k->Jn, m->n, 3 * m->n_nodes) || dm_alloc(&k->Jp, m->n, 2 * m->n_mp)) {
         frames_kin_free(k);
