@@ -58,12 +58,25 @@ const char *sm_version(void);
 
 /* ---------------------------------------------------------------- input */
 
-/** Section properties of a member. */
+/** Section properties of a member.  A planar structure (sm_structure.spatial == 0) reads
+ *  E, A, I and mu only; a spatial one (DESIGN.md 7.1) reads mu and the spatial block only. */
 typedef struct sm_section {
-    double E;   /* Young's modulus, Pa, > 0 */
-    double A;   /* area, m^2, > 0 */
-    double I;   /* in-plane second moment, m^4, > 0 */
-    double mu;  /* mass per length, kg/m, > 0 (masses use mu*l) */
+    double E;   /* Young's modulus, Pa, > 0 (planar) */
+    double A;   /* area, m^2, > 0 (planar) */
+    double I;   /* in-plane second moment, m^4, > 0 (planar) */
+    double mu;  /* mass per length, kg/m, > 0 (masses use mu*l); both kinds */
+    /* spatial: stiffnesses about the section's principal axes (e1 along the member, e2 edgewise,
+     * e3 flapwise, DESIGN.md 7.1), all > 0 */
+    double EA;        /* axial, N */
+    double EI_flap;   /* bending in the e3 direction (about e2), N m^2 */
+    double EI_edge;   /* bending in the e2 direction (about e3), N m^2 */
+    double GJ;        /* torsion, N m^2 */
+    /* mass moments of inertia per length, kg m, >= 0: i_flap about e2 (turns with flap bending),
+     * i_edge about e3; torsional inertia = i_flap + i_edge.  The codec fills the defaults of
+     * DESIGN.md 7.1 (mu I/A); the core takes them as given. */
+    double i_flap, i_edge;
+    /* I_p/A of the torsional (Wagner) geometric stiffness P (I_p/A) int theta_x'^2, m^2, >= 0 */
+    double ip_over_a;
 } sm_section;
 
 /** A straight member between two joints, split into equal elements. */
@@ -72,12 +85,19 @@ typedef struct sm_member {
     int to;        /* joint index */
     int section;   /* section index */
     int elements;  /* number of equal elements, >= 1 */
+    /* spatial only (ignored, and must be zero, for a planar structure): */
+    double twist;  /* rad, right-handed about e1: turns (e2, e3) to the principal axes */
+    double e3[3];  /* a direction for e3 (hub frame, any length, not along the member), or all
+                      zero for the default of DESIGN.md 7.1 (the part of the hub axis z normal to
+                      e1; for a member along z, the part of the radial direction) */
 } sm_member;
 
 /** A point mass attached to a joint (adds to the lumped/consistent mass). */
 typedef struct sm_point_mass {
     int joint;     /* joint index */
     double mass;   /* kg, >= 0 */
+    double inertia[3]; /* spatial only: rotary inertia about the hub axes x, y, z through the
+                          joint, kg m^2, >= 0 (planar: must be zero) */
 } sm_point_mass;
 
 /** The structure.  Arrays are borrowed; sm_model_new copies what it needs. */
@@ -91,6 +111,10 @@ typedef struct sm_structure {
     int n_point_masses;
     const sm_point_mass *point_masses; /* n_point_masses, may be NULL if 0 */
     int clamp;                       /* joint index rigidly attached to the hub */
+    /* 0: planar (DESIGN.md 1; joint_z must be NULL or all zero); 1: spatial (DESIGN.md 7:
+     * 6 DOF per node, the spatial section data, twist, e3 and point-mass inertia) */
+    int spatial;
+    const double *joint_z;           /* n_joints z coordinates (m) or NULL (all zero) */
 } sm_structure;
 
 typedef enum sm_frame_scheme {
@@ -193,6 +217,7 @@ typedef struct sm_model_info {
     int max_frame_nodes; /* largest number of FE nodes in one substructure (its component-mode
                             problem has ~3x that many DOF); free nodes: the frame's root node,
                             clamped in its basis, is not counted, so the DOF are exactly 3x */
+    int spatial;        /* 1 for a spatial model (6 DOF per node), 0 planar */
     int structured;     /* 1 when the solves take the tree-structured path (cost ~ linear in
                            the size; sm_options.solver, or the automatic choice by size),
                            0 for the dense path (cost ~ coordinates^3) */
@@ -219,6 +244,9 @@ int sm_model_element_member(const sm_model *m, int element);
 
 /** Undeformed position of FE node k: xy[0], xy[1]. Returns SM_OK or SM_INVALID_INPUT. */
 int sm_model_node_position(const sm_model *m, int node, double xy[2]);
+
+/** Undeformed position of FE node k in 3D: xyz[0..2] (z = 0 for a planar model). */
+int sm_model_node_position3(const sm_model *m, int node, double xyz[3]);
 
 /* ---------------------------------------------------------------- solve */
 
@@ -268,7 +296,10 @@ typedef struct sm_case {
     double last_omega;        /* last speed reached (== omega when converged) */
     char message[256];        /* diagnostics sentence ("" when solved) */
     int n_nodes;
-    double *nodes;            /* 3*n_nodes: deformed x, y and rotation phi (rad) */
+    int node_dof;             /* values per node in nodes and shapes: 3 planar, 6 spatial */
+    double *nodes;            /* node_dof*n_nodes: planar x, y, phi (rad); spatial x, y, z and
+                                 the rotation vector rx, ry, rz (rad, hub frame) of the node's
+                                 triad from its undeformed orientation */
     int n_elements;
     double *axial_force;      /* n_elements: P_e, N (eq. 24) */
     double max_frame_rotation; /* rad: largest rotation of a node relative to its own frame */
@@ -284,7 +315,8 @@ typedef struct sm_case {
     double *eig_im;           /* n_modes */
     double *mac_to_previous;  /* n_modes: MAC to the tracked mode of the previous speed, -1 for the first speed */
     int *previous_index;      /* n_modes: index of that mode at the previous speed, -1 if none */
-    double *shape_re;         /* n_modes * 3*n_nodes (dx,dy,dphi per node), or NULL */
+    double *shape_re;         /* n_modes * node_dof*n_nodes (planar dx,dy,dphi; spatial dx,dy,dz,
+                                 rx,ry,rz per node, hub frame), or NULL */
     double *shape_im;         /* same, NULL without Coriolis or mode shapes */
     /* timing, ms */
     double t_equilibrium, t_linearize, t_eigen;
