@@ -1,7 +1,8 @@
 /*
  * codec.h — JSON <-> core translation for the spinmodal CLI and daemon.
  *
- * The codec reads the request of DESIGN.md section 3, validates every field
+ * The codec reads the request of DESIGN.md section 3 (planar) and 7.3
+ * (spatial), validates every field
  * (collecting all errors, each with the RFC 6901 JSON pointer of the field),
  * applies the defaults and keeps a canonical copy whose SHA-256 identifies
  * the question.  It builds the core's sm_structure/sm_options/speeds from
@@ -42,13 +43,14 @@ typedef struct codec_limits {
     int max_speeds;           /* entries of analysis.omega, default 1001 */
     int max_modes;            /* analysis.modes, default 200 */
     long max_shape_values;    /* numbers in the mode shapes of a result (speeds x modes x
-                                 nodes x 3, x 2 with Coriolis), default 4e6 (~90 MB JSON) */
+                                 nodes x 3, 6 for a spatial request, x 2 with Coriolis),
+                                 default 4e6 (~90 MB JSON) */
     int max_coordinates;      /* modal coordinates of a model solved by the dense path (cost
                                  ~ n^3; models the tree-structured path takes are bounded by
                                  max_elements only), default 4000 */
     int max_frame_dofs;       /* degrees of freedom of one substructure's component-mode
-                                 problem (3 x its free nodes; cost ~ dofs^3 each), default 1200
-                                 (~3 s on one core) */
+                                 problem (3 x its free nodes, 6 x for a spatial request; cost
+                                 ~ dofs^3 each), default 1200 (~3 s on one core) */
 } codec_limits;
 
 /** Fill *lim with the default limits listed in codec_limits. */
@@ -196,8 +198,10 @@ int codec_model_build(sm_model **out, const codec_request *r, sm_progress_fn cb,
 const char *codec_case_status_name(sm_case_status s);
 
 /**
- * Encode a result as the document of DESIGN.md section 4.  r, m and res are
- * borrowed; *out receives a new reference.  Returns SM_OK or SM_NOMEM.
+ * Encode a result as the document of DESIGN.md section 4 (7.3 for a spatial
+ * request: 6 numbers per node, "model" with "spatial" and "dof_per_node").
+ * r, m and res are borrowed; *out receives a new reference.  Returns SM_OK
+ * or SM_NOMEM.
  */
 int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
                         const sm_result *res);

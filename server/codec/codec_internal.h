@@ -6,6 +6,7 @@
  *   limits.c    the default request limits                           (no helpers)
  *   errors.c    the error list and RFC 6901 pointer building         err_
  *   field.c     reading one request field: check, report, canonical  field_
+ *   section.c   a section in its planar or spatial forms             sec_
  *   validate.c  the request document walked field by field           val_
  *   request.c   canonical text, SHA-256, the core's arrays           req_
  *   diag.c      core diagnostics -> pointers, codec_model_new        diag_
@@ -34,6 +35,9 @@
 
 /* 2*pi, for hertz (M_PI is not C11); result.c and csv.c. */
 #define CODEC_TWO_PI 6.283185307179586476925
+
+/* pi/180: twist_deg (request, degrees) -> sm_member.twist (rad); request.c. */
+#define CODEC_RAD_PER_DEG 0.017453292519943295769
 
 /* GCC/Clang printf format check of argument `fmt` (1-based) and `args`. */
 #if defined(__GNUC__)
@@ -81,6 +85,8 @@ typedef struct val_ctx {
     codec_errors *errs;         /* where errors go (borrowed) */
     const codec_limits *lim;    /* limits (borrowed) */
     long total_elements;        /* FE elements over all valid members */
+    int spatial;                /* kind of the sections: 1 spatial, 0 planar, -1 not known
+                                   (no usable section); DESIGN.md 7.3 */
     int nomem;                  /* an allocation failed */
 } val_ctx;
 
@@ -166,6 +172,56 @@ const json_t *field_object(val_ctx *v, const json_t *obj, const char *key, const
 const char *field_ref(val_ctx *v, const json_t *obj, const char *key, const char *base,
                       json_t *canon, const json_t *names, const char *what);
 
+/* ====================================================== section.c: sec_ */
+
+/** The form of a section object (DESIGN.md 7.3); spatial iff >= SEC_STIFFNESS. */
+typedef enum sec_form {
+    SEC_NONE = 0,   /* not an object */
+    SEC_PLANAR,     /* E, A, I, mass_per_length */
+    SEC_STIFFNESS,  /* EA, EI_flap, EI_edge, GJ, mass_per_length [, flap/edge_inertia] */
+    SEC_MATERIAL    /* E, G, A, I_flap, I_edge, J, mass_per_length [, flap/edge_inertia] */
+} sec_form;
+
+/**
+ * The form of sec (borrowed) from the keys present: any of EA, EI_flap,
+ * EI_edge, GJ is the stiffness form; else any of G, I_flap, I_edge, J the
+ * material form; else planar (whatever else is missing or wrong).
+ */
+sec_form sec_classify(const json_t *sec);
+
+/** "planar (E, A, I, mass_per_length)", ... for messages; never NULL. */
+const char *sec_form_name(sec_form f);
+
+/**
+ * Check the section object sec (borrowed) at ptr in its form f (from
+ * sec_classify, not SEC_NONE): unknown keys, fields of another form, the
+ * required fields (> 0) and, spatial, the inertias (given > 0, or their
+ * defaults written out).  Returns its canonical copy (new reference), or
+ * NULL after reporting a field of another form or running out of memory
+ * (v->nomem).  The copy is complete only when no error was added.
+ */
+json_t *sec_validate(val_ctx *v, const json_t *sec, const char *ptr, sec_form f);
+
+/**
+ * The core's section from a validated canonical section (borrowed): planar
+ * E, A, I, mu; spatial mu and the spatial block (material form: EA = E*A,
+ * EI_flap = E*I_flap, EI_edge = E*I_edge, GJ = G*J, I_p/A = (I_flap +
+ * I_edge)/A; stiffness form: I_p/A = (flap_inertia + edge_inertia)/mu).
+ * Every other field of *out is zero.
+ */
+void sec_fill(const json_t *canon, sm_section *out);
+
+/**
+ * The request field of the canonical section canon (borrowed) behind a core
+ * field name ("EA", "mu", "ip_over_a" ...): the same name when the section
+ * has it, "E" for EA in the material form (I_flap for EI_flap, I_edge for
+ * EI_edge, J for GJ), or NULL when no one field stands for it (the error
+ * then points at the section).  *relation receives NULL or a static text
+ * such as "EA = E*A" that the message should carry.
+ */
+const char *sec_request_field(const json_t *canon, const char *core_field,
+                              const char **relation);
+
 /* ===================================================== validate.c: val_ */
 
 /**
@@ -185,5 +241,16 @@ json_t *val_request(const json_t *root, const codec_limits *lim, codec_errors *e
  * from r; NULL if out of range.
  */
 const char *req_section_name(const codec_request *r, int s);
+
+/**
+ * codec_request_parse without the core's structure check (topology, sizes)
+ * and the cost bounds that need its sizes: what the codec alone makes of a
+ * request, for tests of the codec that must not depend on the core (a
+ * spatial request before the core can check spatial structures).  The
+ * model sizes (codec_request_model_info) are then all zero.  Never used
+ * to accept a request for solving.
+ */
+int req_parse_codec_only(codec_request **out, const char *text, size_t len,
+                         const codec_limits *lim, codec_errors *errs);
 
 #endif /* SPINMODAL_CODEC_INTERNAL_H */

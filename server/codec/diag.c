@@ -8,6 +8,9 @@
  * pointer of the field in the request (joints and sections by name in the
  * sorted order of request.c, core field names to request field names) so a
  * topology error found by the core reads like any validation error.
+ * Section fields go through section.c, which knows the section's form: a
+ * core error on EA of a section given as E, G, A, I_flap, I_edge, J points
+ * at its E and says EA = E*A (EI_flap: I_flap, EI_edge: I_edge, GJ: J).
  * codec_model_new is the one place the codec calls sm_model_new.
  */
 #include "codec_internal.h"
@@ -24,6 +27,10 @@ static const char *diag_field_name(const char *f)
         return "substructure_modes";
     if (!strcmp(f, "omegas"))
         return "omega";
+    if (!strcmp(f, "twist"))
+        return "twist_deg";
+    if (!strcmp(f, "e3"))
+        return "flap_direction";
     return f;
 }
 
@@ -41,8 +48,38 @@ static int diag_among(const char *f, const char *const *names)
 /* 1 when f is a section property, in the core's or the request's spelling. */
 static int diag_is_section_field(const char *f)
 {
-    return !strcmp(f, "E") || !strcmp(f, "A") || !strcmp(f, "I") || !strcmp(f, "mu") ||
-           !strcmp(f, "mass_per_length");
+    static const char *const names[] = {"E", "A", "I", "mu", "mass_per_length", "EA", "EI_flap",
+                                        "EI_edge", "GJ", "G", "I_flap", "I_edge", "J",
+                                        "flap_inertia", "edge_inertia", "i_flap", "i_edge",
+                                        "ip_over_a", NULL};
+
+    return diag_among(f, names);
+}
+
+/*
+ * Pointer of field f of section s (section.c names the request field; the
+ * section itself when none stands for f).  *relation: NULL or a text for
+ * the message ("EA = E*A").  malloc'd, NULL = NOMEM.
+ */
+static char *diag_section_pointer(const codec_request *r, int s, const char *f,
+                                  const char **relation)
+{
+    const json_t *secs =
+        json_object_get(json_object_get(codec_request_canonical(r), "structure"), "sections");
+    const char *name = req_section_name(r, s), *key;
+    char *base = err_ptr_key("/structure/sections", name), *p;
+
+    *relation = NULL;
+    if (!base || f[0] == '\0')
+        return base;
+    if (!strcmp(f, "i_flap") || !strcmp(f, "i_edge")) /* sm_section's spelling */
+        f = f[2] == 'f' ? "flap_inertia" : "edge_inertia";
+    key = sec_request_field(json_object_get(secs, name), f, relation);
+    if (!key)
+        return base;
+    p = err_ptr_key(base, key);
+    free(base);
+    return p;
 }
 
 /* Pointer of an option field reported by the core. */
@@ -70,8 +107,28 @@ static char *diag_options_pointer(const codec_request *r, const char *f, int ind
     return err_ptr_key("/analysis", diag_field_name(f));
 }
 
-/* Pointer of the item a diagnostic names; malloc'd, NULL = NOMEM. */
-static char *diag_pointer(const codec_request *r, const sm_diag *d)
+/* Pointer of joint j's field f ("x", "y", "z": its coordinate; else the joint). */
+static char *diag_joint_pointer(const codec_request *r, int j, const char *f)
+{
+    const json_t *joints =
+        json_object_get(json_object_get(codec_request_canonical(r), "structure"), "joints");
+    const char *name = codec_request_joint_name(r, j);
+    char *base = err_ptr_key("/structure/joints", name), *p;
+    int k = !strcmp(f, "x") ? 0 : !strcmp(f, "y") ? 1 : !strcmp(f, "z") ? 2 : -1;
+
+    /* z only where the joint has one (a spatial request writes every z out) */
+    if (!base || k < 0 || (size_t)k >= json_array_size(json_object_get(joints, name)))
+        return base;
+    p = err_fmt("%s/%d", base, k);
+    free(base);
+    return p;
+}
+
+/*
+ * Pointer of the item a diagnostic names; malloc'd, NULL = NOMEM.
+ * *relation: NULL or a text the message should carry (section fields).
+ */
+static char *diag_pointer(const codec_request *r, const sm_diag *d, const char **relation)
 {
     const sm_structure *st = codec_request_structure(r);
     const char *f = d->field;
@@ -79,41 +136,29 @@ static char *diag_pointer(const codec_request *r, const sm_diag *d)
     char *base, *p;
 
     static const char *const member_fields[] = {"id", "from", "to", "section", "elements",
-                                                NULL};
-    static const char *const pm_fields[] = {"joint", "mass", NULL};
-    static const char *const no_fields[] = {NULL};
-    const char *const *known = no_fields;
+                                                "twist_deg", "flap_direction", NULL};
+    static const char *const pm_fields[] = {"joint", "mass", "inertia", NULL};
+    const char *const *known;
 
+    *relation = NULL;
     switch (d->item) {
     case SM_ITEM_MEMBER:
         if (i < 0 || i >= st->n_members)
             return strdup("/structure/members");
         if (diag_is_section_field(f) && st->members[i].section >= 0 &&
-            st->members[i].section < st->n_sections) {
-            base = err_ptr_key("/structure/sections",
-                               req_section_name(r, st->members[i].section));
-            known = NULL;
-            break;
-        }
+            st->members[i].section < st->n_sections)
+            return diag_section_pointer(r, st->members[i].section, f, relation);
         base = err_ptr_idx("/structure/members", (size_t)i);
         known = member_fields;
         break;
     case SM_ITEM_JOINT:
         if (i < 0 || i >= st->n_joints)
             return strdup("/structure/joints");
-        base = err_ptr_key("/structure/joints", codec_request_joint_name(r, i));
-        if (base && (!strcmp(f, "x") || !strcmp(f, "y"))) {
-            p = err_fmt("%s/%d", base, f[0] == 'y');
-            free(base);
-            return p;
-        }
-        return base;
+        return diag_joint_pointer(r, i, f);
     case SM_ITEM_SECTION:
         if (i < 0 || i >= st->n_sections)
             return strdup("/structure/sections");
-        base = err_ptr_key("/structure/sections", req_section_name(r, i));
-        known = NULL;
-        break;
+        return diag_section_pointer(r, i, f, relation);
     case SM_ITEM_POINT_MASS:
         if (i < 0 || i >= st->n_point_masses)
             return strdup("/structure/point_masses");
@@ -129,7 +174,7 @@ static char *diag_pointer(const codec_request *r, const sm_diag *d)
         return strdup("/structure");
     }
     /* a field the request does not have: point at the item itself */
-    if (!base || f[0] == '\0' || (known ? !diag_among(f, known) : !diag_is_section_field(f)))
+    if (!base || f[0] == '\0' || !diag_among(diag_field_name(f), known))
         return base;
     p = err_ptr_key(base, diag_field_name(f));
     free(base);
@@ -138,14 +183,19 @@ static char *diag_pointer(const codec_request *r, const sm_diag *d)
 
 int codec_diag_error(const codec_request *r, const sm_diag *d, codec_errors *errs)
 {
-    char *p = diag_pointer(r, d);
+    const char *relation;
+    const char *msg = d->message[0] ? d->message : sm_strerror(d->status);
+    char *p = diag_pointer(r, d, &relation);
     int rc;
 
     if (!p) {
         err_mark_nomem(errs);
         return SM_NOMEM;
     }
-    rc = codec_errors_add(errs, p, "%s", d->message[0] ? d->message : sm_strerror(d->status));
+    if (relation)
+        rc = codec_errors_add(errs, p, "%s (%s)", msg, relation);
+    else
+        rc = codec_errors_add(errs, p, "%s", msg);
     free(p);
     return rc;
 }

@@ -30,6 +30,7 @@ struct codec_request {
     const char **joint_names;   /* n_joints, sorted, borrowed from canon */
     const char **section_names; /* n_sections, sorted, borrowed from canon */
     double *joint_xy;           /* 2*n_joints */
+    double *joint_z;            /* n_joints (spatial requests), else NULL */
     sm_section *sections;       /* n_sections */
     sm_member *members;         /* n_members */
     sm_point_mass *point_masses;/* n_point_masses (NULL if 0) */
@@ -80,7 +81,11 @@ static double req_number(const json_t *x)
     return d;
 }
 
-/* Joints and sections arrays, sorted by name. */
+/*
+ * Joints and sections arrays, sorted by name.  The request is spatial when
+ * its sections are (validate.c made them all of one kind); then every
+ * canonical joint is [x, y, z].
+ */
 static int req_build_tables(codec_request *r)
 {
     const json_t *st = json_object_get(r->canon, "structure");
@@ -93,26 +98,39 @@ static int req_build_tables(codec_request *r)
     if (!r->joint_names || !r->section_names)
         return SM_NOMEM;
     r->joint_xy = malloc(2 * (size_t)nj * sizeof(double));
-    r->sections = malloc((size_t)(ns ? ns : 1) * sizeof(sm_section));
+    r->sections = calloc((size_t)(ns ? ns : 1), sizeof(sm_section));
     if (!r->joint_xy || !r->sections)
+        return SM_NOMEM;
+    for (i = 0; i < ns; i++)
+        sec_fill(json_object_get(secs, r->section_names[i]), &r->sections[i]);
+    r->st.spatial = ns > 0 && sec_classify(json_object_get(secs, r->section_names[0])) >=
+                                  SEC_STIFFNESS;
+    if (r->st.spatial && !(r->joint_z = malloc((size_t)(nj ? nj : 1) * sizeof(double))))
         return SM_NOMEM;
     for (i = 0; i < nj; i++) {
         const json_t *xy = json_object_get(joints, r->joint_names[i]);
         r->joint_xy[2 * i] = req_number(json_array_get(xy, 0));
         r->joint_xy[2 * i + 1] = req_number(json_array_get(xy, 1));
-    }
-    for (i = 0; i < ns; i++) {
-        const json_t *s = json_object_get(secs, r->section_names[i]);
-        r->sections[i].E = req_number(json_object_get(s, "E"));
-        r->sections[i].A = req_number(json_object_get(s, "A"));
-        r->sections[i].I = req_number(json_object_get(s, "I"));
-        r->sections[i].mu = req_number(json_object_get(s, "mass_per_length"));
+        if (r->joint_z)
+            r->joint_z[i] = req_number(json_array_get(xy, 2));
     }
     r->st.n_joints = nj;
     r->st.joint_xy = r->joint_xy;
+    r->st.joint_z = r->joint_z;
     r->st.n_sections = ns;
     r->st.sections = r->sections;
     return SM_OK;
+}
+
+/* The spatial fields of member b from its canonical object x (zero when absent). */
+static void req_member_spatial(const json_t *x, sm_member *b)
+{
+    const json_t *e3 = json_object_get(x, "flap_direction");
+    int k;
+
+    b->twist = req_number(json_object_get(x, "twist_deg")) * CODEC_RAD_PER_DEG;
+    for (k = 0; k < 3; k++)
+        b->e3[k] = req_number(json_array_get(e3, (size_t)k));
 }
 
 /* Members, point masses and clamp as indices. */
@@ -123,10 +141,10 @@ static int req_build_structure(codec_request *r)
     const json_t *pms = json_object_get(st, "point_masses");
     const json_t *x;
     size_t i, nm = json_array_size(mems), np = json_array_size(pms);
-    int nj = r->st.n_joints, ns = r->st.n_sections;
+    int nj = r->st.n_joints, ns = r->st.n_sections, k;
 
-    r->members = malloc((nm ? nm : 1) * sizeof(sm_member));
-    r->point_masses = np ? malloc(np * sizeof(sm_point_mass)) : NULL;
+    r->members = calloc(nm ? nm : 1, sizeof(sm_member));
+    r->point_masses = np ? calloc(np, sizeof(sm_point_mass)) : NULL;
     if (!r->members || (np && !r->point_masses))
         return SM_NOMEM;
     json_array_foreach(mems, i, x) {
@@ -137,11 +155,15 @@ static int req_build_structure(codec_request *r)
         r->members[i].section = req_name_index(r->section_names, ns,
                                                json_string_value(json_object_get(x, "section")));
         r->members[i].elements = (int)json_integer_value(json_object_get(x, "elements"));
+        req_member_spatial(x, &r->members[i]);
     }
     json_array_foreach(pms, i, x) {
+        const json_t *in = json_object_get(x, "inertia");
         r->point_masses[i].joint = req_name_index(r->joint_names, nj,
                                                   json_string_value(json_object_get(x, "joint")));
         r->point_masses[i].mass = req_number(json_object_get(x, "mass"));
+        for (k = 0; k < 3; k++)
+            r->point_masses[i].inertia[k] = req_number(json_array_get(in, (size_t)k));
     }
     r->st.n_members = (int)nm;
     r->st.members = r->members;
@@ -212,19 +234,22 @@ int codec_sha256_hex(const void *data, size_t len, char hex[65])
 /*
  * The checks that need the model's topology and sizes, without building it
  * (sm_structure_check is linear in the size): a tree rooted at the clamp,
- * then the cost bounds of lim (a 422 that says what to change).  Returns
- * SM_OK, SM_INVALID_INPUT (errs filled) or SM_NOMEM.
+ * then the cost bounds of lim (a 422 that says what to change).  A frame's
+ * component-mode problem has 3 DOF per free node, 6 in a spatial model; the
+ * coordinates are the core's count for either.  Returns SM_OK,
+ * SM_INVALID_INPUT (errs filled) or SM_NOMEM.
  */
 static int req_check_model(codec_request *r, const codec_limits *lim, codec_errors *errs)
 {
     sm_diag d;
     int st = sm_structure_check(&r->st, &r->opt, &r->info, &d), dofs;
+    int node_dof = r->st.spatial ? 6 : 3;
 
     if (st == SM_INVALID_INPUT)
         return codec_diag_error(r, &d, errs) == SM_NOMEM ? SM_NOMEM : SM_INVALID_INPUT;
     if (st != SM_OK)
         return st;
-    dofs = 3 * r->info.max_frame_nodes;
+    dofs = node_dof * r->info.max_frame_nodes;
     if (dofs > lim->max_frame_dofs &&
         codec_errors_add(errs, "/frames",
                          "one reference frame would carry %d degrees of freedom (%d FE nodes), "
@@ -232,7 +257,7 @@ static int req_check_model(codec_request *r, const codec_limits *lim, codec_erro
                          "frames (\"per_element\", or {\"elements_per_frame\": n} with n up to "
                          "%d)",
                          dofs, r->info.max_frame_nodes, lim->max_frame_dofs,
-                         lim->max_frame_dofs / 3) == SM_NOMEM)
+                         lim->max_frame_dofs / node_dof) == SM_NOMEM)
         return SM_NOMEM;
     if (!r->info.structured && r->info.coordinates > lim->max_coordinates &&
         codec_errors_add(errs, "/structure",
@@ -267,16 +292,99 @@ static double req_element_length(const codec_request *r, int i)
     double dx = r->joint_xy[2 * b->to] - r->joint_xy[2 * b->from];
     double dy = r->joint_xy[2 * b->to + 1] - r->joint_xy[2 * b->from + 1];
 
+    if (r->joint_z) /* |(dx, dy, dz)| */
+        return hypot(hypot(dx, dy), r->joint_z[b->to] - r->joint_z[b->from]) / b->elements;
     return hypot(dx, dy) / b->elements;
 }
 
-/* One error at pointer base/key (key escaped); SM_OK or SM_NOMEM. */
-static int req_error_at(codec_errors *errs, const char *base, const char *key, const char *msg)
+/*
+ * Planar section c: "E" or "mass_per_length" when its element stiffness
+ * (EI/l^3, EA/l) or mass (mu*l) leaves the range, with the message in msg;
+ * NULL when in range.
+ */
+static const char *req_planar_range(const sm_section *c, double lmin, double lmax, char *msg,
+                                    size_t n)
 {
-    char *p = err_ptr_key(base, key);
-    int rc = p ? codec_errors_add(errs, p, "%s", msg) : SM_NOMEM;
+    double kb = c->E * c->I / (lmin * lmin * lmin), ka = c->E * c->A / lmin;
+    double mass = c->mu * lmax;
+    const char *field = NULL;
 
+    if (!(kb < REQ_MAX_MAGNITUDE && ka < REQ_MAX_MAGNITUDE) ||
+        !(kb > 1 / REQ_MAX_MAGNITUDE && ka > 1 / REQ_MAX_MAGNITUDE))
+        field = "E";
+    else if (!(mass < REQ_MAX_MAGNITUDE && mass > 1 / REQ_MAX_MAGNITUDE))
+        field = "mass_per_length";
+    if (field)
+        snprintf(msg, n,
+                 "with this value the element %s (EI/l^3 = %.3g N/m, EA/l = %.3g N/m, "
+                 "mu*l = %.3g kg) leaves the range the numerics carry (%g to %g): check the "
+                 "units (SI: Pa, m^2, m^4, kg/m)",
+                 field[0] == 'E' ? "stiffness" : "mass", kb, ka, mass, 1 / REQ_MAX_MAGNITUDE,
+                 REQ_MAX_MAGNITUDE);
+    return field;
+}
+
+/*
+ * Spatial section c: the core field name of the first element stiffness,
+ * mass or rotary inertia out of range, with the message in msg; NULL when
+ * all are in range.
+ */
+static const char *req_spatial_range(const sm_section *c, double lmin, double lmax, char *msg,
+                                     size_t n)
+{
+    double l3 = lmin * lmin * lmin;
+    const struct {
+        const char *field, *what, *unit;
+        double value;
+    } q[] = {
+        {"EA", "axial stiffness EA/l", "N/m", c->EA / lmin},
+        {"EI_flap", "flapwise bending stiffness EI_flap/l^3", "N/m", c->EI_flap / l3},
+        {"EI_edge", "edgewise bending stiffness EI_edge/l^3", "N/m", c->EI_edge / l3},
+        {"GJ", "torsional stiffness GJ/l", "N m", c->GJ / lmin},
+        {"mu", "mass mu*l", "kg", c->mu * lmax},
+        {"flap_inertia", "rotary inertia flap_inertia*l", "kg m^2", c->i_flap * lmax},
+        {"edge_inertia", "rotary inertia edge_inertia*l", "kg m^2", c->i_edge * lmax},
+    };
+    size_t k;
+
+    for (k = 0; k < sizeof(q) / sizeof(q[0]); k++) {
+        if (q[k].value < REQ_MAX_MAGNITUDE && q[k].value > 1 / REQ_MAX_MAGNITUDE)
+            continue;
+        snprintf(msg, n,
+                 "with this value the element %s = %.3g %s leaves the range the numerics "
+                 "carry (%g to %g): check the units (SI: N, N m^2, kg/m, kg m; or Pa, m^2, "
+                 "m^4)",
+                 q[k].what, q[k].value, q[k].unit, 1 / REQ_MAX_MAGNITUDE, REQ_MAX_MAGNITUDE);
+        return q[k].field;
+    }
+    return NULL;
+}
+
+/*
+ * One conditioning error for section i: at its field that stands for the
+ * core field `field` (section.c: E for EA in the material form, with the
+ * relation added to the message), or at the section.  SM_OK or SM_NOMEM.
+ */
+static int req_section_error(const codec_request *r, int i, const char *field, const char *msg,
+                             codec_errors *errs)
+{
+    const json_t *secs = json_object_get(json_object_get(r->canon, "structure"), "sections");
+    const char *relation, *key;
+    char *sec = err_ptr_key("/structure/sections", r->section_names[i]), *p = NULL;
+    int rc = SM_NOMEM;
+
+    if (!sec)
+        return SM_NOMEM;
+    key = sec_request_field(json_object_get(secs, r->section_names[i]), field, &relation);
+    if (key && !(p = err_ptr_key(sec, key)))
+        goto done;
+    if (relation)
+        rc = codec_errors_add(errs, p ? p : sec, "%s (%s)", msg, relation);
+    else
+        rc = codec_errors_add(errs, p ? p : sec, "%s", msg);
+done:
     free(p);
+    free(sec);
     return rc;
 }
 
@@ -307,39 +415,24 @@ static int req_check_conditioning(const codec_request *r, codec_errors *errs)
         }
     }
     for (i = 0; i < r->st.n_sections; i++) {
-        const sm_section *c = &r->sections[i];
-        const char *name = r->section_names[i];
-        double kb = c->E * c->I / (lmin * lmin * lmin), ka = c->E * c->A / lmin;
-        double mass = c->mu * lmax;
-        const char *field = NULL;
-        if (!(kb < REQ_MAX_MAGNITUDE && ka < REQ_MAX_MAGNITUDE) ||
-            !(kb > 1 / REQ_MAX_MAGNITUDE && ka > 1 / REQ_MAX_MAGNITUDE))
-            field = "E";
-        else if (!(mass < REQ_MAX_MAGNITUDE && mass > 1 / REQ_MAX_MAGNITUDE))
-            field = "mass_per_length";
+        const char *field = r->st.spatial
+                                ? req_spatial_range(&r->sections[i], lmin, lmax, msg, sizeof(msg))
+                                : req_planar_range(&r->sections[i], lmin, lmax, msg, sizeof(msg));
         if (!field)
             continue;
-        snprintf(base, sizeof(base), "/structure/sections");
-        snprintf(msg, sizeof(msg),
-                 "with this value the element %s (EI/l^3 = %.3g N/m, EA/l = %.3g N/m, "
-                 "mu*l = %.3g kg) leaves the range the numerics carry (%g to %g): check the "
-                 "units (SI: Pa, m^2, m^4, kg/m)",
-                 field[0] == 'E' ? "stiffness" : "mass", kb, ka, mass, 1 / REQ_MAX_MAGNITUDE,
-                 REQ_MAX_MAGNITUDE);
-        {
-            char *sec = err_ptr_key(base, name);
-            int rc = sec ? req_error_at(errs, sec, field, msg) : SM_NOMEM;
-            free(sec);
-            if (rc == SM_NOMEM)
-                return SM_NOMEM;
-        }
+        if (req_section_error(r, i, field, msg, errs) == SM_NOMEM)
+            return SM_NOMEM;
         bad = 1;
     }
     return bad ? SM_INVALID_INPUT : SM_OK;
 }
 
-int codec_request_from_json(codec_request **out, const json_t *root,
-                            const codec_limits *lim, codec_errors *errs)
+/*
+ * codec_request_from_json; core_check 0 leaves out the core's structure
+ * check and the cost bounds (req_parse_codec_only).
+ */
+static int req_from_json(codec_request **out, const json_t *root, const codec_limits *lim,
+                         codec_errors *errs, int core_check)
 {
     codec_limits deflim;
     codec_request *r = NULL;
@@ -368,7 +461,8 @@ int codec_request_from_json(codec_request **out, const json_t *root,
         goto fail;
     if ((rc = codec_sha256_hex(r->canon_text, strlen(r->canon_text), r->sha)) ||
         (rc = req_build_tables(r)) || (rc = req_build_structure(r)) ||
-        (rc = req_build_options(r)) || (rc = req_check_model(r, lim, errs)) ||
+        (rc = req_build_options(r)) ||
+        (core_check && (rc = req_check_model(r, lim, errs))) ||
         (rc = req_check_conditioning(r, errs)))
         goto fail;
     *out = r;
@@ -379,8 +473,15 @@ fail:
     return rc;
 }
 
-int codec_request_parse(codec_request **out, const char *text, size_t len,
-                        const codec_limits *lim, codec_errors *errs)
+int codec_request_from_json(codec_request **out, const json_t *root,
+                            const codec_limits *lim, codec_errors *errs)
+{
+    return req_from_json(out, root, lim, errs, 1);
+}
+
+/* codec_request_parse; core_check as for req_from_json. */
+static int req_parse(codec_request **out, const char *text, size_t len, const codec_limits *lim,
+                     codec_errors *errs, int core_check)
 {
     codec_limits deflim;
     json_error_t jerr;
@@ -412,9 +513,21 @@ int codec_request_parse(codec_request **out, const char *text, size_t len,
             return SM_NOMEM;
         return SM_INVALID_INPUT;
     }
-    rc = codec_request_from_json(out, root, lim, errs);
+    rc = req_from_json(out, root, lim, errs, core_check);
     json_decref(root);
     return rc;
+}
+
+int codec_request_parse(codec_request **out, const char *text, size_t len,
+                        const codec_limits *lim, codec_errors *errs)
+{
+    return req_parse(out, text, len, lim, errs, 1);
+}
+
+int req_parse_codec_only(codec_request **out, const char *text, size_t len,
+                         const codec_limits *lim, codec_errors *errs)
+{
+    return req_parse(out, text, len, lim, errs, 0);
 }
 
 void codec_request_free(codec_request *r)
@@ -426,6 +539,7 @@ void codec_request_free(codec_request *r)
     free(r->members);
     free(r->sections);
     free(r->joint_xy);
+    free(r->joint_z);
     free(r->section_names);
     free(r->joint_names);
     free(r->canon_text);

@@ -8,6 +8,12 @@
  * of request.c), the model the joint -> node map and the sizes.  Numbers
  * that are not finite become null (JSON has no NaN or infinity).  csv.c
  * writes the same frequencies as a table.
+ *
+ * Planar or spatial (DESIGN.md 7.3): every node, joint and shape row has
+ * the case's node_dof numbers, [x, y, phi] planar and [x, y, z, rx, ry, rz]
+ * spatial; a spatial model adds "spatial": true and "dof_per_node": 6 to
+ * "model".  A planar result has no new key, so its bytes are those of
+ * before the spatial model existed.
  */
 #include "codec_internal.h"
 
@@ -47,8 +53,14 @@ fail:
     return NULL;
 }
 
-/* [[x, y, z], ...] from n triples. */
-static json_t *res_triples(const double *v, int n)
+/* Values per node of case c: node_dof (3 planar, 6 spatial). */
+static int res_node_dof(const sm_case *c)
+{
+    return c->node_dof == 6 ? 6 : 3; /* a core before 0.4.0 leaves node_dof 0: planar */
+}
+
+/* [[x, y, phi], ...] from n rows of dof reals each. */
+static json_t *res_rows(const double *v, int n, int dof)
 {
     json_t *a = json_array();
     int k;
@@ -56,7 +68,7 @@ static json_t *res_triples(const double *v, int n)
     if (!a)
         return NULL;
     for (k = 0; k < n; k++)
-        if (json_array_append_new(a, res_reals(v + 3 * (size_t)k, 3)))
+        if (json_array_append_new(a, res_reals(v + (size_t)dof * (size_t)k, dof)))
             goto fail;
     return a;
 fail:
@@ -68,7 +80,7 @@ fail:
 static json_t *res_equilibrium(const codec_request *r, const sm_model *m, const sm_case *c)
 {
     json_t *e = json_object(), *joints = NULL;
-    int j, nj = codec_request_structure(r)->n_joints;
+    int j, nj = codec_request_structure(r)->n_joints, dof = res_node_dof(c);
 
     if (!e)
         return NULL;
@@ -85,13 +97,13 @@ static json_t *res_equilibrium(const codec_request *r, const sm_model *m, const 
             if (node < 0 || node >= c->n_nodes)
                 continue;
             if (json_object_set_new(joints, codec_request_joint_name(r, j),
-                                    res_reals(c->nodes + 3 * (size_t)node, 3)))
+                                    res_reals(c->nodes + (size_t)dof * (size_t)node, dof)))
                 goto fail;
         }
         if (json_object_set_new(e, "joints", joints))
             goto fail_set;
         joints = NULL;
-        if (json_object_set_new(e, "nodes", res_triples(c->nodes, c->n_nodes)))
+        if (json_object_set_new(e, "nodes", res_rows(c->nodes, c->n_nodes, dof)))
             goto fail;
     }
     if (c->axial_force && c->n_elements > 0 &&
@@ -111,7 +123,8 @@ fail_set:
 /* One mode of a case. */
 static json_t *res_mode(const sm_case *c, int k, int shapes)
 {
-    size_t stride = 3 * (size_t)c->n_nodes;
+    int dof = res_node_dof(c);
+    size_t stride = (size_t)dof * (size_t)c->n_nodes;
     json_t *md = json_object(), *shape;
     double mac = c->mac_to_previous ? c->mac_to_previous[k] : -1;
     int prev = c->previous_index ? c->previous_index[k] : -1;
@@ -129,10 +142,11 @@ static json_t *res_mode(const sm_case *c, int k, int shapes)
         shape = json_object();
         if (json_object_set_new(md, "shape", shape))
             goto fail;
-        if (json_object_set_new(shape, "re", res_triples(c->shape_re + k * stride, c->n_nodes)))
+        if (json_object_set_new(shape, "re",
+                                res_rows(c->shape_re + k * stride, c->n_nodes, dof)))
             goto fail;
         if (c->shape_im &&
-            json_object_set_new(shape, "im", res_triples(c->shape_im + k * stride, c->n_nodes)))
+            json_object_set_new(shape, "im", res_rows(c->shape_im + k * stride, c->n_nodes, dof)))
             goto fail;
     }
     return md;
@@ -181,6 +195,22 @@ fail:
     return NULL;
 }
 
+/* The "model" object: sizes, and for a spatial model "spatial" and "dof_per_node". */
+static json_t *res_model(const codec_request *r, const sm_model_info *info)
+{
+    json_t *o = json_pack("{s:i, s:i, s:i, s:i}", "nodes", info->nodes, "elements",
+                          info->elements, "frames", info->frames, "coordinates",
+                          info->coordinates);
+
+    if (o && codec_request_structure(r)->spatial &&
+        (json_object_set_new(o, "spatial", json_true()) ||
+         json_object_set_new(o, "dof_per_node", json_integer(6)))) {
+        json_decref(o);
+        return NULL;
+    }
+    return o;
+}
+
 int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
                         const sm_result *res)
 {
@@ -197,10 +227,7 @@ int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
     if (json_object_set_new(doc, "solver",
                             json_pack("{s:s, s:s, s:s}", "name", "spinmodal", "version",
                                       SM_VERSION, "request_sha256", codec_request_sha256(r))) ||
-        json_object_set_new(doc, "model",
-                            json_pack("{s:i, s:i, s:i, s:i}", "nodes", info.nodes,
-                                      "elements", info.elements, "frames", info.frames,
-                                      "coordinates", info.coordinates)))
+        json_object_set_new(doc, "model", res_model(r, &info)))
         goto fail;
     cases = json_array();
     if (json_object_set_new(doc, "cases", cases))

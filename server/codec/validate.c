@@ -1,5 +1,5 @@
 /*
- * validate.c — the request document of DESIGN.md section 3, walked field by field.
+ * validate.c — the request document of DESIGN.md sections 3 and 7.3, walked field by field.
  *
  * How it fits: request.c hands the parsed JSON to val_request, which checks
  * it against the request's shape and builds the canonical copy with every
@@ -10,6 +10,15 @@
  * (type, range, references, unknown keys) with the readers of field.c, and
  * each error carries the JSON pointer of its field.  The limits of
  * codec_limits are checked before anything is built from a count.
+ *
+ * Planar or spatial (DESIGN.md 7.3): the sections decide (section.c tells
+ * the form of each).  They must all be of one kind; the spatial fields of
+ * the other items ([x, y, z] joints, a member's twist_deg and
+ * flap_direction, a point mass's inertia) and the "paper" basis are checked
+ * against that kind, each mismatch a 422 that says what to add.  A planar
+ * request keeps exactly its canonical form of before the spatial fields
+ * existed; a spatial one writes its defaults out (z = 0, twist_deg 0,
+ * inertia [0, 0, 0], the section inertias).
  *
  * Topology (cycles, disconnected members) is the core's job: sm_model_new
  * reports it and diag.c maps it back to a pointer.  Here only the cheap
@@ -22,17 +31,24 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Coordinates of joint `name` in the input joints object, if valid. */
-static int val_joint_xy(const json_t *joints, const char *name, double xy[2])
+/* What to add for spatial sections, in messages. */
+#define VAL_SPATIAL_SECTIONS                                                                   \
+    "give every section EA, EI_flap, EI_edge, GJ and mass_per_length (or E, G, A, I_flap, "    \
+    "I_edge, J and mass_per_length)"
+
+/* Position of joint `name` in the input joints object (z = 0 for [x, y]), if valid. */
+static int val_joint_pos(const json_t *joints, const char *name, double p[3])
 {
     const json_t *j = joints ? json_object_get(joints, name) : NULL;
+    size_t n = json_array_size(j), k;
 
-    if (!json_is_array(j) || json_array_size(j) != 2)
+    if (!json_is_array(j) || n < 2 || n > 3)
         return 0;
-    if (!field_number(json_array_get(j, 0), &xy[0]) ||
-        !field_number(json_array_get(j, 1), &xy[1]))
-        return 0;
-    return isfinite(xy[0]) && isfinite(xy[1]);
+    p[2] = 0;
+    for (k = 0; k < n; k++)
+        if (!field_number(json_array_get(j, k), &p[k]) || !isfinite(p[k]))
+            return 0;
+    return 1;
 }
 
 /*
@@ -55,14 +71,20 @@ static int val_count(val_ctx *v, const char *base, size_t n, int limit, const ch
 
 /* ---------------------------------------------------------- structure */
 
-/* structure.joints: {"name": [x, y], ...}; returns the input object if usable. */
-static const json_t *val_joints(val_ctx *v, const json_t *st, json_t *cst)
+/*
+ * structure.joints: {"name": [x, y] or [x, y, z], ...}; returns the input
+ * object if usable.  *first_z receives the name (borrowed) of the first
+ * joint given with z, or NULL: whether z is allowed depends on the
+ * sections (val_spatial_joints).
+ */
+static const json_t *val_joints(val_ctx *v, const json_t *st, json_t *cst, const char **first_z)
 {
     static const char *base = "/structure/joints";
     const json_t *joints = field_object(v, st, "joints", "/structure");
     json_t *cj, *xy;
     const char *name;
 
+    *first_z = NULL;
     if (!joints)
         return NULL;
     if (!val_count(v, base, json_object_size(joints), v->lim->max_joints, "joints",
@@ -73,8 +95,9 @@ static const json_t *val_joints(val_ctx *v, const json_t *st, json_t *cst)
         v->nomem = 1;
     json_object_foreach((json_t *)joints, name, xy) {
         char *p = err_ptr_key(base, name);
-        double c[2];
-        size_t k;
+        double c[3];
+        size_t k, n = json_array_size(xy);
+        int ok = 1;
         json_t *arr;
         if (!p) {
             v->nomem = 1;
@@ -82,44 +105,98 @@ static const json_t *val_joints(val_ctx *v, const json_t *st, json_t *cst)
         }
         if (name[0] == '\0')
             field_error(v, p, "a joint name must not be empty");
-        if (!json_is_array(xy) || json_array_size(xy) != 2) {
+        if (!json_is_array(xy) || n < 2 || n > 3) {
             if (json_is_array(xy))
-                field_error(v, p, "must be [x, y] (2 numbers), got %zu value%s",
-                            json_array_size(xy), json_array_size(xy) == 1 ? "" : "s");
+                field_error(v, p, "must be [x, y] or [x, y, z] (2 or 3 numbers), got %zu value%s",
+                            n, n == 1 ? "" : "s");
             else
-                field_error(v, p, "must be [x, y] (2 numbers), not %s", field_type_name(xy));
+                field_error(v, p, "must be [x, y] or [x, y, z] (2 or 3 numbers), not %s",
+                            field_type_name(xy));
             free(p);
             continue;
         }
-        for (k = 0; k < 2; k++) {
+        if (n == 3 && !*first_z)
+            *first_z = name;
+        for (k = 0; k < n; k++) {
             char *pk = err_ptr_idx(p, k);
             if (!field_check_real(v, json_array_get(xy, k), pk ? pk : p, FIELD_FINITE, " (m)",
                                   &c[k]))
-                c[k] = NAN;
+                ok = 0;
             free(pk);
         }
         free(p);
-        if (isfinite(c[0]) && isfinite(c[1])) {
-            arr = json_pack("[f, f]", c[0], c[1]);
-            if (cj && (!arr || json_object_set_new(cj, name, arr)))
-                v->nomem = 1;
-            else if (!cj)
-                json_decref(arr);
-        }
+        if (!ok)
+            continue;
+        arr = n == 3 ? json_pack("[f, f, f]", c[0], c[1], c[2]) : json_pack("[f, f]", c[0], c[1]);
+        if (cj && (!arr || json_object_set_new(cj, name, arr)))
+            v->nomem = 1;
+        else if (!cj)
+            json_decref(arr);
     }
     field_set(v, cst, "joints", cj);
     return joints;
 }
 
-/* structure.sections: {"name": {E, A, I, mass_per_length}, ...}. */
+/*
+ * Joints and the kind of the sections: with planar sections a joint must
+ * not have z (one error, at the first joint given with z); with spatial
+ * sections every canonical joint is [x, y, z] (z = 0 written out).
+ */
+static void val_spatial_joints(val_ctx *v, json_t *cst, const char *first_z)
+{
+    json_t *cj = json_object_get(cst, "joints"), *xy;
+    const char *name;
+
+    if (v->spatial == 0 && first_z) {
+        field_error_key(v, "/structure/joints", first_z,
+                        "a joint with z needs spatial sections: " VAL_SPATIAL_SECTIONS
+                        ", or give the joint as [x, y]");
+        return;
+    }
+    if (v->spatial != 1 || !cj)
+        return;
+    json_object_foreach(cj, name, xy)
+        if (json_array_size(xy) == 2 && json_array_append_new(xy, json_real(0.0)))
+            v->nomem = 1;
+}
+
+/*
+ * The kind of one section (form f, named name) against the first section
+ * with a form (*first, *first_form): planar and spatial do not mix.
+ */
+static void val_section_kind(val_ctx *v, const char *ptr, const char *name, sec_form f,
+                             const char **first, sec_form *first_form)
+{
+    int spatial = f >= SEC_STIFFNESS;
+
+    if (!*first) {
+        *first = name;
+        *first_form = f;
+        v->spatial = spatial;
+        return;
+    }
+    if (spatial == v->spatial)
+        return;
+    field_error(v, ptr,
+                "section '%s' is %s but the first section, '%s', is %s: planar and spatial "
+                "sections do not mix; %s",
+                field_short_name(name).s, sec_form_name(f), field_short_name(*first).s,
+                sec_form_name(*first_form),
+                spatial ? "give every section in spatial form (add EI_flap, EI_edge and GJ "
+                          "or G, I_flap, I_edge and J to the planar ones), or this one as "
+                          "E, A, I, mass_per_length"
+                        : "give this section in spatial form: EA, EI_flap, EI_edge, GJ and "
+                          "mass_per_length (or E, G, A, I_flap, I_edge, J and mass_per_length)");
+}
+
+/* structure.sections: {"name": {planar or spatial section}, ...} (section.c). */
 static const json_t *val_sections(val_ctx *v, const json_t *st, json_t *cst)
 {
-    static const char *const keys[] = {"E", "A", "I", "mass_per_length", NULL};
-    static const char *const units[] = {" (Pa)", " (m^2)", " (m^4)", " (kg/m)"};
     static const char *base = "/structure/sections";
     const json_t *secs = field_object(v, st, "sections", "/structure");
     json_t *cs, *sec;
-    const char *name;
+    const char *name, *first = NULL;
+    sec_form first_form = SEC_NONE;
 
     if (!secs)
         return NULL;
@@ -131,26 +208,23 @@ static const json_t *val_sections(val_ctx *v, const json_t *st, json_t *cst)
         v->nomem = 1;
     json_object_foreach((json_t *)secs, name, sec) {
         char *p = err_ptr_key(base, name);
+        sec_form f = sec_classify(sec);
         json_t *c;
-        int k;
         if (!p) {
             v->nomem = 1;
             break;
         }
         if (name[0] == '\0')
             field_error(v, p, "a section name must not be empty");
-        if (!json_is_object(sec)) {
-            field_error(v, p, "must be an object {E, A, I, mass_per_length}, not %s",
+        if (f == SEC_NONE) {
+            field_error(v, p, "must be an object {E, A, I, mass_per_length} (planar) or {EA, "
+                        "EI_flap, EI_edge, GJ, mass_per_length} (spatial), not %s",
                         field_type_name(sec));
             free(p);
             continue;
         }
-        field_check_keys(v, sec, p, keys, "section");
-        c = json_object();
-        if (!c)
-            v->nomem = 1;
-        for (k = 0; keys[k]; k++)
-            field_real(v, sec, keys[k], p, c, FIELD_POSITIVE, units[k], NULL);
+        val_section_kind(v, p, name, f, &first, &first_form);
+        c = sec_validate(v, sec, p, f);
         free(p);
         if (cs && c && json_object_set_new(cs, name, c))
             v->nomem = 1;
@@ -161,16 +235,96 @@ static const json_t *val_sections(val_ctx *v, const json_t *st, json_t *cst)
     return secs;
 }
 
-/* Member i: {id, from, to, section, elements}; adds its elements to *total. */
+/*
+ * A spatial-only field obj[key] at base/key: with planar sections its
+ * presence is an error saying what to add (returns 0); with spatial
+ * sections it is checked by the caller (returns 1); when the kind is not
+ * known (no usable section: already an error) it is left alone (0).
+ */
+static int val_spatial_field(val_ctx *v, const json_t *obj, const char *key, const char *base)
+{
+    if (v->spatial == 1)
+        return 1;
+    if (v->spatial == 0 && json_object_get(obj, key))
+        field_error_key(v, base, key, "'%s' needs spatial sections: " VAL_SPATIAL_SECTIONS
+                        ", or drop '%s'", key, key);
+    return 0;
+}
+
+/*
+ * A vector field obj[key] of 3 numbers of kind at base/key, copied to
+ * canon; nonzero: it must not be [0, 0, 0].  shape ("[x, y, z]") and unit
+ * (" (m)" or "") go into messages.  Returns 1 when valid.
+ */
+static int val_vector3(val_ctx *v, const json_t *obj, const char *key, const char *base,
+                       json_t *canon, enum field_real_kind kind, int nonzero, const char *shape,
+                       const char *unit)
+{
+    const json_t *x = json_object_get(obj, key);
+    char *p = err_ptr_key(base, key);
+    double c[3];
+    size_t k;
+    int ok = 1;
+
+    if (!p) {
+        v->nomem = 1;
+        return 0;
+    }
+    if (!json_is_array(x) || json_array_size(x) != 3) {
+        if (json_is_array(x))
+            field_error(v, p, "must be %s (3 numbers), got %zu value%s", shape,
+                        json_array_size(x), json_array_size(x) == 1 ? "" : "s");
+        else
+            field_error(v, p, "must be %s (3 numbers), not %s", shape, field_type_name(x));
+        free(p);
+        return 0;
+    }
+    for (k = 0; k < 3; k++) {
+        char *pk = err_ptr_idx(p, k);
+        if (!field_check_real(v, json_array_get(x, k), pk ? pk : p, kind, unit, &c[k]))
+            ok = 0;
+        free(pk);
+    }
+    if (ok && nonzero && c[0] == 0 && c[1] == 0 && c[2] == 0) {
+        field_error(v, p, "[0, 0, 0] is no direction: give a non-zero [x, y, z] (hub frame) "
+                    "for the member's e3 (flapwise) axis, or drop '%s' for the default", key);
+        ok = 0;
+    }
+    free(p);
+    if (ok)
+        field_set(v, canon, key, json_pack("[f, f, f]", c[0], c[1], c[2]));
+    return ok;
+}
+
+/*
+ * The spatial fields of member p (DESIGN.md 7.1, 7.3): twist_deg (degrees,
+ * default 0 written out) and flap_direction ([x, y, z], hub frame, any
+ * length; no default in the canonical form: the core finds e3).
+ */
+static void val_member_spatial(val_ctx *v, const json_t *mem, const char *p, json_t *c)
+{
+    if (val_spatial_field(v, mem, "twist_deg", p)) {
+        if (json_object_get(mem, "twist_deg"))
+            field_real(v, mem, "twist_deg", p, c, FIELD_FINITE, " (degrees)", NULL);
+        else
+            field_set(v, c, "twist_deg", json_real(0.0));
+    }
+    if (val_spatial_field(v, mem, "flap_direction", p) && json_object_get(mem, "flap_direction"))
+        val_vector3(v, mem, "flap_direction", p, c, FIELD_FINITE, 1, "[x, y, z]", "");
+}
+
+/* Member i: {id, from, to, section, elements [, twist_deg, flap_direction]}; adds its
+ * elements to *total. */
 static void val_member(val_ctx *v, const json_t *mem, size_t i, const json_t *joints,
                        const json_t *secs, json_t *cm, json_t *ids, json_t *ends,
                        int *ends_ok, long *total)
 {
-    static const char *const keys[] = {"id", "from", "to", "section", "elements", NULL};
+    static const char *const keys[] = {"id", "from", "to", "section", "elements", "twist_deg",
+                                       "flap_direction", NULL};
     char *p = err_ptr_idx("/structure/members", i);
     const json_t *id;
     const char *from, *to;
-    double a[2], b[2];
+    double a[3], b[3];
     long el;
     json_t *c = NULL;
 
@@ -209,6 +363,7 @@ static void val_member(val_ctx *v, const json_t *mem, size_t i, const json_t *jo
     if (field_int(v, mem, "elements", p, c, 1, 0, 1, v->lim->max_elements,
                   "the number of elements", &el))
         *total += el;
+    val_member_spatial(v, mem, p, c);
     if (!from || !to) {
         *ends_ok = 0;
     } else {
@@ -218,8 +373,8 @@ static void val_member(val_ctx *v, const json_t *mem, size_t i, const json_t *jo
         if (!strcmp(from, to))
             field_error_key(v, p, "to", "zero-length member: it starts and ends at joint '%s'",
                             field_short_name(to).s);
-        else if (val_joint_xy(joints, from, a) && val_joint_xy(joints, to, b) && a[0] == b[0] &&
-                 a[1] == b[1])
+        else if (val_joint_pos(joints, from, a) && val_joint_pos(joints, to, b) &&
+                 a[0] == b[0] && a[1] == b[1] && a[2] == b[2])
             field_error(v, p, "zero-length member: joints '%s' and '%s' are at the same position",
                         field_short_name(from).s, field_short_name(to).s);
     }
@@ -269,10 +424,14 @@ static void val_members(val_ctx *v, const json_t *st, const json_t *joints, cons
     field_set(v, cst, "members", cm);
 }
 
-/* structure.point_masses: optional array of {joint, mass}. */
+/*
+ * structure.point_masses: optional array of {joint, mass [, inertia]};
+ * inertia [Ixx, Iyy, Izz] (kg m^2, hub axes) with spatial sections only,
+ * default [0, 0, 0] written out.
+ */
 static void val_point_masses(val_ctx *v, const json_t *st, const json_t *joints, json_t *cst)
 {
-    static const char *const keys[] = {"joint", "mass", NULL};
+    static const char *const keys[] = {"joint", "mass", "inertia", NULL};
     static const char *base = "/structure/point_masses";
     const json_t *pms = json_object_get(st, "point_masses");
     json_t *cp, *pm;
@@ -312,6 +471,13 @@ static void val_point_masses(val_ctx *v, const json_t *st, const json_t *joints,
             v->nomem = 1;
         field_ref(v, pm, "joint", p, c, joints, "joint");
         field_real(v, pm, "mass", p, c, FIELD_NONNEG, " (kg)", NULL);
+        if (val_spatial_field(v, pm, "inertia", p)) {
+            if (json_object_get(pm, "inertia"))
+                val_vector3(v, pm, "inertia", p, c, FIELD_NONNEG, 0, "[Ixx, Iyy, Izz]",
+                            " (kg m^2)");
+            else
+                field_set(v, c, "inertia", json_pack("[f, f, f]", 0.0, 0.0, 0.0));
+        }
         free(p);
         if (c && json_array_append_new(cp, c))
             v->nomem = 1;
@@ -340,6 +506,7 @@ static void val_structure(val_ctx *v, const json_t *root, json_t *canon)
                                        "clamp", NULL};
     const json_t *st = field_object(v, root, "structure", "");
     const json_t *joints, *secs, *clamp;
+    const char *first_z;
     json_t *cst, *ends;
     int ends_ok = 0;
 
@@ -350,8 +517,9 @@ static void val_structure(val_ctx *v, const json_t *root, json_t *canon)
     ends = json_object();
     if (!cst || !ends)
         v->nomem = 1;
-    joints = val_joints(v, st, cst);
+    joints = val_joints(v, st, cst, &first_z);
     secs = val_sections(v, st, cst);
+    val_spatial_joints(v, cst, first_z);
     if (ends)
         val_members(v, st, joints, secs, cst, ends, &ends_ok);
     val_point_masses(v, st, joints, cst);
@@ -472,6 +640,7 @@ static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
     static const char *base = "/analysis";
     const json_t *an = field_object(v, root, "analysis", "");
     const json_t *mpf;
+    const char *basis_name;
     json_t *can;
 
     if (!an)
@@ -487,6 +656,12 @@ static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
     field_bool(v, an, "coriolis", base, can, 1);
     field_enum(v, an, "mass", base, can, mass, "lumped");
     field_enum(v, an, "substructure_modes", base, can, basis, "augmented");
+    basis_name = json_string_value(json_object_get(can, "substructure_modes"));
+    if (v->spatial == 1 && basis_name && !strcmp(basis_name, "paper"))
+        field_error(v, "/analysis/substructure_modes",
+                    "the \"paper\" basis is planar-only (Kim & Yoo's condensed in-plane "
+                    "component modes, kept to reproduce their Table 2): use \"augmented\" (the "
+                    "default) with spatial sections");
     mpf = json_object_get(an, "modes_per_frame");
     if (!mpf || (json_is_string(mpf) && !strcmp(json_string_value(mpf), "all")))
         field_set(v, can, "modes_per_frame", json_string("all"));
@@ -502,7 +677,8 @@ static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
 
 /*
  * Size of the mode shapes in the result: speeds x modes x nodes x 3
- * (x 2 with Coriolis: complex shapes) against max_shape_values.
+ * (6 for a spatial request; x 2 with Coriolis: complex shapes) against
+ * max_shape_values.
  */
 static void val_output_size(val_ctx *v, const json_t *canon)
 {
@@ -511,7 +687,7 @@ static void val_output_size(val_ctx *v, const json_t *canon)
     double speeds = json_is_array(om) ? (double)json_array_size(om) : 1;
     double modes = (double)json_integer_value(json_object_get(an, "modes"));
     double nodes = (double)v->total_elements + 1; /* a tree of elements */
-    double values = speeds * modes * nodes * 3 *
+    double values = speeds * modes * nodes * (v->spatial == 1 ? 6 : 3) *
                     (json_is_true(json_object_get(an, "coriolis")) ? 2 : 1);
 
     if (!json_is_true(json_object_get(an, "mode_shapes")) || !(values > v->lim->max_shape_values))
@@ -555,6 +731,7 @@ json_t *val_request(const json_t *root, const codec_limits *lim, codec_errors *e
     v.errs = errs;
     v.lim = lim;
     v.total_elements = 0;
+    v.spatial = -1;
     v.nomem = 0;
     canon = val_document(&v, root);
     *nomem = v.nomem;
