@@ -128,8 +128,8 @@ static int sec_foreign(val_ctx *v, const json_t *sec, const char *ptr, sec_form 
                 continue;
             field_error_key(v, ptr, inertias[i],
                             "'%s' is spatial section data, and a planar section (E, A, I, "
-                            "mass_per_length) has none: give the section in spatial form, "
-                            SEC_SPATIAL_HINT ", or drop '%s'",
+                            "mass_per_length) has none: give the section in spatial form ("
+                            SEC_SPATIAL_HINT "), or drop '%s'",
                             inertias[i], inertias[i]);
             n++;
         }

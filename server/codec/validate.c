@@ -182,9 +182,10 @@ static void val_section_kind(val_ctx *v, const char *ptr, const char *name, sec_
                 "sections do not mix; %s",
                 field_short_name(name).s, sec_form_name(f), field_short_name(*first).s,
                 sec_form_name(*first_form),
-                spatial ? "give every section in spatial form (add EI_flap, EI_edge and GJ "
-                          "or G, I_flap, I_edge and J to the planar ones), or this one as "
-                          "E, A, I, mass_per_length"
+                spatial ? "give every section in spatial form (EA, EI_flap, EI_edge, GJ and "
+                          "mass_per_length, or E, G, A, I_flap, I_edge, J and "
+                          "mass_per_length), or this one in planar form (E, A, I, "
+                          "mass_per_length)"
                         : "give this section in spatial form: EA, EI_flap, EI_edge, GJ and "
                           "mass_per_length (or E, G, A, I_flap, I_edge, J and mass_per_length)");
 }

@@ -9,13 +9,28 @@
  *       codec_model_new (topology errors come from the core).  Every entry
  *       of "errors" ({"pointer" or "pointer_prefix", "contains"}) must match
  *       one reported error; optional "status" is the HTTP status (400, 413,
- *       422) and "limits" overrides codec_limits fields.
+ *       422) and "limits" overrides codec_limits fields; "spatial": true
+ *       reads a spatial request with the codec alone while the core has no
+ *       spatial model (see below).
  *   request.json + checks.json  a valid request; checks: canonical_contains,
+ *       canonical_text and sha256 (exact: pins of the canonical form),
  *       same_sha_as / different_sha_from (other files of the folder),
- *       joint_names, speeds, options, structure, model (sizes from
- *       sm_model_get_info).
+ *       joint_names, speeds, options, structure (with the spatial arrays:
+ *       spatial, joint_z, member_spatial, point_mass_inertia), sections
+ *       (sm_section values), model (sizes from sm_model_get_info).
+ *
+ * Spatial requests (DESIGN.md 7.3) while the core has no spatial model:
+ * a valid case with "spatial": true in checks.json is read by the codec
+ * alone (req_parse_codec_only: no structure check of the core), so its
+ * codec checks do not depend on the core; the full codec_request_parse
+ * (same canonical text and SHA-256) and the "model" checks run only when
+ * the core is spatial (solver >= 0.4.0, or SPINMODAL_TEST_SPATIAL_CORE=1 in
+ * the environment), and print "skip" otherwise.  An invalid case whose
+ * expected error comes from the core's spatial checks says
+ * "needs_spatial_core": true and is skipped the same way.
  * Before the folders a few unit checks run (SHA-256 vector, error list cap,
- * problem document, CSV encoder).  One line per case; exit status 1 when
+ * problem document, CSV encoder, diag pointers; spatial_units.c: spatial
+ * diag pointers and result rows).  One line per case; exit status 1 when
  * anything failed.
  */
 #include <dirent.h>
@@ -25,20 +40,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "codec.h"
+#include "codec_test.h"
 
 #define TEST_PATH_MAX 4096
 
-/* Failure messages of the current case. */
-typedef struct test_case {
-    const char *name; /* folder name */
-    int failures;     /* checks that failed */
-} test_case;
-
-#if defined(__GNUC__)
-__attribute__((format(printf, 2, 3)))
-#endif
-static void fail(test_case *tc, const char *fmt, ...)
+void fail(test_case *tc, const char *fmt, ...)
 {
     va_list ap;
 
@@ -108,13 +114,29 @@ static void apply_limits(codec_limits *lim, const json_t *spec)
         lim->max_shape_values = (long)json_integer_value(x);
 #define LIMIT(f) if ((x = json_object_get(spec, #f))) lim->f = (int)json_integer_value(x);
     LIMIT(max_joints) LIMIT(max_sections) LIMIT(max_members) LIMIT(max_point_masses)
-    LIMIT(max_elements) LIMIT(max_speeds) LIMIT(max_modes)
+    LIMIT(max_elements) LIMIT(max_speeds) LIMIT(max_modes) LIMIT(max_coordinates)
+    LIMIT(max_frame_dofs)
 #undef LIMIT
 }
 
-/* Parse dir/file into a request; NULL (and a failure) when it does not validate. */
+int core_is_spatial(void)
+{
+    const char *env = getenv("SPINMODAL_TEST_SPATIAL_CORE");
+    int major = 0, minor = 0;
+
+    if (env && !strcmp(env, "1"))
+        return 1;
+    if (sscanf(sm_version(), "%d.%d", &major, &minor) != 2)
+        return 0;
+    return major > 0 || minor >= 4;
+}
+
+/*
+ * Parse dir/file into a request; NULL (and a failure) when it does not
+ * validate.  codec_only: without the core's structure check.
+ */
 static codec_request *load_request(test_case *tc, const char *dir, const char *file,
-                                   const codec_limits *lim)
+                                   const codec_limits *lim, int codec_only)
 {
     char path[TEST_PATH_MAX];
     codec_errors *errs = codec_errors_new();
@@ -128,7 +150,8 @@ static codec_request *load_request(test_case *tc, const char *dir, const char *f
         fail(tc, "cannot read %s", path);
         goto done;
     }
-    st = codec_request_parse(&req, text, len, lim, errs);
+    st = codec_only ? req_parse_codec_only(&req, text, len, lim, errs)
+                    : codec_request_parse(&req, text, len, lim, errs);
     if (st != SM_OK) {
         fail(tc, "%s rejected (%s):", file, sm_strerror(st));
         for (i = 0; i < codec_errors_count(errs); i++)
@@ -173,8 +196,12 @@ static int error_matches(const codec_errors *errs, const json_t *e)
     return 0;
 }
 
-/* An invalid request: every expected error must be reported. */
-static void run_invalid(test_case *tc, const char *dir, const json_t *exp)
+/*
+ * An invalid request: every expected error must be reported.  Returns 1
+ * when skipped (an error of the core's spatial checks, before the core has
+ * them).
+ */
+static int run_invalid(test_case *tc, const char *dir, const json_t *exp)
 {
     char path[TEST_PATH_MAX];
     codec_limits lim;
@@ -185,16 +212,22 @@ static void run_invalid(test_case *tc, const char *dir, const json_t *exp)
     json_t *problem = NULL;
     size_t len = 0, k;
     char *text;
-    int st, i;
+    int st, i, codec_only;
 
+    if (json_is_true(json_object_get(exp, "needs_spatial_core")) && !core_is_spatial()) {
+        codec_errors_free(errs);
+        return 1;
+    }
+    codec_only = json_is_true(json_object_get(exp, "spatial")) && !core_is_spatial();
     apply_limits(&lim, json_object_get(exp, "limits"));
     text = path_join(path, dir, "request.json") ? NULL : read_text(path, &len);
     if (!text || !errs) {
         fail(tc, "cannot read %s", path);
         goto done;
     }
-    st = codec_request_parse(&req, text, len, &lim, errs);
-    if (st == SM_OK)
+    st = codec_only ? req_parse_codec_only(&req, text, len, &lim, errs)
+                    : codec_request_parse(&req, text, len, &lim, errs);
+    if (st == SM_OK && !codec_only)
         st = codec_model_new(&m, req, errs, NULL);
     if (st == SM_OK) {
         fail(tc, "the request was accepted");
@@ -229,6 +262,7 @@ done:
     codec_request_free(req);
     codec_errors_free(errs);
     free(text);
+    return 0;
 }
 
 /* checks.options: selected sm_options fields. */
@@ -257,6 +291,85 @@ static void check_options(test_case *tc, const sm_options *o, const json_t *want
     }
 }
 
+/* a and b agree to 2 ulp-ish (1e-15 relative), or are both zero. */
+static int near(double a, double b)
+{
+    return a == b || fabs(a - b) <= 1e-15 * fmax(fabs(a), fabs(b));
+}
+
+/* n numbers at got against the JSON array want; 1 when they agree (near). */
+static int numbers_match(const double *got, int n, const json_t *want)
+{
+    int k;
+
+    if (!json_is_array(want) || json_array_size(want) != (size_t)n)
+        return 0;
+    for (k = 0; k < n; k++)
+        if (!near(got[k], json_number_value(json_array_get(want, (size_t)k))))
+            return 0;
+    return 1;
+}
+
+/*
+ * checks.structure, spatial part: spatial (0/1), joint_z (n_joints numbers,
+ * or null for NULL), member_spatial [[twist (rad), e3x, e3y, e3z], ...],
+ * point_mass_inertia [[Ixx, Iyy, Izz], ...].
+ */
+static void check_structure_spatial(test_case *tc, const sm_structure *st, const json_t *want)
+{
+    const json_t *x, *row;
+    size_t i;
+
+    if ((x = json_object_get(want, "spatial")) && st->spatial != (int)json_integer_value(x))
+        fail(tc, "spatial is %d, expected %d", st->spatial, (int)json_integer_value(x));
+    if ((x = json_object_get(want, "joint_z"))) {
+        if (json_is_null(x) ? st->joint_z != NULL
+                            : !st->joint_z || !numbers_match(st->joint_z, st->n_joints, x))
+            fail(tc, "joint_z differs");
+    }
+    json_array_foreach(json_object_get(want, "member_spatial"), i, row) {
+        const sm_member *m = (int)i < st->n_members ? &st->members[i] : NULL;
+        double got[4];
+        if (m) {
+            got[0] = m->twist;
+            memcpy(got + 1, m->e3, sizeof(m->e3));
+        }
+        if (!m || !numbers_match(got, 4, row))
+            fail(tc, "member %zu: twist %g, e3 [%g, %g, %g] differ", i, m ? m->twist : 0,
+                 m ? m->e3[0] : 0, m ? m->e3[1] : 0, m ? m->e3[2] : 0);
+    }
+    json_array_foreach(json_object_get(want, "point_mass_inertia"), i, row) {
+        const sm_point_mass *p = (int)i < st->n_point_masses ? &st->point_masses[i] : NULL;
+        if (!p || !numbers_match(p->inertia, 3, row))
+            fail(tc, "point mass %zu: inertia differs", i);
+    }
+}
+
+/*
+ * checks.sections: one object per section (sorted name order) with any of
+ * the sm_section fields E, A, I, mu, EA, EI_flap, EI_edge, GJ, i_flap,
+ * i_edge, ip_over_a; fields not named must be zero.
+ */
+static void check_sections(test_case *tc, const sm_structure *st, const json_t *want)
+{
+    const json_t *row;
+    size_t i;
+
+    if (json_array_size(want) != (size_t)st->n_sections)
+        fail(tc, "%d sections, expected %zu", st->n_sections, json_array_size(want));
+    json_array_foreach(want, i, row) {
+        const sm_section *c = (int)i < st->n_sections ? &st->sections[i] : NULL;
+        if (!c)
+            break;
+#define FIELD(f) if (!near(c->f, json_number_value(json_object_get(row, #f)))) \
+        fail(tc, "section %zu: " #f " is %.17g, expected %.17g", i, c->f, \
+             json_number_value(json_object_get(row, #f)));
+        FIELD(E) FIELD(A) FIELD(I) FIELD(mu) FIELD(EA) FIELD(EI_flap) FIELD(EI_edge) FIELD(GJ)
+        FIELD(i_flap) FIELD(i_edge) FIELD(ip_over_a)
+#undef FIELD
+    }
+}
+
 /* checks.structure: counts, clamp, members [from, to, section, elements], point masses. */
 static void check_structure(test_case *tc, const sm_structure *st, const json_t *want)
 {
@@ -281,16 +394,22 @@ static void check_structure(test_case *tc, const sm_structure *st, const json_t 
             p->mass != json_number_value(json_array_get(row, 1)))
             fail(tc, "point mass %zu differs", i);
     }
+    check_structure_spatial(tc, st, want);
 }
 
-/* Same canonical text after a second pass (the canonical form is a fixpoint). */
-static void check_idempotent(test_case *tc, const codec_request *req)
+/*
+ * Same canonical text after a second pass (the canonical form is a
+ * fixpoint); codec_only as for load_request.
+ */
+static void check_idempotent(test_case *tc, const codec_request *req, int codec_only)
 {
     const char *text = codec_request_canonical_text(req);
     codec_errors *errs = codec_errors_new();
     codec_request *again = NULL;
 
-    if (!errs || codec_request_parse(&again, text, strlen(text), NULL, errs) != SM_OK)
+    if (!errs || (codec_only ? req_parse_codec_only(&again, text, strlen(text), NULL, errs)
+                             : codec_request_parse(&again, text, strlen(text), NULL, errs)) !=
+                     SM_OK)
         fail(tc, "the canonical request does not validate");
     else if (strcmp(text, codec_request_canonical_text(again)))
         fail(tc, "canonicalizing twice changes the text");
@@ -300,13 +419,13 @@ static void check_idempotent(test_case *tc, const codec_request *req)
 
 /* Compare the SHA-256 of req with the requests in files. */
 static void check_shas(test_case *tc, const char *dir, const codec_request *req,
-                       const json_t *files, int same)
+                       const json_t *files, int same, int codec_only)
 {
     const json_t *f;
     size_t i;
 
     json_array_foreach(files, i, f) {
-        codec_request *other = load_request(tc, dir, json_string_value(f), NULL);
+        codec_request *other = load_request(tc, dir, json_string_value(f), NULL, codec_only);
         if (!other)
             continue;
         if (same != !strcmp(codec_request_sha256(req), codec_request_sha256(other)))
@@ -346,23 +465,56 @@ done:
     codec_errors_free(errs);
 }
 
-/* A valid request and its checks. */
-static void run_valid(test_case *tc, const char *dir, const json_t *chk)
+/*
+ * A spatial request through the whole codec_request_parse, the core's
+ * structure check included: the same canonical text and SHA-256 as the
+ * codec alone gave, then the model checks.
+ */
+static void check_with_core(test_case *tc, const char *dir, const codec_request *req,
+                            const json_t *chk)
 {
-    codec_request *req = load_request(tc, dir, "request.json", NULL);
+    codec_request *full = load_request(tc, dir, "request.json", NULL, 0);
+    const json_t *x;
+
+    if (!full)
+        return;
+    if (strcmp(codec_request_canonical_text(full), codec_request_canonical_text(req)) ||
+        strcmp(codec_request_sha256(full), codec_request_sha256(req)))
+        fail(tc, "the full parse gives another canonical text or SHA-256");
+    if ((x = json_object_get(chk, "model")))
+        check_model(tc, full, x);
+    check_idempotent(tc, full, 0);
+    codec_request_free(full);
+}
+
+/*
+ * A valid request and its checks.  Returns 1 when the checks that need the
+ * core's spatial model were skipped.
+ */
+static int run_valid(test_case *tc, const char *dir, const json_t *chk)
+{
+    int spatial = json_is_true(json_object_get(chk, "spatial")), skipped = 0;
+    codec_request *req = load_request(tc, dir, "request.json", NULL, spatial);
     const json_t *x;
     const double *sp;
     size_t i;
     int n, k;
 
     if (!req)
-        return;
+        return 0;
     json_array_foreach(json_object_get(chk, "canonical_contains"), i, x)
         if (!strstr(codec_request_canonical_text(req), json_string_value(x)))
             fail(tc, "canonical text lacks %s:\n       %s", json_string_value(x),
                  codec_request_canonical_text(req));
-    check_shas(tc, dir, req, json_object_get(chk, "same_sha_as"), 1);
-    check_shas(tc, dir, req, json_object_get(chk, "different_sha_from"), 0);
+    if ((x = json_object_get(chk, "canonical_text")) &&
+        strcmp(codec_request_canonical_text(req), json_string_value(x)))
+        fail(tc, "canonical text differs:\n       got  %s\n       want %s",
+             codec_request_canonical_text(req), json_string_value(x));
+    if ((x = json_object_get(chk, "sha256")) && strcmp(codec_request_sha256(req),
+                                                       json_string_value(x)))
+        fail(tc, "SHA-256 is %s, expected %s", codec_request_sha256(req), json_string_value(x));
+    check_shas(tc, dir, req, json_object_get(chk, "same_sha_as"), 1, spatial);
+    check_shas(tc, dir, req, json_object_get(chk, "different_sha_from"), 0, spatial);
     json_array_foreach(json_object_get(chk, "joint_names"), i, x) {
         const char *got = codec_request_joint_name(req, (int)i);
         if (!got || strcmp(got, json_string_value(x)))
@@ -381,12 +533,19 @@ static void run_valid(test_case *tc, const char *dir, const json_t *chk)
         check_options(tc, codec_request_options(req), x);
     if ((x = json_object_get(chk, "structure")))
         check_structure(tc, codec_request_structure(req), x);
-    if ((x = json_object_get(chk, "model")))
+    if ((x = json_object_get(chk, "sections")))
+        check_sections(tc, codec_request_structure(req), x);
+    if (!spatial && (x = json_object_get(chk, "model")))
         check_model(tc, req, x);
     if (strlen(codec_request_sha256(req)) != 64)
         fail(tc, "SHA-256 is not 64 hex digits");
-    check_idempotent(tc, req);
+    check_idempotent(tc, req, spatial);
+    if (spatial && core_is_spatial())
+        check_with_core(tc, dir, req, chk);
+    else if (spatial)
+        skipped = 1;
     codec_request_free(req);
+    return skipped;
 }
 
 static int run_case(const char *root, const char *name)
@@ -395,6 +554,7 @@ static int run_case(const char *root, const char *name)
     test_case tc = {name, 0};
     json_error_t jerr;
     json_t *spec;
+    int skipped = 0;
 
     if (path_join(dir, root, name) || path_join(path, dir, "expected-error.json")) {
         fail(&tc, "path too long");
@@ -405,16 +565,19 @@ static int run_case(const char *root, const char *name)
         if (!spec)
             fail(&tc, "%s: %s", path, jerr.text);
         else
-            run_invalid(&tc, dir, spec);
+            skipped = run_invalid(&tc, dir, spec);
     } else {
         spec = path_join(path, dir, "checks.json") ? NULL : json_load_file(path, 0, &jerr);
         if (!spec)
             fail(&tc, "no expected-error.json or readable checks.json: %s", jerr.text);
         else
-            run_valid(&tc, dir, spec);
+            skipped = run_valid(&tc, dir, spec);
     }
     json_decref(spec);
-    if (!tc.failures)
+    if (!tc.failures && skipped)
+        printf("ok   %s (skip: the checks that need the core's spatial model; core %s)\n", name,
+               sm_version());
+    else if (!tc.failures)
         printf("ok   %s\n", name);
     return tc.failures != 0;
 }
@@ -552,7 +715,8 @@ static int cmp_name(const void *a, const void *b)
 
 int main(int argc, char **argv)
 {
-    test_case tc = {"unit: sha256, error list, problem, csv, diag pointers", 0};
+    test_case tc = {"unit: sha256, error list, problem, csv, diag pointers, spatial diag and "
+                    "result rows", 0};
     char **names = NULL;
     size_t n = 0, cap = 0, i;
     struct dirent *de;
@@ -567,6 +731,8 @@ int main(int argc, char **argv)
     unit_errors(&tc);
     unit_csv(&tc);
     unit_diag(&tc);
+    unit_spatial_diag(&tc);
+    unit_spatial_result(&tc);
     if (tc.failures)
         failed++;
     else

@@ -1,0 +1,32 @@
+/*
+ * codec_test.h — what the files of the codec test share (codec_test.c runs
+ * the data folders and the planar unit checks, spatial_units.c the unit
+ * checks of spatial requests).
+ */
+#ifndef SPINMODAL_CODEC_TEST_H
+#define SPINMODAL_CODEC_TEST_H
+
+#include "codec.h"
+#include "codec_internal.h" /* req_parse_codec_only */
+
+/* Failure messages of the current case. */
+typedef struct test_case {
+    const char *name; /* folder name */
+    int failures;     /* checks that failed */
+} test_case;
+
+/** Record a failed check of tc and print it (the first one prints the case name). */
+void fail(test_case *tc, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
+
+/** 1 when the core builds spatial models: solver >= 0.4.0, or SPINMODAL_TEST_SPATIAL_CORE=1. */
+int core_is_spatial(void);
+
+/** Unit checks of spatial requests: diag pointers, result rows (spatial_units.c). */
+void unit_spatial_diag(test_case *tc);
+void unit_spatial_result(test_case *tc);
+
+#endif /* SPINMODAL_CODEC_TEST_H */
