@@ -329,7 +329,8 @@ class Contracts:
                 "statuses": sorted(statuses)}
 
     def _check_examples(self):
-        """Every `example` of a media type validates against its schema."""
+        """Every `example` of a media type, and every `value` of its `examples`, validates
+        against its schema."""
         problems = []
 
         def media_types(node, where):
@@ -338,8 +339,15 @@ class Contracts:
                     w = where + "/" + k.replace("~", "~0").replace("/", "~1")
                     if k == "content" and isinstance(v, dict):
                         for mt, media in v.items():
-                            if isinstance(media, dict) and "schema" in media and "example" in media:
-                                yield w + "/" + mt.replace("~", "~0").replace("/", "~1"), media
+                            if not isinstance(media, dict) or "schema" not in media:
+                                continue
+                            mw = w + "/" + mt.replace("~", "~0").replace("/", "~1")
+                            if "example" in media:
+                                yield mw, media
+                            for name, ex in (media.get("examples") or {}).items():
+                                if isinstance(ex, dict) and "value" in ex:
+                                    yield (mw + "/examples/" + name.replace("~", "~0").replace("/", "~1"),
+                                           {"schema": media["schema"], "example": ex["value"]})
                     yield from media_types(v, w)
             elif isinstance(node, list):
                 for i, v in enumerate(node):

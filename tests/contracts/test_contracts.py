@@ -136,6 +136,14 @@ SCHEMA_REJECTS = [
     "sections-not-object", "stiffening-number", "structure-not-object",
     "substructure-modes-foo", "unknown-analysis-key", "unknown-structure-key",
     "unknown-top-level-key", "unknown-top-level-key-typo", "zero-A",
+    # spatial requests (DESIGN.md 7.3)
+    "spatial-mixed-kinds", "spatial-mixed-kinds-planar-second", "section-mixes-forms",
+    "section-material-with-I", "section-stiffness-missing-GJ", "section-material-missing-J",
+    "section-planar-with-inertia", "twist-with-planar", "flap-direction-with-planar",
+    "point-mass-inertia-with-planar", "paper-basis-spatial", "twist-string", "spatial-EA-zero",
+    "spatial-GJ-negative", "spatial-flap-inertia-zero", "spatial-edge-inertia-negative",
+    "spatial-EI-flap-null", "flap-direction-zero", "flap-direction-two-numbers",
+    "flap-direction-string", "point-mass-inertia-negative", "point-mass-inertia-number",
 ]
 
 # Invalid codec cases a JSON Schema cannot express (not forced; printed for information).
@@ -164,6 +172,16 @@ SCHEMA_CANNOT = {
     "too-many-joints": "run with a lowered limit (max_joints 2); valid at the default limits",
     "too-many-members": "run with a lowered limit (max_members 1); valid at the default limits",
     "too-many-shape-values": "a product speeds x modes x nodes x 3 (x 2) against 4e6",
+    "twist-overflow": "1e400 overflows a double: a parse error (400) in the codec",
+    "material-EA-overflows": "a product of two fields (EA = E*A) overflows",
+    "spatial-default-inertia-overflows": "a computed default (mass_per_length*EI_flap/EA) overflows",
+    "spatial-zero-length-member": "needs the coordinates of the referenced joints ([x, y] is z = 0)",
+    "spatial-stiffness-range": "element stiffness EI_flap/l^3 needs the element lengths",
+    "material-EA-range": "element stiffness E*A/l needs a product and the element lengths",
+    "spatial-shape-values": "a product speeds x modes x nodes x 6 (x 2) against a lowered limit",
+    "spatial-on-axis-no-flap-direction": "geometry: a member on the spin axis at radius zero (core)",
+    "spatial-flap-direction-along-member": "geometry: flap_direction parallel to the member (core)",
+    "spatial-frame-too-large": "a cost bound from the model's sizes (lowered --max-frame-dofs)",
 }
 
 # --------------------------------------------------------------------- groups
@@ -516,6 +534,69 @@ def t_negative():
         edit(bad)
         rejected(bad, "result", "result with " + what)
 
+    # a spatial result (DESIGN.md 7.3): "spatial" and "dof_per_node" in model, rows of 6
+    sp_doc = copy.deepcopy(res_doc)
+    sp_doc["model"].update({"spatial": True, "dof_per_node": 6})
+    sp_case = sp_doc["cases"][0]
+    sp_case["equilibrium"].update({"joints": {"O": [0, 0, 0, 0, 0, 0], "C": [1, 0, 0.1, 0, -0.1, 0]},
+                                   "nodes": [[0, 0, 0, 0, 0, 0], [1, 0, 0.1, 0, -0.1, 0]]})
+    sp_case["modes"][0]["shape"] = {"re": [[0] * 6, [0, 0, 1, 0, 0.5, 0]], "im": [[0] * 6, [0.1, 0, 0, 0, 0, 0]]}
+    validates(sp_doc, "result", "spatial result document")
+    validates(sp_doc, "Result", "spatial result document (as openapi Result)")
+    for what, edit in [
+        ("spatial model, a triple node row", lambda d: d["cases"][0]["equilibrium"]["nodes"].__setitem__(0, [0, 0, 0])),
+        ("spatial model, a triple joint row", lambda d: d["cases"][0]["equilibrium"]["joints"].__setitem__("O", [0, 0, 0])),
+        ("spatial model, a triple shape row", lambda d: d["cases"][0]["modes"][0]["shape"]["im"].__setitem__(1, [0, 0, 0])),
+        ("spatial without dof_per_node", lambda d: d["model"].pop("dof_per_node")),
+        ("dof_per_node 3", lambda d: d["model"].__setitem__("dof_per_node", 3)),
+        ("spatial false", lambda d: d["model"].__setitem__("spatial", False)),
+    ]:
+        bad = copy.deepcopy(sp_doc)
+        edit(bad)
+        rejected(bad, "result", "result with " + what)
+    bad = copy.deepcopy(res_doc)
+    bad["cases"][0]["modes"][0]["shape"]["re"] = [[0] * 6, [1, 0, 0, 0, 0, 0]]
+    rejected(bad, "result", "planar result (no model.spatial) with a shape row of 6")
+
+    # spatial requests: both forms of section, z, twist, flap direction, inertia
+    sp_req = {"structure": {"joints": {"O": [0.5, 0], "T": [5.5, 0, 0.5]},
+                            "sections": {"a": {"EA": 2.8e7, "EI_flap": 1.4e4, "EI_edge": 5.6e4, "GJ": 1.3e4,
+                                               "mass_per_length": 1.2, "flap_inertia": 6e-4},
+                                         "b": {"E": 7e10, "G": 2.6e10, "A": 4e-4, "I_flap": 2e-7, "I_edge": 8e-7,
+                                               "J": 5e-7, "mass_per_length": 1.2}},
+                            "members": [{"from": "O", "to": "T", "section": "a", "elements": 4, "twist_deg": 12,
+                                         "flap_direction": [0, 0, 1]}],
+                            "point_masses": [{"joint": "T", "mass": 1, "inertia": [0, 0, 0.1]}],
+                            "clamp": "O"},
+              "analysis": {"omega": 10}}
+    validates(sp_req, "request", "spatial request (stiffness and material forms)")
+    for what, edit in [
+        ("a planar section beside spatial ones", lambda r: r["structure"]["sections"].__setitem__(
+            "c", {"E": 7e10, "A": 4e-4, "I": 2e-7, "mass_per_length": 1.2})),
+        ("EA beside E in one section", lambda r: r["structure"]["sections"]["b"].__setitem__("EA", 1e7)),
+        ("a spatial section without GJ", lambda r: r["structure"]["sections"]["a"].pop("GJ")),
+        ("a joint of 4 numbers", lambda r: r["structure"]["joints"].__setitem__("T", [5, 0, 0, 0])),
+        ("flap_direction of 2 numbers", lambda r: r["structure"]["members"][0].__setitem__("flap_direction", [0, 1])),
+        ("flap_direction [0, 0, 0]", lambda r: r["structure"]["members"][0].__setitem__("flap_direction", [0, 0.0, 0])),
+        ("a negative point-mass inertia", lambda r: r["structure"]["point_masses"][0].__setitem__("inertia", [0, -1, 0])),
+        ("the paper basis", lambda r: r["analysis"].__setitem__("substructure_modes", "paper")),
+        ("edge_inertia 0", lambda r: r["structure"]["sections"]["b"].__setitem__("edge_inertia", 0)),
+    ]:
+        bad = copy.deepcopy(sp_req)
+        edit(bad)
+        rejected(bad, "request", "spatial request with " + what)
+    for what, edit in [
+        ("a joint with z", lambda r: r["structure"]["joints"].__setitem__("P", [5, 5, 0])),
+        ("twist_deg", lambda r: r["structure"]["members"][0].__setitem__("twist_deg", 0)),
+        ("flap_direction", lambda r: r["structure"]["members"][0].__setitem__("flap_direction", [0, 0, 1])),
+        ("a point-mass inertia", lambda r: r["structure"].__setitem__(
+            "point_masses", [{"joint": "P", "mass": 1, "inertia": [0, 0, 0]}])),
+        ("flap_inertia in a planar section", lambda r: r["structure"]["sections"]["al"].__setitem__("flap_inertia", 1e-4)),
+    ]:
+        bad = copy.deepcopy(example)
+        edit(bad)
+        rejected(bad, "request", "planar request with " + what)
+
     for what, edit in [
         ("negative omega", lambda r: r["analysis"].__setitem__("omega", -1)),
         ("frames 'per_frame'", lambda r: r.__setitem__("frames", "per_frame")),
@@ -549,6 +630,10 @@ def t_negative():
     expect_raise("an example that no longer matches",
                  lambda q, s, a: a["components"]["schemas"]["JobState"].__setitem__("enum", ["queued"]),
                  "example")
+    expect_raise("a spatial example (examples/spatial) that no longer matches",
+                 lambda q, s, a: a["paths"]["/v1/validate"]["post"]["responses"]["200"]["content"][
+                     "application/json"]["examples"]["spatial"]["value"]["canonical"]["analysis"].__setitem__(
+                     "substructure_modes", "paper"), "examples/spatial")
     expect_raise("a missing query parameter",
                  lambda q, s, a: a["paths"]["/v1/analyses"]["get"].__setitem__("parameters", []), "'limit'")
     expect_raise("an error response that is not problem+json",
