@@ -257,6 +257,23 @@ def t_requests():
                 n += 1
     check(n >= 5, "validated %d valid codec requests" % n)
 
+    # the request examples of README.md (planar and spatial) validate too
+    import re
+    with open(os.path.join(ROOT, "README.md"), encoding="utf-8") as f:
+        readme = f.read()
+    kinds = []
+    for body in re.findall(r"^```json\n(.*?)^```", readme, re.S | re.M):
+        try:
+            doc = json.loads(body)
+        except ValueError:
+            continue  # excerpts with elisions
+        if isinstance(doc, dict) and "structure" in doc and "analysis" in doc:
+            secs = doc["structure"].get("sections", {})
+            kind = "spatial" if any("EA" in x or "G" in x for x in secs.values()) else "planar"
+            kinds.append(kind)
+            validates(doc, "request", "README.md %s request example" % kind)
+    check("planar" in kinds and "spatial" in kinds, "README.md shows a planar and a spatial request (%s)" % kinds)
+
 
 def t_invalid():
     """Invalid codec cases: the schema rejects those a schema can express."""

@@ -18,6 +18,13 @@
  *     form is a fixed point); the core arrays respect the limits and refer
  *     to existing joints and sections; codec_request_from_json on the same
  *     document agrees with codec_request_parse;
+ *     (spatial requests, DESIGN.md 7.3: the spatial block of every section
+ *     positive and finite, joint_z present; planar: the spatial fields
+ *     zero);
+ *   the codec alone (req_parse_codec_only, no core structure check) accepts
+ *     whatever codec_request_parse accepts, with the same canonical text,
+ *     and what it accepts passes the same array and fixed-point checks, so
+ *     spatial requests are fuzzed before the core can check them;
  *   codec_model_new: a model and no error, or no model and at least one
  *     error that becomes a 422 problem document;
  *   tiny models (one speed, at most FUZZ_SOLVE_MAX_ELEMENTS elements) are
@@ -35,6 +42,7 @@
 #include <jansson.h>
 
 #include "codec.h"
+#include "codec_internal.h" /* req_parse_codec_only */
 #include "fuzz.h"
 #include "spinmodal.h"
 
@@ -147,10 +155,27 @@ static void fuzz_check_arrays(const codec_request *r, const codec_limits *lim)
             FUZZ_CHECK(strcmp(codec_request_joint_name(r, i - 1), a) < 0);
     }
     FUZZ_CHECK(codec_request_joint_name(r, st->n_joints) == NULL);
+    FUZZ_CHECK(st->spatial == 0 || st->spatial == 1);
+    FUZZ_CHECK(st->spatial ? st->joint_z != NULL : st->joint_z == NULL);
+    for (i = 0; st->joint_z && i < st->n_joints; i++)
+        FUZZ_CHECK(isfinite(st->joint_z[i]));
     for (i = 0; i < st->n_sections; i++) {
         const sm_section *s = &st->sections[i];
-        FUZZ_CHECK(s->E > 0 && s->A > 0 && s->I > 0 && s->mu > 0);
-        FUZZ_CHECK(isfinite(s->E) && isfinite(s->A) && isfinite(s->I) && isfinite(s->mu));
+        FUZZ_CHECK(s->mu > 0 && isfinite(s->mu));
+        if (!st->spatial) { /* planar: E, A, I, mu; the spatial block zero */
+            FUZZ_CHECK(s->E > 0 && s->A > 0 && s->I > 0);
+            FUZZ_CHECK(isfinite(s->E) && isfinite(s->A) && isfinite(s->I));
+            FUZZ_CHECK(s->EA == 0 && s->EI_flap == 0 && s->EI_edge == 0 && s->GJ == 0 &&
+                       s->i_flap == 0 && s->i_edge == 0 && s->ip_over_a == 0);
+            continue;
+        }
+        /* spatial (DESIGN.md 7.3): the spatial block positive and finite, E, A, I zero */
+        FUZZ_CHECK(s->EA > 0 && s->EI_flap > 0 && s->EI_edge > 0 && s->GJ > 0);
+        FUZZ_CHECK(isfinite(s->EA) && isfinite(s->EI_flap) && isfinite(s->EI_edge) &&
+                   isfinite(s->GJ));
+        FUZZ_CHECK(s->i_flap > 0 && s->i_edge > 0 && s->ip_over_a > 0);
+        FUZZ_CHECK(isfinite(s->i_flap) && isfinite(s->i_edge) && isfinite(s->ip_over_a));
+        FUZZ_CHECK(s->E == 0 && s->A == 0 && s->I == 0);
     }
     for (i = 0; i < st->n_members; i++) {
         const sm_member *m = &st->members[i];
@@ -158,6 +183,10 @@ static void fuzz_check_arrays(const codec_request *r, const codec_limits *lim)
         FUZZ_CHECK(m->to >= 0 && m->to < st->n_joints && m->to != m->from);
         FUZZ_CHECK(m->section >= 0 && m->section < st->n_sections);
         FUZZ_CHECK(m->elements >= 1 && m->elements <= lim->max_elements);
+        FUZZ_CHECK(isfinite(m->twist) && isfinite(m->e3[0]) && isfinite(m->e3[1]) &&
+                   isfinite(m->e3[2]));
+        if (!st->spatial) /* planar: no twist, no e3 */
+            FUZZ_CHECK(m->twist == 0 && m->e3[0] == 0 && m->e3[1] == 0 && m->e3[2] == 0);
         total += m->elements;
     }
     FUZZ_CHECK(total <= lim->max_elements);
@@ -165,6 +194,11 @@ static void fuzz_check_arrays(const codec_request *r, const codec_limits *lim)
         const sm_point_mass *pm = &st->point_masses[i];
         FUZZ_CHECK(pm->joint >= 0 && pm->joint < st->n_joints);
         FUZZ_CHECK(isfinite(pm->mass) && pm->mass >= 0);
+        FUZZ_CHECK(pm->inertia[0] >= 0 && pm->inertia[1] >= 0 && pm->inertia[2] >= 0);
+        FUZZ_CHECK(isfinite(pm->inertia[0]) && isfinite(pm->inertia[1]) &&
+                   isfinite(pm->inertia[2]));
+        if (!st->spatial)
+            FUZZ_CHECK(pm->inertia[0] == 0 && pm->inertia[1] == 0 && pm->inertia[2] == 0);
     }
     FUZZ_CHECK(opt->modes >= 1 && opt->modes <= lim->max_modes);
 }
@@ -297,6 +331,47 @@ static void fuzz_check_from_json(const json_t *root, const codec_request *parsed
     codec_errors_free(errs);
 }
 
+/*
+ * The codec alone on the same input: accepts what the full parse accepted
+ * (full: its request, or NULL), with the same canonical text; what it
+ * accepts has sound arrays and a canonical text that is a fixed point.
+ */
+static void fuzz_check_codec_only(const uint8_t *data, size_t size, const codec_limits *lim,
+                                  const codec_request *full)
+{
+    codec_limits big = *lim;
+    codec_errors *errs = codec_errors_new(), *errs2 = codec_errors_new();
+    codec_request *r = NULL, *again = NULL;
+    const char *text;
+    int rc;
+
+    if (!errs || !errs2)
+        goto done;
+    rc = req_parse_codec_only(&r, (const char *)data, size, lim, errs);
+    if (rc == SM_NOMEM)
+        goto done;
+    if (full)
+        FUZZ_CHECK(rc == SM_OK &&
+                   !strcmp(codec_request_canonical_text(r), codec_request_canonical_text(full)));
+    if (rc != SM_OK) {
+        FUZZ_CHECK(r == NULL && codec_errors_count(errs) > 0);
+        goto done;
+    }
+    fuzz_check_arrays(r, lim);
+    text = codec_request_canonical_text(r);
+    big.max_request_bytes = SIZE_MAX;
+    rc = req_parse_codec_only(&again, text, strlen(text), &big, errs2);
+    if (rc != SM_NOMEM) {
+        FUZZ_CHECK(rc == SM_OK && again != NULL);
+        FUZZ_CHECK(strcmp(codec_request_canonical_text(again), text) == 0);
+    }
+done:
+    codec_request_free(again);
+    codec_request_free(r);
+    codec_errors_free(errs2);
+    codec_errors_free(errs);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     codec_limits lim;
@@ -331,6 +406,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     if (root)
         fuzz_check_from_json(root, r, rc, &lim);
+    if (rc != SM_NOMEM)
+        fuzz_check_codec_only(data, size, &lim, rc == SM_OK ? r : NULL);
 
     json_decref(root);
     codec_request_free(r);

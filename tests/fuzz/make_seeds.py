@@ -130,3 +130,27 @@ w("empty.json", b"")
 w("null.json", "null")
 w("whitespace.json", " \t\r\n ")
 w("many-errors.json", json.dumps({"structure": {"joints": {str(i): "x" for i in range(150)}}, "x": 1}))
+
+# spatial requests (DESIGN.md 7.3): tiny valid ones in both section forms, and mismatches
+def spatial():
+    r = base()
+    r["structure"]["joints"]["C"] = [1, 0, 0.25]
+    r["structure"]["sections"]["s"] = {"EA": 2.8e7, "EI_flap": 1.4e4, "EI_edge": 5.6e4, "GJ": 1.3e4,
+                                       "mass_per_length": 1.2}
+    return r
+w("spatial-stiffness.json", spatial())
+r = spatial(); r["structure"]["sections"]["s"] = {"E": 7e10, "G": 2.6e10, "A": 4e-4, "I_flap": 2e-7,
+                                                  "I_edge": 8e-7, "J": 5e-7, "mass_per_length": 1.2,
+                                                  "flap_inertia": 1e-4}
+r["structure"]["members"][0].update({"twist_deg": 1e300, "flap_direction": [0, 1e-300, 1]})
+r["structure"]["point_masses"] = [{"joint": "C", "mass": 1, "inertia": [0, 5e-324, 1e308]}]
+w("spatial-material-extremes.json", r)
+r = spatial(); r["structure"]["sections"]["p"] = {"E": 7e10, "A": 4e-4, "I": 2e-7, "mass_per_length": 1.2,
+                                                  "EA": 1, "G": 1}
+r["analysis"]["substructure_modes"] = "paper"
+r["structure"]["members"][0]["flap_direction"] = [0, 0, 0]
+w("spatial-mixed-everything.json", r)
+r = base(); r["structure"]["joints"]["C"] = [1, 0, 0]
+r["structure"]["members"][0]["twist_deg"] = 5
+r["structure"]["point_masses"] = [{"joint": "C", "mass": 1, "inertia": [1, 1]}]
+w("spatial-fields-planar-sections.json", r)
