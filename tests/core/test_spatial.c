@@ -379,6 +379,48 @@ static void calculix(const char *dir)
     tu_csv_free(&c);
 }
 
+/* Bad spatial input: each an SM_INVALID_INPUT naming the item and field. */
+static void bad_input(void)
+{
+    double xyz[6] = {0, 0, 0, 0, 0, 4}; /* along the spin axis, at radius zero */
+    int ft[1][2] = {{0, 1}}, el[1] = {4};
+    struct { const char *field; sm_item item; int what; } cases[] = {
+        {"flap_direction", SM_ITEM_MEMBER, 0}, /* on the spin axis without flap_direction */
+        {"EI_flap", SM_ITEM_SECTION, 1},       /* zero stiffness */
+        {"GJ", SM_ITEM_SECTION, 2},            /* negative */
+        {"twist_deg", SM_ITEM_MEMBER, 3},      /* not finite */
+        {"flap_direction", SM_ITEM_MEMBER, 4}, /* along the member */
+        {"substructure_modes", SM_ITEM_OPTIONS, 5}, /* the paper basis */
+        {"inertia", SM_ITEM_POINT_MASS, 6},    /* negative inertia */
+        {"z", SM_ITEM_JOINT, 7},               /* planar sections with z */
+    };
+    for (int i = 0; i < 8; i++) {
+        sp3 s;
+        sp3_init(&s, 2, xyz, 1, (const int (*)[2])ft, el, sp_section(1e8, 1e4, 1e4, 1e4, 1.0, 1e-4, 1e-4));
+        sm_options o;
+        sm_default_options(&o);
+        if (cases[i].what != 0)
+            s.mem[0].e3[0] = 1; /* usable orientation for the other cases */
+        switch (cases[i].what) {
+        case 1: s.sec.EI_flap = 0; break;
+        case 2: s.sec.GJ = -1; break;
+        case 3: s.mem[0].twist = NAN; break;
+        case 4: s.mem[0].e3[0] = 0, s.mem[0].e3[2] = 2; break;
+        case 5: o.basis = SM_BASIS_PAPER; break;
+        case 6: s.pm.joint = 1, s.pm.mass = 1, s.pm.inertia[1] = -1, s.st.n_point_masses = 1, s.st.point_masses = &s.pm; break;
+        case 7: s.st.spatial = 0, s.sec.E = 1, s.sec.A = 1, s.sec.I = 1, s.mem[0].e3[0] = 0; break;
+        }
+        sm_model *m = NULL;
+        sm_diag d;
+        int rc = sm_model_new(&m, &s.st, &o, &d);
+        TU_CHECK(rc == SM_INVALID_INPUT && d.item == cases[i].item && !strcmp(d.field, cases[i].field),
+                 "bad input %d: rc %d item %d field '%s' (want %s): %s", i, rc, d.item, d.field, cases[i].field,
+                 d.message);
+        printf("bad input %d -> %s: %s\n", i, d.field, d.message);
+        sm_model_free(m);
+    }
+}
+
 int main(int argc, char **argv)
 {
     const char *dir = argc > 1 ? argv[1] : "tests/reference";
@@ -386,6 +428,7 @@ int main(int argc, char **argv)
     planar_equivalence(SM_MASS_LUMPED, 0, 1);
     planar_equivalence(SM_MASS_LUMPED, 1, 0);
     planar_equivalence(SM_MASS_CONSISTENT, 1, 1);
+    bad_input();
     torsion();
     schemes_at_rest();
     wright_blade(dir);
