@@ -9,9 +9,7 @@
  *       codec_model_new (topology errors come from the core).  Every entry
  *       of "errors" ({"pointer" or "pointer_prefix", "contains"}) must match
  *       one reported error; optional "status" is the HTTP status (400, 413,
- *       422) and "limits" overrides codec_limits fields; "spatial": true
- *       reads a spatial request with the codec alone while the core has no
- *       spatial model (see below).
+ *       422) and "limits" overrides codec_limits fields.
  *   request.json + checks.json  a valid request; checks: canonical_contains,
  *       canonical_text and sha256 (exact: pins of the canonical form),
  *       same_sha_as / different_sha_from (other files of the folder),
@@ -19,15 +17,12 @@
  *       spatial, joint_z, member_spatial, point_mass_inertia), sections
  *       (sm_section values), model (sizes from sm_model_get_info).
  *
- * Spatial requests (DESIGN.md 7.3) while the core has no spatial model:
- * a valid case with "spatial": true in checks.json is read by the codec
- * alone (req_parse_codec_only: no structure check of the core), so its
- * codec checks do not depend on the core; the full codec_request_parse
- * (same canonical text and SHA-256) and the "model" checks run only when
- * the core is spatial (solver >= 0.4.0, or SPINMODAL_TEST_SPATIAL_CORE=1 in
- * the environment), and print "skip" otherwise.  An invalid case whose
- * expected error comes from the core's spatial checks says
- * "needs_spatial_core": true and is skipped the same way.
+ * Spatial requests (DESIGN.md 7.3): a valid case with "spatial": true in
+ * checks.json is read twice: by the codec alone (req_parse_codec_only, no
+ * structure check of the core), for the codec checks, so that they say
+ * what the codec makes of the request whatever the core does; then by the
+ * whole codec_request_parse, which must give the same canonical text and
+ * SHA-256, for the "model" checks.
  * Before the folders a few unit checks run (SHA-256 vector, error list cap,
  * problem document, CSV encoder, diag pointers; spatial_units.c: spatial
  * diag pointers and result rows).  One line per case; exit status 1 when
@@ -119,18 +114,6 @@ static void apply_limits(codec_limits *lim, const json_t *spec)
 #undef LIMIT
 }
 
-int core_is_spatial(void)
-{
-    const char *env = getenv("SPINMODAL_TEST_SPATIAL_CORE");
-    int major = 0, minor = 0;
-
-    if (env && !strcmp(env, "1"))
-        return 1;
-    if (sscanf(sm_version(), "%d.%d", &major, &minor) != 2)
-        return 0;
-    return major > 0 || minor >= 4;
-}
-
 /*
  * Parse dir/file into a request; NULL (and a failure) when it does not
  * validate.  codec_only: without the core's structure check.
@@ -196,12 +179,8 @@ static int error_matches(const codec_errors *errs, const json_t *e)
     return 0;
 }
 
-/*
- * An invalid request: every expected error must be reported.  Returns 1
- * when skipped (an error of the core's spatial checks, before the core has
- * them).
- */
-static int run_invalid(test_case *tc, const char *dir, const json_t *exp)
+/* An invalid request: every expected error must be reported. */
+static void run_invalid(test_case *tc, const char *dir, const json_t *exp)
 {
     char path[TEST_PATH_MAX];
     codec_limits lim;
@@ -212,22 +191,16 @@ static int run_invalid(test_case *tc, const char *dir, const json_t *exp)
     json_t *problem = NULL;
     size_t len = 0, k;
     char *text;
-    int st, i, codec_only;
+    int st, i;
 
-    if (json_is_true(json_object_get(exp, "needs_spatial_core")) && !core_is_spatial()) {
-        codec_errors_free(errs);
-        return 1;
-    }
-    codec_only = json_is_true(json_object_get(exp, "spatial")) && !core_is_spatial();
     apply_limits(&lim, json_object_get(exp, "limits"));
     text = path_join(path, dir, "request.json") ? NULL : read_text(path, &len);
     if (!text || !errs) {
         fail(tc, "cannot read %s", path);
         goto done;
     }
-    st = codec_only ? req_parse_codec_only(&req, text, len, &lim, errs)
-                    : codec_request_parse(&req, text, len, &lim, errs);
-    if (st == SM_OK && !codec_only)
+    st = codec_request_parse(&req, text, len, &lim, errs);
+    if (st == SM_OK)
         st = codec_model_new(&m, req, errs, NULL);
     if (st == SM_OK) {
         fail(tc, "the request was accepted");
@@ -262,7 +235,6 @@ done:
     codec_request_free(req);
     codec_errors_free(errs);
     free(text);
-    return 0;
 }
 
 /* checks.options: selected sm_options fields. */
@@ -487,13 +459,10 @@ static void check_with_core(test_case *tc, const char *dir, const codec_request 
     codec_request_free(full);
 }
 
-/*
- * A valid request and its checks.  Returns 1 when the checks that need the
- * core's spatial model were skipped.
- */
-static int run_valid(test_case *tc, const char *dir, const json_t *chk)
+/* A valid request and its checks. */
+static void run_valid(test_case *tc, const char *dir, const json_t *chk)
 {
-    int spatial = json_is_true(json_object_get(chk, "spatial")), skipped = 0;
+    int spatial = json_is_true(json_object_get(chk, "spatial"));
     codec_request *req = load_request(tc, dir, "request.json", NULL, spatial);
     const json_t *x;
     const double *sp;
@@ -501,7 +470,7 @@ static int run_valid(test_case *tc, const char *dir, const json_t *chk)
     int n, k;
 
     if (!req)
-        return 0;
+        return;
     json_array_foreach(json_object_get(chk, "canonical_contains"), i, x)
         if (!strstr(codec_request_canonical_text(req), json_string_value(x)))
             fail(tc, "canonical text lacks %s:\n       %s", json_string_value(x),
@@ -540,12 +509,9 @@ static int run_valid(test_case *tc, const char *dir, const json_t *chk)
     if (strlen(codec_request_sha256(req)) != 64)
         fail(tc, "SHA-256 is not 64 hex digits");
     check_idempotent(tc, req, spatial);
-    if (spatial && core_is_spatial())
+    if (spatial)
         check_with_core(tc, dir, req, chk);
-    else if (spatial)
-        skipped = 1;
     codec_request_free(req);
-    return skipped;
 }
 
 static int run_case(const char *root, const char *name)
@@ -554,7 +520,6 @@ static int run_case(const char *root, const char *name)
     test_case tc = {name, 0};
     json_error_t jerr;
     json_t *spec;
-    int skipped = 0;
 
     if (path_join(dir, root, name) || path_join(path, dir, "expected-error.json")) {
         fail(&tc, "path too long");
@@ -565,19 +530,16 @@ static int run_case(const char *root, const char *name)
         if (!spec)
             fail(&tc, "%s: %s", path, jerr.text);
         else
-            skipped = run_invalid(&tc, dir, spec);
+            run_invalid(&tc, dir, spec);
     } else {
         spec = path_join(path, dir, "checks.json") ? NULL : json_load_file(path, 0, &jerr);
         if (!spec)
             fail(&tc, "no expected-error.json or readable checks.json: %s", jerr.text);
         else
-            skipped = run_valid(&tc, dir, spec);
+            run_valid(&tc, dir, spec);
     }
     json_decref(spec);
-    if (!tc.failures && skipped)
-        printf("ok   %s (skip: the checks that need the core's spatial model; core %s)\n", name,
-               sm_version());
-    else if (!tc.failures)
+    if (!tc.failures)
         printf("ok   %s\n", name);
     return tc.failures != 0;
 }

@@ -22,9 +22,6 @@ void fail(test_case *tc, const char *fmt, ...)
 #endif
     ;
 
-/** 1 when the core builds spatial models: solver >= 0.4.0, or SPINMODAL_TEST_SPATIAL_CORE=1. */
-int core_is_spatial(void);
-
 /** Unit checks of spatial requests: diag pointers, result rows (spatial_units.c). */
 void unit_spatial_diag(test_case *tc);
 void unit_spatial_result(test_case *tc);

@@ -24,7 +24,8 @@
  *   the codec alone (req_parse_codec_only, no core structure check) accepts
  *     whatever codec_request_parse accepts, with the same canonical text,
  *     and what it accepts passes the same array and fixed-point checks, so
- *     spatial requests are fuzzed before the core can check them;
+ *     the codec's own handling of spatial requests is fuzzed whatever the
+ *     core's structure check refuses;
  *   codec_model_new: a model and no error, or no model and at least one
  *     error that becomes a 422 problem document;
  *   tiny models (one speed, at most FUZZ_SOLVE_MAX_ELEMENTS elements) are
