@@ -232,6 +232,94 @@ def t_usage(tmp):
         check(rc == 64 and out == "" and "usage" in err, "usage error %s: exit 64 (got %d)" % (args, rc))
 
 
+def blade(section, modes, **member):
+    """The straight blade of examples/straight-blade.json with the given section."""
+    return {
+        "structure": {
+            "joints": {"root": [0.5, 0], "tip": [5.5, 0]},
+            "sections": {"blade": section},
+            "members": [dict({"id": "blade", "from": "root", "to": "tip", "section": "blade",
+                              "elements": 24}, **member)],
+            "point_masses": [{"joint": "tip", "mass": 0.2}],
+            "clamp": "root",
+        },
+        "frames": {"per_member": 4},
+        "analysis": {"omega": 10, "modes": modes},
+    }
+
+
+def in_plane_frequencies(doc):
+    """Frequencies of the modes of a spatial result whose shapes stay in the plane
+    (dz, rx, ry below 1e-6 of the largest translation, 1)."""
+    out = []
+    for m in doc["cases"][0]["modes"]:
+        rows = m["shape"]["re"] + m["shape"].get("im", [])
+        if max(max(abs(r[k]) for k in (2, 3, 4)) for r in rows) < 1e-6:
+            out.append(m["frequency_rad_s"])
+    return out
+
+
+def t_spatial(tmp):
+    """(g) spatial requests (DESIGN.md 7.3) through the CLI: the planar blade given as spatial
+    sections (stiffness form, material form, and twisted by 90 degrees with I_flap and I_edge
+    swapped) has the planar frequencies among its in-plane modes (negligible rotary inertia);
+    the result has 6 numbers per row; CSV, validate and a 422 of a mixed request."""
+    rc, out, err = run(["solve", write_request(tmp, "planar.json", blade(SECTION, 4))])
+    planar = parse_json(out, "planar blade") if check(rc == 0, "spatial: planar blade solves (%d)" % rc) else None
+    tiny = {"flap_inertia": 1e-12, "edge_inertia": 1e-12}
+    variants = [
+        ("stiffness form", dict({"EA": E * AREA, "EI_flap": 2 * E * INERTIA, "EI_edge": E * INERTIA,
+                                 "GJ": 1e4, "mass_per_length": MU}, **tiny), {}),
+        ("material form", dict({"E": E, "G": 2.6e10, "A": AREA, "I_flap": 2 * INERTIA, "I_edge": INERTIA,
+                                "J": 3 * INERTIA, "mass_per_length": MU}, **tiny), {}),
+        ("twist 90 deg, I_flap and I_edge swapped", dict({"E": E, "G": 2.6e10, "A": AREA, "I_flap": INERTIA,
+                                                          "I_edge": 2 * INERTIA, "J": 3 * INERTIA,
+                                                          "mass_per_length": MU}, **tiny), {"twist_deg": 90}),
+    ]
+    for what, section, member in variants:
+        path = write_request(tmp, "spatial.json", blade(section, 16, **member))
+        rc, out, err = run(["solve", path])
+        if not check(rc == 0, "spatial %s: exit 0 (%d %.300s)" % (what, rc, err)):
+            continue
+        doc = parse_json(out, "spatial result")
+        if not doc or not planar:
+            continue
+        check(doc["model"].get("spatial") is True and doc["model"].get("dof_per_node") == 6,
+              "spatial %s: model has spatial true, dof_per_node 6 (%s)" % (what, doc["model"]))
+        case = doc["cases"][0]
+        rows = case["equilibrium"]["nodes"] + list(case["equilibrium"]["joints"].values())
+        rows += [r for m in case["modes"] for part in m["shape"].values() for r in part]
+        check(rows and all(len(r) == 6 for r in rows), "spatial %s: every node, joint and shape row "
+              "has 6 numbers (%d rows)" % (what, len(rows)))
+        want = [m["frequency_rad_s"] for m in planar["cases"][0]["modes"]]
+        got = in_plane_frequencies(doc)[:len(want)]
+        check(len(got) == len(want) and all(abs(g - w) <= 1e-7 * w for g, w in zip(got, want)),
+              "spatial %s: in-plane frequencies are the planar ones to 1e-7 (%s vs %s)" % (what, got, want))
+        rc, csv, err = run(["solve", "--csv", path])
+        lines = csv.splitlines()
+        check(rc == 0 and lines[0] == "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status"
+              and len(lines) == 17, "spatial %s: CSV header and one row per mode (%d lines)" % (what, len(lines)))
+    # validate: the canonical form writes the spatial defaults out
+    rc, out, err = run(["validate", write_request(tmp, "spatial.json", blade(variants[0][1], 4))])
+    v = parse_json(out, "validate") if check(rc == 0, "spatial validate: exit 0 (%d)" % rc) else None
+    if v:
+        st = v["canonical"]["structure"]
+        check(st["joints"]["root"] == [0.5, 0.0, 0.0] and st["members"][0]["twist_deg"] == 0.0 and
+              st["point_masses"][0]["inertia"] == [0.0, 0.0, 0.0],
+              "spatial validate: z, twist_deg and inertia written out (%s)" % st)
+    # a planar and a spatial section together: 422 at the second
+    req = blade(SECTION, 4)
+    req["structure"]["sections"]["sp"] = variants[0][1]
+    req["structure"]["members"][0]["section"] = "sp"
+    rc, out, err = run(["solve", write_request(tmp, "mixed.json", req)])
+    prob = parse_json(err, "mixed stderr")
+    check(rc == 2 and out == "" and prob and prob.get("status") == 422 and
+          prob["errors"][0]["pointer"] == "/structure/sections/sp" and
+          "do not mix" in prob["errors"][0]["message"],
+          "spatial: planar and spatial sections together: exit 2, 422 at the second (%s)"
+          % (prob or {}).get("errors"))
+
+
 SCENARIOS = {
     "cantilever": t_cantilever,
     "invalid": t_invalid,
@@ -239,6 +327,7 @@ SCENARIOS = {
     "csv": t_csv,
     "help_version": t_help_version,
     "usage": t_usage,
+    "spatial": t_spatial,
 }
 
 

@@ -375,6 +375,32 @@ def t_cli():
                 validates(doc, "result", name)
                 docs[name] = doc
 
+        # a spatial request (DESIGN.md 7.3): result and validate answer against the contracts
+        sp = {"structure": {"joints": {"root": [0.5, 0], "C": [3, 0, 0.1], "tip": [5.5, 0.5, 0.3]},
+                            "sections": {"in": {"E": 7e10, "G": 2.6e10, "A": 4e-4, "I_flap": 2e-7, "I_edge": 8e-7,
+                                                "J": 5e-7, "mass_per_length": 1.2},
+                                         "out": {"EA": 2.8e7, "EI_flap": 1.4e4, "EI_edge": 5.6e4, "GJ": 1.3e4,
+                                                 "mass_per_length": 1.2, "flap_inertia": 5e-4}},
+                            "members": [{"from": "root", "to": "C", "section": "in", "elements": 6, "twist_deg": 5},
+                                        {"from": "C", "to": "tip", "section": "out", "elements": 6,
+                                         "flap_direction": [0, 0, 1]}],
+                            "point_masses": [{"joint": "tip", "mass": 0.2, "inertia": [0, 0, 1e-3]}],
+                            "clamp": "root"},
+              "frames": {"per_member": 2}, "analysis": {"omega": [0, 8], "modes": 4}}
+        check(C.is_valid(sp, "request"), "spatial: request is valid")
+        doc = solve(tmp, "spatial", sp, 0)
+        if doc is not None:
+            validates(doc, "result", "spatial")
+            validates(doc, "Result", "spatial (as openapi Result)")
+            check(doc["model"].get("spatial") is True and doc["model"].get("dof_per_node") == 6,
+                  "spatial: model.spatial true, dof_per_node 6")
+        path = os.path.join(tmp, "spatial.json")
+        rc, out, err = run_cli(["validate", path])
+        if check(rc == 0, "spatial: spinmodal validate exits 0"):
+            v = json.loads(out)
+            validates(v["canonical"], "request", "spatial: canonical form")
+            validates(dict(v, id="0" * 64), "Validation", "spatial: validate output (+ id) as /v1/validate answer")
+
         # facts the schema leaves to the request: complex shapes with Coriolis only
         d = docs.get("coriolis")
         if d:

@@ -1555,6 +1555,78 @@ def t_validate(sc):
     stop_clean(d, "validate")
 
 
+def spatial_blade(**analysis):
+    """A spatial blade (DESIGN.md 7.3): precone (z), both section forms, twist, a
+    flap direction and a tip inertia; 8 + 8 elements, a few tens of ms per speed."""
+    return {
+        "structure": {
+            "joints": {"root": [0.5, 0], "mid": [3, 0, 0.1], "tip": [5.5, 0, 0.2]},
+            "sections": {"inner": {"E": 7e10, "G": 2.6e10, "A": 4e-4, "I_flap": 2e-7, "I_edge": 8e-7,
+                                   "J": 5e-7, "mass_per_length": 1.2},
+                         "outer": {"EA": 2.8e7, "EI_flap": 1.4e4, "EI_edge": 5.6e4, "GJ": 1.3e4,
+                                   "mass_per_length": 1.2}},
+            "members": [{"id": "in", "from": "root", "to": "mid", "section": "inner", "elements": 8,
+                         "twist_deg": 8},
+                        {"id": "out", "from": "mid", "to": "tip", "section": "outer", "elements": 8,
+                         "flap_direction": [0, 0, 1]}],
+            "point_masses": [{"joint": "tip", "mass": 0.2, "inertia": [0, 0, 1e-3]}],
+            "clamp": "root",
+        },
+        "frames": {"per_member": 2},
+        "analysis": dict({"omega": [0, 6], "modes": 4}, **analysis),
+    }
+
+
+def t_spatial(sc):
+    """A spatial request over HTTP: validate, submit, the result (rows of 6, schema), CSV,
+    the same job for the request with its defaults written out, 422s with pointers."""
+    d = sc.daemon(["--workers", "1"])
+    req = spatial_blade()
+    r = d.post("/v1/validate", req)
+    v = r.json() or {}
+    check(r.status == 200 and v.get("valid") is True, "spatial: /v1/validate -> 200 (%s %s)" % (r.status, r.text(300)))
+    schema_ok(v, "Validation", "spatial: validate answer")
+    canon = v.get("canonical") or {}
+    jid, r = submit_id(d, req, "spatial", wait=60)
+    check(jid == v.get("id"), "spatial: the job id is the one /v1/validate announced")
+    done = poll(d, jid) if jid else None
+    if not check(done is not None and done.get("state") == "done", "spatial: job done (%s)" % (done and done.get("error"))):
+        stop_clean(d, "spatial")
+        return
+    res = d.get(job_path(jid) + "/result").json() or {}
+    schema_ok(res, "result", "spatial: result document")
+    schema_ok(done, "Job", "spatial: done status document")
+    check(res.get("model", {}).get("spatial") is True and res["model"].get("dof_per_node") == 6,
+          "spatial: model.spatial true, dof_per_node 6 (%s)" % res.get("model"))
+    rows = [r for c in res.get("cases", []) for r in c["equilibrium"].get("nodes", [])]
+    rows += [r for c in res.get("cases", []) for r in c["equilibrium"].get("joints", {}).values()]
+    rows += [r for c in res.get("cases", []) for m in c["modes"] for part in m["shape"].values() for r in part]
+    check(rows and all(len(x) == 6 for x in rows), "spatial: every row has 6 numbers (%d rows)" % len(rows))
+    joints = res["cases"][0]["equilibrium"]["joints"]
+    check(abs(joints["tip"][2] - 0.2) < 1e-9 and joints["root"] == [0.5, 0.0, 0.0, 0.0, 0.0, 0.0],
+          "spatial: at rest the tip is at its z, the clamp at rest (%s)" % joints)
+    csv = d.get(job_path(jid) + "/result?format=csv")
+    lines = csv.body.decode().splitlines()
+    check(csv.status == 200 and lines[0].startswith("omega,mode,frequency_rad_s") and len(lines) == 1 + 2 * 4,
+          "spatial: CSV with one row per speed and mode (%s, %d lines)" % (csv.status, len(lines)))
+    # the canonical form (defaults written out) is the same question: 200, the same job
+    r = submit(d, canon)
+    check(r.status == 200 and (r.json() or {}).get("id") == jid,
+          "spatial: the canonical request is the same job (%s)" % r.status)
+    # errors
+    bad = spatial_blade(substructure_modes="paper")
+    problem_ok(d.post("/v1/analyses", bad), 422, "spatial: paper basis", pointer="/analysis/substructure_modes")
+    bad = spatial_blade()
+    bad["structure"]["sections"]["outer"]["E"] = 7e10
+    problem_ok(d.post("/v1/analyses", bad), 422, "spatial: EA and E in one section",
+               pointer="/structure/sections/outer/E")
+    bad = spatial_blade()
+    bad["structure"]["members"][1]["flap_direction"] = [2.5, 0, 0.1]
+    problem_ok(d.post("/v1/analyses", bad), 422, "spatial: flap_direction along the member (from the core)",
+               pointer="/structure/members/1/flap_direction")
+    stop_clean(d, "spatial")
+
+
 # ------------------------------------------------------------------ main
 
 SCENARIOS = {
@@ -1575,6 +1647,7 @@ SCENARIOS = {
     "list": t_list,
     "misc": t_misc,
     "validate": t_validate,
+    "spatial": t_spatial,
 }
 
 
