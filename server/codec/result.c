@@ -56,7 +56,7 @@ fail:
 /* Values per node of case c: node_dof (3 planar, 6 spatial). */
 static int res_node_dof(const sm_case *c)
 {
-    return c->node_dof == 6 ? 6 : 3; /* a core before 0.4.0 leaves node_dof 0: planar */
+    return c->node_dof == 6 ? 6 : 3; /* only 3 and 6 exist: never read past the arrays */
 }
 
 /* [[x, y, phi], ...] from n rows of dof reals each. */

@@ -254,8 +254,9 @@ static int val_spatial_field(val_ctx *v, const json_t *obj, const char *key, con
 
 /*
  * A vector field obj[key] of 3 numbers of kind at base/key, copied to
- * canon; nonzero: it must not be [0, 0, 0].  shape ("[x, y, z]") and unit
- * (" (m)" or "") go into messages.  Returns 1 when valid.
+ * canon; nonzero (a direction: flap_direction): it must not be [0, 0, 0].
+ * shape ("[x, y, z]") and unit (" (m)" or "") go into messages.  Returns 1
+ * when valid.
  */
 static int val_vector3(val_ctx *v, const json_t *obj, const char *key, const char *base,
                        json_t *canon, enum field_real_kind kind, int nonzero, const char *shape,
