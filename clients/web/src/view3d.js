@@ -78,6 +78,19 @@ function projector(points, cam) {
   return f;
 }
 
+/** The largest side of the bounding box of the points and the origin (the planar view's size). */
+function extent(points) {
+  const lo = [0, 0, 0], hi = [0, 0, 0];
+  for (const p of points) {
+    for (let i = 0; i < 3; i++) {
+      if (!Number.isFinite(p[i])) continue;
+      lo[i] = Math.min(lo[i], p[i]);
+      hi[i] = Math.max(hi[i], p[i]);
+    }
+  }
+  return Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-9);
+}
+
 /** "x y" pairs of a polyline. */
 function pts2(list) {
   return list.map((p) => `${r2(p[0])},${r2(p[1])}`).join(' ');
@@ -93,15 +106,24 @@ function circle(f, r, z0 = 0, a0 = 0, a1 = 2 * Math.PI, n = 64) {
   return out;
 }
 
-/** The hub axis (z) with the spin arrow, the hub circle, and the plane of rotation (a faint disc). */
-function hub(g, f, hubR, discR) {
+/** Points the drawing of the hub axis needs in view (its ends: see hub()). */
+function axisPoints(size) {
+  return [[0, 0, -0.35 * 0.3 * size], [0, 0, 0.3 * size]];
+}
+
+/**
+ * The hub axis (z) with the spin arrow, the hub circle, and the plane of
+ * rotation swept by the structure (a faint floor: it is not fitted into the
+ * view, so it may run off its edges).
+ */
+function hub(g, f, hubR, discR, size) {
   if (discR > 0) el('polygon', {points: pts2(circle(f, discR)), class: 'disc'}, g);
   if (hubR > 0) el('polyline', {points: pts2(circle(f, hubR)), class: 'hub'}, g);
-  const h = 0.3 * f.size;
+  const h = 0.3 * size;
   const [x0, y0] = f([0, 0, -0.35 * h]), [x1, y1] = f([0, 0, h]);
   el('line', {x1: r2(x0), y1: r2(y0), x2: r2(x1), y2: r2(y1), class: 'axis-line', 'marker-end': 'url(#arrow)'}, g);
   // Ω positive about z: an arc turning counter-clockwise seen from +z
-  const r = Math.max(0.06 * f.size, 14 / f.scale);
+  const r = Math.max(0.06 * size, 14 / f.scale);
   el('polyline', {points: pts2(circle(f, r, 0.7 * h, -2.4, 1.6, 24)), class: 'spin', 'marker-end': 'url(#arrow)'}, g);
   const t = el('text', {x: r2(x1 + 6), y: r2(y1 + 4), class: 'label axis-label'}, g);
   t.textContent = 'Ω, z';
@@ -170,12 +192,14 @@ export function drawStructure3d(svg, st, mesh, cam, opts = {}) {
   const hubR = clampAt ? Math.hypot(clampAt[0], clampAt[1]) : 0;
   let discR = hubR;
   for (const p of pts) discR = Math.max(discR, Math.hypot(p[0], p[1]));
-  pts.push([discR, 0, 0], [-discR, 0, 0], [0, discR, 0], [0, -discR, 0]);
-  const f = projector(pts.length ? pts : [[1, 1, 1]], cam);
+  if (hubR > 0) pts.push([hubR, 0, 0], [-hubR, 0, 0], [0, hubR, 0], [0, -hubR, 0]);
+  const size = extent(pts);
+  pts.push(...axisPoints(size));
+  const f = projector(pts, cam);
   svg.dataset.scale = String(f.scale);
 
   const g = el('g', {}, svg);
-  hub(g, f, hubR, discR);
+  hub(g, f, hubR, discR, size);
 
   // out of the hub plane: the members' shadows on it and drop lines from the joints
   const sh = el('g', {class: 'shadows'}, g);
@@ -280,17 +304,9 @@ export function modeView3d(svg, mesh, eq, shape, amp, cam) {
   const im = shape && Array.isArray(shape.im) ? shape.im : null;
   const base = eq && eq.length === n ? eq.map(rowXYZ) : mesh.nodes.map((p) => [p.x, p.y, p.z]);
   const und = mesh.nodes.map((p) => [p.x, p.y, p.z]);
-  let size = 1e-9;
-  {
-    const lo = [0, 0, 0], hi = [0, 0, 0];
-    for (const p of base) for (let i = 0; i < 3; i++) {
-      lo[i] = Math.min(lo[i], p[i]);
-      hi[i] = Math.max(hi[i], p[i]);
-    }
-    size = Math.max(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], 1e-9);
-  }
+  const size = extent(base);
   const A = amp * size;
-  const pts = base.concat(und);
+  const pts = base.concat(und, axisPoints(size));
   for (const p of base) {
     for (let i = 0; i < 3; i++) {
       const q = p.slice(), r = p.slice();
@@ -304,7 +320,7 @@ export function modeView3d(svg, mesh, eq, shape, amp, cam) {
   const g = el('g', {}, svg);
   let discR = 0;
   for (const p of base) discR = Math.max(discR, Math.hypot(p[0], p[1]));
-  hub(g, f, 0, discR);
+  hub(g, f, 0, discR, size);
   el('path', {d: elemPath(mesh.elems, (k) => f(und[k])), class: 'member ghost'}, g);
   el('path', {d: elemPath(mesh.elems, (k) => f(base[k])), class: 'equilibrium thin'}, g);
   const shadow = el('path', {d: '', class: 'mode-shadow', id: 'mode-shadow'}, g);
