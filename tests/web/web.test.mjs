@@ -638,6 +638,20 @@ async function run() {
       await page.locator('#structure-svg line.member').count() === 3, 'the 3D switch draws a planar structure in 3D');
     await page.uncheck('#view-3d');
     ok(await page.evaluate(() => window.__spinmodal.view().structure) === 'plane', 'and back in the hub plane');
+    // the spatial switch: exact conversions only (EA = E·A, EI_edge = E·I), and back
+    await page.check('#spatial');
+    let trunk = (await page.evaluate(() => window.__spinmodal.doc)).structure.sections.trunk;
+    ok(trunk.EA === 4.2e7 && trunk.EI_edge === 28000 && trunk.mass_per_length === 1.8 && !('E' in trunk) &&
+      !('EI_flap' in trunk) && await page.getByLabel('GJ (N·m²) of section trunk').inputValue() === '' &&
+      await page.locator('#joints thead th', {hasText: 'z (m)'}).count() === 1 &&
+      await page.evaluate(() => window.__spinmodal.view().structure) === '3d',
+    'the spatial switch: EA = E·A, EI_edge = E·I, EI_flap and GJ left to fill in, z column, 3D view',
+    JSON.stringify(trunk));
+    await page.uncheck('#spatial');
+    trunk = (await page.evaluate(() => window.__spinmodal.doc)).structure.sections.trunk;
+    ok(JSON.stringify(trunk) === JSON.stringify({E: 7e10, A: 6e-4, I: 4e-7, mass_per_length: 1.8}) &&
+      await page.evaluate(() => window.__spinmodal.view().structure) === 'plane',
+    'and back: the planar section as it was, the hub-plane view', JSON.stringify(trunk));
 
     await spatial(page, base);
 

@@ -423,6 +423,11 @@ function cameraChanged() {
 }
 attachOrbit($('structure-svg'), () => S.cam, cameraChanged);
 attachOrbit($('mode-svg'), () => S.cam, cameraChanged);
+// switching the model between planar and spatial (editor.js) lets the view follow it again
+$('spatial').addEventListener('change', () => {
+  S.view3d = null;
+  draw();
+});
 $('view-3d').addEventListener('change', () => {
   S.view3d = $('view-3d').checked;
   draw();

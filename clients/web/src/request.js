@@ -300,8 +300,10 @@ const prod = (a, b) => (a !== null && b !== null ? fmtNum(Number((a * b).toPreci
  * Switch the rows between a planar and a spatial model (the "spatial" switch).
  * To spatial: EA = E·A and EI_edge = E·I (the planar bending is in the plane:
  * edgewise); EI_flap and GJ are left for the user (nothing in a planar section
- * says them; the daemon names them).  To planar: E, A, I from a section in the
- * E, G, A, I_flap, I_edge, J form (I = I_edge), else empty; the z coordinates,
+ * says them; the daemon names them).  To planar: the E, A, I the section had
+ * when it was made spatial here (if EA and EI_edge were not edited since),
+ * else those of a section in the E, G, A, I_flap, I_edge, J form (I = I_edge),
+ * else empty; the z coordinates,
  * twists, flap directions and point-mass inertias are dropped (a planar request
  * cannot carry them).  mass_per_length and unknown keys stay.
  */
@@ -313,13 +315,18 @@ export function convertRows(rows, spatial) {
     if (spatial) {
       const E = num(s.v.E), A = num(s.v.A), I = num(s.v.I);
       for (const k of ['E', 'A', 'I']) delete s.extra[k];
-      s.v = {EA: prod(E, A), EI_flap: '', EI_edge: prod(E, I), GJ: '', mass_per_length: mu, flap_inertia: '',
+      const v = {EA: prod(E, A), EI_flap: '', EI_edge: prod(E, I), GJ: '', mass_per_length: mu, flap_inertia: '',
         edge_inertia: ''};
+      s.memo = {E: s.v.E, A: s.v.A, I: s.v.I, EA: v.EA, EI_edge: v.EI_edge};
+      s.v = v;
       s.had = {};
     } else {
-      const x = s.extra;
-      s.v = {E: text(x.E), A: text(x.A), I: text(x.I_edge), mass_per_length: mu};
+      const x = s.extra, m = s.memo;
+      s.v = m && m.EA === s.v.EA && m.EI_edge === s.v.EI_edge
+        ? {E: m.E, A: m.A, I: m.I, mass_per_length: mu}
+        : {E: text(x.E), A: text(x.A), I: text(x.I_edge), mass_per_length: mu};
       s.had = {};
+      delete s.memo;
       for (const k of SPATIAL_ONLY) delete x[k];
     }
   }
