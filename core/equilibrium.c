@@ -11,7 +11,7 @@
  * the predictor (a jump to another branch), step growth when it converges
  * fast.  Running out of step size is the reported "no equilibrium" outcome.
  */
-#include "internal.h"
+#include "spatial.h"
 
 #include <lapacke.h>
 #include <math.h>
@@ -31,7 +31,8 @@
 typedef struct eq_ws {
     int tree;                /* 1: tangent in the tree form (t, light kin), else dense Kt */
     tree_ws t;
-    sm_kin kin;
+    sm_kin kin;              /* planar kinematics */
+    sp_kin sk;               /* spatial kinematics (m->spatial) */
     double *F, *g, *dq, *qt, *q0, *qp, *work;
     double *P;               /* n_elems axial forces */
     dmat Kt, M, H, W;
@@ -43,6 +44,7 @@ typedef struct eq_ws {
 static void eq_ws_free(eq_ws *w)
 {
     frames_kin_free(&w->kin);
+    sp_kin_free(&w->sk);
     free(w->F);
     free(w->g);
     free(w->dq);
@@ -71,10 +73,18 @@ static int eq_ws_alloc(const sm_model *m, eq_ws *w)
     w->qt = dm_vec((size_t)n);
     w->q0 = dm_vec((size_t)n);
     w->qp = dm_vec((size_t)n);
-    w->work = dm_vec((size_t)(4 * mx + n));
+    w->work = dm_vec((size_t)(12 * mx + n));
     w->ipiv = malloc((size_t)n * sizeof(int));
     w->P = dm_vec((size_t)m->n_elems);
     w->tree = tree_use(m);
+    if (m->spatial) {
+        if (!w->P || !w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp || !w->work || !w->ipiv ||
+            sp_kin_alloc(m, &w->sk, 0) || dm_alloc(&w->Kt, n, n) || dm_alloc(&w->H, n, n)) {
+            eq_ws_free(w);
+            return SM_NOMEM;
+        }
+        return SM_OK;
+    }
     if (w->tree) {
         if (!w->P || !w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp || !w->work ||
             frames_kin_alloc_light(m, &w->kin) || tree_alloc(m, &w->t)) {
@@ -92,9 +102,14 @@ static int eq_ws_alloc(const sm_model *m, eq_ws *w)
     return SM_OK;
 }
 
-/* g = sum m J' r at the kinematics in w->kin. */
-static void eq_centrifugal(const sm_model *m, eq_ws *w)
+/* g = sum m J' r at q (planar: also leaves the kinematics of q in w->kin). */
+static void eq_centrifugal(const sm_model *m, const double *q, eq_ws *w)
 {
+    if (m->spatial) {
+        sp_centrifugal(m, q, &w->sk, w->g);
+        return;
+    }
+    frames_eval(m, q, &w->kin);
     if (w->tree)
         tree_centrifugal(m, &w->kin, &w->t, w->g);
     else
@@ -105,12 +120,11 @@ static void eq_centrifugal(const sm_model *m, eq_ws *w)
 static double eq_residual(const sm_model *m, const double *q, double s, eq_ws *w)
 {
     int n = m->n;
-    frames_eval(m, q, &w->kin);
-    eq_centrifugal(m, w);
+    eq_centrifugal(m, q, w);
     memset(w->F, 0, (size_t)n * sizeof(double));
     lin_elastic_force(m, q, w->F);
     if (m->opt.geometric_stiffening)
-        lin_geometric_force(m, q, w->F);
+        (m->spatial ? lin3_geometric_force : lin_geometric_force)(m, q, w->F);
     for (int i = 0; i < n; i++)
         w->F[i] -= s * w->g[i];
     return dm_norm(w->F, n);
@@ -126,7 +140,10 @@ static int eq_tangent(const sm_model *m, const double *q, double s, eq_ws *w)
         tree_assemble(m, q, &w->kin, s, 0, 0, &w->t);
         return tree_factor(m, &w->t, 0);
     }
-    lin_tangent(m, q, &w->kin, s, 0, &w->Kt, &w->M, &w->H, &w->W, w->work);
+    if (m->spatial)
+        lin3_tangent(m, q, &w->sk, s, 0, &w->Kt, &w->H, w->work);
+    else
+        lin_tangent(m, q, &w->kin, s, 0, &w->Kt, &w->M, &w->H, &w->W, w->work);
     return dm_lapack_status(LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, n, n, w->Kt.a, n, w->ipiv), SM_SINGULAR);
 }
 
@@ -290,8 +307,7 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
         double sn = s + h >= s_to - 1e-12 * s_to ? s_to : s + h;
         /* predictor: Kt dq = g ds */
         memcpy(w.q0, q, (size_t)n * sizeof(double));
-        frames_eval(m, q, &w.kin);
-        eq_centrifugal(m, &w);
+        eq_centrifugal(m, q, &w);
         memcpy(w.qp, q, (size_t)n * sizeof(double));
         if (have_lu) {
             memcpy(w.dq, w.g, (size_t)n * sizeof(double));

@@ -30,6 +30,11 @@ typedef struct sm_node {
     int sub;            /* substructure that holds it as a free node, -1 for the clamp */
     int local;          /* free-node index within that substructure, -1 for the clamp */
     int joint;          /* joint index, -1 for member-interior nodes */
+    /* spatial models (m->spatial) */
+    double z;           /* undeformed z, hub frame */
+    double rot[9];      /* lumped rotary inertia tensor about the node, hub axes at rest, kg m^2
+                           (section tributaries + point-mass inertia), column-major 3x3 */
+    double point_rot[9]; /* point-mass inertia alone (consistent mass keeps only this) */
 } sm_node;
 
 /* FE element (2 nodes, 3 DOF each), oriented away from the clamp. */
@@ -40,6 +45,12 @@ typedef struct sm_elem {
     double l;           /* length, m */
     double angle;       /* direction angle in the hub frame, rad */
     double EA, EI, mu;  /* section data */
+    /* spatial models: principal axes at rest (hub frame) as the columns of ax (column-major
+     * 3x3: e1 along the element, p2 edgewise, p3 flapwise, DESIGN.md 7.1) and the section */
+    double ax[9];
+    double GJ, EI_edge, EI_flap; /* torsion; bending in the p2 and p3 directions */
+    double i_flap, i_edge;       /* mass moments per length about p2, p3, kg m */
+    double ip_over_a;            /* Wagner ratio I_p/A, m^2 */
 } sm_elem;
 
 /* A point that carries mass (lumped node, or quadrature point for consistent mass). */
@@ -75,6 +86,10 @@ typedef struct sm_sub {
     double *d;          /* nel*m: d_e = EA/l (T_e[3,:] - T_e[0,:]) so P_e = d_e . q_s (eq. 24) */
     double *gq;         /* nel*4*4 bending block of G_e (rows/cols v1,phi1,v2,phi2), eq. 23 */
     double *qpN;        /* consistent mass: quadrature-point N storage */
+    /* spatial models: ubar has 3 per free node, N has 6 rows per free node (u, v, w, then the
+     * small rotation psi, frame coordinates), T 12 rows per element (element axes) */
+    double A0[9];       /* frame orientation at rest: columns = frame axes in the hub frame */
+    double Arel[9];     /* A0(parent)^T A0(this): orientation relative to the parent frame (A0 for a root) */
 } sm_sub;
 
 struct sm_model {
@@ -88,6 +103,9 @@ struct sm_model {
     int n_mp;
     sm_mpoint *mp;      /* mass points */
     int clamp_node;     /* = 0 */
+    int spatial;        /* 1: DESIGN.md 7 (6 DOF per node, spatial.h) */
+    int n_pt;           /* spatial: points = the FE nodes (0 .. n_nodes-1) + quadrature points */
+    struct sp_point *pt; /* spatial: n_pt points (spatial.h) */
 };
 
 /* ------------------------------------------------------------- fe.c */

@@ -9,7 +9,7 @@
  * (substructures); a substructure's root is the near node of its first
  * element and its parent is the substructure holding that node.
  */
-#include "internal.h"
+#include "spatial.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -17,6 +17,8 @@
 #include <string.h>
 
 #define MESH_MAX_ITEMS 1000000
+/* z of joint j (0 for a planar structure or without joint_z). */
+#define MESH_Z(st, j) ((st)->spatial && (st)->joint_z ? (st)->joint_z[j] : 0.0)
 
 static int mesh_fail(sm_diag *d, sm_item item, int index, const char *field,
                      const char *msg)
@@ -52,7 +54,10 @@ static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
     for (int j = 0; j < st->n_joints; j++)
         if (!isfinite(st->joint_xy[2 * j]) || !isfinite(st->joint_xy[2 * j + 1]))
             return mesh_fail(d, SM_ITEM_JOINT, j, "", "joint coordinates must be finite numbers");
-    for (int s = 0; s < st->n_sections; s++) {
+    int rc = st->spatial ? mesh3_check(st, o, d) : mesh3_check_planar(st, d);
+    if (rc < 0)
+        return rc;
+    for (int s = 0; !st->spatial && s < st->n_sections; s++) {
         const sm_section *c = &st->sections[s];
         if (!mesh_positive(c->E))
             return mesh_fail(d, SM_ITEM_SECTION, s, "E", "E must be a positive number (Pa)");
@@ -80,7 +85,8 @@ static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
             return mesh_fail(d, SM_ITEM_MEMBER, i, "elements", "too many elements");
         double dx = st->joint_xy[2 * b->to] - st->joint_xy[2 * b->from];
         double dy = st->joint_xy[2 * b->to + 1] - st->joint_xy[2 * b->from + 1];
-        if (b->from == b->to || !(hypot(dx, dy) > 0.0))
+        double dz = st->spatial && st->joint_z ? st->joint_z[b->to] - st->joint_z[b->from] : 0.0;
+        if (b->from == b->to || !(hypot(hypot(dx, dy), dz) > 0.0))
             return mesh_fail(d, SM_ITEM_MEMBER, i, "", "zero-length member: its joints coincide");
     }
     for (int i = 0; i < st->n_point_masses; i++) {
@@ -202,6 +208,7 @@ static int mesh_nodes(sm_model *m, const sm_structure *st, const int *order, con
     sm_node *c = &m->nodes[nn++];
     c->x = st->joint_xy[2 * st->clamp];
     c->y = st->joint_xy[2 * st->clamp + 1];
+    c->z = MESH_Z(st, st->clamp);
     c->joint = st->clamp;
     c->sub = c->local = -1;
     m->joint_node[st->clamp] = 0;
@@ -212,18 +219,21 @@ static int mesh_nodes(sm_model *m, const sm_structure *st, const int *order, con
         int a = near[k], z = b->from == a ? b->to : b->from;
         double x0 = st->joint_xy[2 * a], y0 = st->joint_xy[2 * a + 1];
         double dx = st->joint_xy[2 * z] - x0, dy = st->joint_xy[2 * z + 1] - y0;
-        double len = hypot(dx, dy), ang = atan2(dy, dx);
+        double z0 = MESH_Z(st, a), dz = MESH_Z(st, z) - z0;
+        double len = st->spatial ? sqrt(dx * dx + dy * dy + dz * dz) : hypot(dx, dy), ang = atan2(dy, dx);
         int prev = m->joint_node[a];
         for (int i = 1; i <= b->elements; i++) {
             sm_node *nd = &m->nodes[nn];
             double t = (double)i / b->elements;
             nd->x = x0 + t * dx;
             nd->y = y0 + t * dy;
+            nd->z = z0 + t * dz;
             nd->joint = i == b->elements ? z : -1;
             nd->sub = nd->local = -1;
             if (i == b->elements) {
                 nd->x = st->joint_xy[2 * z]; /* exact joint position */
                 nd->y = st->joint_xy[2 * z + 1];
+                nd->z = MESH_Z(st, z);
                 m->joint_node[z] = nn;
             }
             sm_elem *el = &m->elems[e++];
@@ -307,7 +317,7 @@ static int mesh_subs(sm_model *m, const sm_structure *st)
         sm_sub *b = &m->subs[k];
         b->elems = malloc((size_t)b->nel * sizeof(int));
         b->free_nodes = malloc((size_t)b->nel * sizeof(int));
-        b->ubar = malloc((size_t)b->nel * 2 * sizeof(double));
+        b->ubar = malloc((size_t)b->nel * (m->spatial ? 3 : 2) * sizeof(double));
         b->attach = malloc((size_t)b->nel * sizeof(int));
         if (!b->elems || !b->free_nodes || !b->ubar || !b->attach)
             return SM_NOMEM;
@@ -329,7 +339,7 @@ static int mesh_subs(sm_model *m, const sm_structure *st)
         sm_sub *b = &m->subs[k];
         const sm_node *r = &m->nodes[b->root];
         double c = cos(b->theta0), si = sin(b->theta0);
-        for (int i = 0; i < b->nfree; i++) {
+        for (int i = 0; !m->spatial && i < b->nfree; i++) {
             const sm_node *nd = &m->nodes[b->free_nodes[i]];
             double dx = nd->x - r->x, dy = nd->y - r->y;
             b->ubar[2 * i] = c * dx + si * dy; /* A(theta0)' (X - X_root) */
@@ -365,10 +375,15 @@ int mesh_build(sm_model *m, const sm_structure *st, sm_diag *d)
     rc = mesh_walk(st, order, near, d);
     if (rc < 0)
         goto done;
+    m->spatial = st->spatial != 0;
     rc = mesh_nodes(m, st, order, near);
+    if (rc == SM_OK && m->spatial)
+        rc = mesh3_elements(m, st, d);
     if (rc < 0)
         goto done;
     rc = mesh_subs(m, st);
+    if (rc == SM_OK && m->spatial)
+        mesh3_subs(m);
 done:
     free(order);
     free(near);

@@ -4,7 +4,7 @@
  * same mesh phase (model_mesh) without the component-mode bases and predicts
  * the sizes with modes_count.
  */
-#include "internal.h"
+#include "spatial.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -48,6 +48,7 @@ void sm_model_free(sm_model *m)
     free(m->elems);
     free(m->joint_node);
     free(m->mp);
+    free(m->pt);
     free(m);
 }
 
@@ -94,6 +95,7 @@ static void model_mesh_info(const sm_model *m, sm_model_info *info)
     info->nodes = m->n_nodes;
     info->elements = m->n_elems;
     info->frames = m->n_subs;
+    info->spatial = m->spatial;
     for (int s = 0; s < m->n_subs; s++)
         if (m->subs[s].nfree > info->max_frame_nodes)
             info->max_frame_nodes = m->subs[s].nfree;
@@ -123,7 +125,7 @@ int sm_model_build(sm_model **out, const sm_structure *st, const sm_options *opt
     *out = NULL;
     if (rc < 0)
         return model_fail(d, rc);
-    if ((rc = modes_build(m, cb, user, d)) < 0) {
+    if ((rc = m->spatial ? modes3_build(m, cb, user, d) : modes_build(m, cb, user, d)) < 0) {
         sm_model_free(m);
         return model_fail(d, rc);
     }
@@ -142,13 +144,14 @@ int sm_structure_check(const sm_structure *st, const sm_options *opt, sm_model_i
     if (info) {
         model_mesh_info(m, info);
         for (int s = 0; s < m->n_subs; s++) {
-            int nm, na, k = modes_count(&m->opt, &m->subs[s], &nm, &na);
+            int nm, na, k = m->spatial ? modes3_count(&m->opt, &m->subs[s], &nm, &na)
+                                       : modes_count(&m->opt, &m->subs[s], &nm, &na);
             info->coordinates += k;
             if (k > info->max_frame_coordinates)
                 info->max_frame_coordinates = k;
         }
-        info->structured = tree_choose(m->opt.solver, info->coordinates,
-                                       info->max_frame_coordinates, m->opt.modes);
+        info->structured = !m->spatial && tree_choose(m->opt.solver, info->coordinates,
+                                                      info->max_frame_coordinates, m->opt.modes);
     }
     sm_model_free(m);
     return SM_OK;
@@ -172,6 +175,16 @@ int sm_model_joint_node(const sm_model *m, int joint)
 int sm_model_element_member(const sm_model *m, int element)
 {
     return element >= 0 && element < m->n_elems ? m->elems[element].member : -1;
+}
+
+int sm_model_node_position3(const sm_model *m, int node, double xyz[3])
+{
+    if (node < 0 || node >= m->n_nodes)
+        return SM_INVALID_INPUT;
+    xyz[0] = m->nodes[node].x;
+    xyz[1] = m->nodes[node].y;
+    xyz[2] = m->nodes[node].z;
+    return SM_OK;
 }
 
 int sm_model_node_position(const sm_model *m, int node, double xy[2])

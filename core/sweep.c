@@ -4,7 +4,7 @@
  * frozen), the eigen-analysis (eigen.c), mode shapes in the hub frame and
  * mode tracking across speeds by MAC (DESIGN.md 1.3-1.4).
  */
-#include "internal.h"
+#include "spatial.h"
 
 #include <complex.h>
 #include <math.h>
@@ -44,8 +44,9 @@ void sm_result_free(sm_result *r)
  * or (tree != 0) the local blocks of tree.c with light kinematics (O(n) memory). */
 typedef struct sweep_lin {
     int tree;           /* 1: tree form (t, light kin); 0: dense matrices */
-    sm_kin kin;
-    dmat M, C, K, H, W, X;
+    sm_kin kin;         /* planar kinematics */
+    sp_kin sk;          /* spatial kinematics with J, W (m->spatial) */
+    dmat M, C, K, H, W, X; /* spatial: W is n x 6P scratch, X unused */
     double *work;
     tree_ws t;
 } sweep_lin;
@@ -53,6 +54,7 @@ typedef struct sweep_lin {
 static void sweep_lin_free(sweep_lin *L)
 {
     frames_kin_free(&L->kin);
+    sp_kin_free(&L->sk);
     dm_free(&L->M);
     dm_free(&L->C);
     dm_free(&L->K);
@@ -70,7 +72,15 @@ static int sweep_lin_alloc(const sm_model *m, sweep_lin *L, int tree)
     L->tree = tree;
     for (int s = 0; s < m->n_subs; s++)
         mx = m->subs[s].m > mx ? m->subs[s].m : mx;
-    L->work = dm_vec((size_t)(4 * mx + n));
+    L->work = dm_vec((size_t)(12 * mx + n));
+    if (m->spatial) {
+        if (!L->work || sp_kin_alloc(m, &L->sk, 1) || dm_alloc(&L->M, n, n) || dm_alloc(&L->C, n, n) ||
+            dm_alloc(&L->K, n, n) || dm_alloc(&L->H, n, n) || dm_alloc(&L->W, n, 6 * m->n_pt)) {
+            sweep_lin_free(L);
+            return SM_NOMEM;
+        }
+        return SM_OK;
+    }
     if (tree) {
         if (!L->work || frames_kin_alloc_light(m, &L->kin) || tree_alloc(m, &L->t)) {
             sweep_lin_free(L);
@@ -93,27 +103,53 @@ static int sweep_linearize(const sm_model *m, const double *q, double omega, swe
 {
     int n = m->n;
     double s = omega * omega;
-    frames_eval(m, q, &L->kin);
+    if (m->spatial) { /* K*, P frozen; M*; C* (DESIGN.md 7.3) */
+        sp_eval(m, q, &L->sk);
+        lin3_tangent(m, q, &L->sk, s, 1, &L->K, &L->H, L->work);
+        lin3_mass(m, &L->sk, &L->M, &L->W);
+        if (m->opt.coriolis)
+            lin3_gyro(m, &L->sk, omega, &L->C, &L->W);
+    } else {
+        frames_eval(m, q, &L->kin);
+    }
     if (L->tree)
         return tree_assemble(m, q, &L->kin, s, 1, m->opt.coriolis, &L->t); /* K*, P frozen; M*; C* */
-    lin_tangent(m, q, &L->kin, s, 1, &L->K, &L->M, &L->H, &L->W, L->work); /* K*, P frozen; M* */
-    if (m->opt.coriolis)
-        lin_gyro(m, &L->kin, omega, &L->C, &L->W, &L->X);
+    if (!m->spatial) {
+        lin_tangent(m, q, &L->kin, s, 1, &L->K, &L->M, &L->H, &L->W, L->work); /* K*, P frozen; M* */
+        if (m->opt.coriolis)
+            lin_gyro(m, &L->kin, omega, &L->C, &L->W, &L->X);
+    }
     for (int j = 0; j < n; j++) /* symmetric up to round-off: make it exact */
         for (int i = 0; i < j; i++)
             DM(&L->K, i, j) = DM(&L->K, j, i) = 0.5 * (DM(&L->K, i, j) + DM(&L->K, j, i));
     return 1;
 }
 
-/* Nodal shapes (dx, dy, dphi) = J_k x in the hub frame; largest translation = 1. */
+/* Values per node in nodes and shapes: 3 planar (x, y, phi), 6 spatial (x, y, z, rx, ry, rz). */
+static int sweep_dof(const sm_model *m)
+{
+    return m->spatial ? 6 : 3;
+}
+
+/* 1 when component c of a nodal vector with dof values per node is a translation. */
+static int sweep_translation(int c, int dof)
+{
+    return dof == 6 ? c % 6 < 3 : c % 3 != 2;
+}
+
+/* Nodal shapes (dx, dy, dphi) = J_k x in the hub frame (spatial: dx..dz, rx..rz); largest
+ * translation = 1. */
 static void sweep_shapes(const sm_model *m, sweep_lin *L, const sm_eig_out *e, double *sr, double *si)
 {
-    int n = m->n, nn = m->n_nodes;
+    int n = m->n, nn = m->n_nodes, dof = sweep_dof(m);
     const sm_kin *k = &L->kin;
     for (int j = 0; j < e->n_modes; j++) {
         const double *xr = e->xre + (size_t)j * n, *xi = e->xim + (size_t)j * n;
-        double *yr = sr + (size_t)j * 3 * nn, *yi = si + (size_t)j * 3 * nn;
-        if (L->tree) {
+        double *yr = sr + (size_t)j * dof * nn, *yi = si + (size_t)j * dof * nn;
+        if (m->spatial) {
+            lin3_nodal(m, &L->sk, xr, yr);
+            lin3_nodal(m, &L->sk, xi, yi);
+        } else if (L->tree) {
             tree_nodal(m, k, &L->t, xr, yr);
             tree_nodal(m, k, &L->t, xi, yi);
         } else {
@@ -130,15 +166,15 @@ static void sweep_shapes(const sm_model *m, sweep_lin *L, const sm_eig_out *e, d
         }
         double best = -1;
         double complex piv = 1;
-        for (int c = 0; c < 3 * nn; c++)
-            if (c % 3 != 2 && hypot(yr[c], yi[c]) > best) {
+        for (int c = 0; c < dof * nn; c++)
+            if (sweep_translation(c, dof) && hypot(yr[c], yi[c]) > best) {
                 best = hypot(yr[c], yi[c]);
-                piv = yr[c] + I * yi[c];
+                piv = yr[c] + _Complex_I * yi[c];
             }
         if (!(best > 0))
             continue;
-        for (int c = 0; c < 3 * nn; c++) {
-            double complex v = (yr[c] + I * yi[c]) / piv;
+        for (int c = 0; c < dof * nn; c++) {
+            double complex v = (yr[c] + _Complex_I * yi[c]) / piv;
             yr[c] = creal(v);
             yi[c] = cimag(v);
         }
@@ -148,15 +184,15 @@ static void sweep_shapes(const sm_model *m, sweep_lin *L, const sm_eig_out *e, d
 /* MAC between mode a of case A and mode b of case B (translations only). */
 static double sweep_mac(const sm_case *A, int a, const sm_case *B, int b)
 {
-    int nn = A->n_nodes;
-    const double *ar = A->shape_re + (size_t)a * 3 * nn, *ai = A->shape_im + (size_t)a * 3 * nn;
-    const double *br = B->shape_re + (size_t)b * 3 * nn, *bi = B->shape_im + (size_t)b * 3 * nn;
+    int nn = A->n_nodes, dof = A->node_dof;
+    const double *ar = A->shape_re + (size_t)a * dof * nn, *ai = A->shape_im + (size_t)a * dof * nn;
+    const double *br = B->shape_re + (size_t)b * dof * nn, *bi = B->shape_im + (size_t)b * dof * nn;
     double complex dot = 0;
     double na = 0, nb = 0;
-    for (int c = 0; c < 3 * nn; c++) {
-        if (c % 3 == 2)
+    for (int c = 0; c < dof * nn; c++) {
+        if (!sweep_translation(c, dof))
             continue;
-        double complex u = ar[c] + I * ai[c], v = br[c] + I * bi[c];
+        double complex u = ar[c] + _Complex_I * ai[c], v = br[c] + _Complex_I * bi[c];
         dot += conj(u) * v;
         na += creal(conj(u) * u);
         nb += creal(conj(v) * v);
@@ -202,21 +238,26 @@ static void sweep_track(sm_case *cur, const sm_case *prev)
     free(mac);
 }
 
-/* Fill equilibrium outputs of case c at q (kinematics in k). */
-static int sweep_equilibrium_out(const sm_model *m, const double *q, const sm_kin *k, sm_case *c)
+/* Fill equilibrium outputs of case c at q (kinematics of q in L). */
+static int sweep_equilibrium_out(const sm_model *m, const double *q, sweep_lin *L, sm_case *c)
 {
+    const sm_kin *k = &L->kin;
     c->n_nodes = m->n_nodes;
+    c->node_dof = sweep_dof(m);
     c->n_elements = m->n_elems;
-    c->nodes = dm_vec(3 * (size_t)m->n_nodes);
+    c->nodes = dm_vec((size_t)c->node_dof * m->n_nodes);
     c->axial_force = dm_vec((size_t)m->n_elems);
     if (!c->nodes || !c->axial_force)
         return SM_NOMEM;
-    memcpy(c->nodes, k->rn, 3 * (size_t)m->n_nodes * sizeof(double));
     lin_axial_forces(m, q, c->axial_force);
-    /* rotation of each node relative to its frame: phi_k - (theta_s - theta0_s) */
     double rot = 0;
     int at = -1;
-    for (int s = 0; s < m->n_subs; s++) {
+    if (m->spatial)
+        rot = lin3_nodes(m, &L->sk, c->nodes, &at); /* |psi|: rotation relative to the own frame */
+    else
+        memcpy(c->nodes, k->rn, 3 * (size_t)m->n_nodes * sizeof(double));
+    /* rotation of each node relative to its frame: phi_k - (theta_s - theta0_s) */
+    for (int s = 0; !m->spatial && s < m->n_subs; s++) {
         const sm_sub *b = &m->subs[s];
         for (int i = 0; i < b->nfree; i++) {
             double p = k->rn[3 * b->free_nodes[i] + 2] - (k->theta[s] - b->theta0);
@@ -305,15 +346,15 @@ static int sweep_modes(const sm_model *m, const double *q, sweep_lin *L, sm_case
         sweep_lin_free(&D);
         return sweep_eigen_failed(c, rc, finite);
     }
-    int k = e.n_modes, nn = m->n_nodes;
+    int k = e.n_modes, nn = m->n_nodes * sweep_dof(m);
     c->n_modes = k;
     c->frequency = dm_vec((size_t)k);
     c->eig_re = dm_vec((size_t)k);
     c->eig_im = dm_vec((size_t)k);
     c->mac_to_previous = dm_vec((size_t)k);
     c->previous_index = calloc((size_t)(k ? k : 1), sizeof(int));
-    c->shape_re = dm_vec((size_t)k * 3 * nn);
-    c->shape_im = dm_vec((size_t)k * 3 * nn);
+    c->shape_re = dm_vec((size_t)k * nn);
+    c->shape_im = dm_vec((size_t)k * nn);
     if (!c->frequency || !c->eig_re || !c->eig_im || !c->mac_to_previous || !c->previous_index ||
         !c->shape_re || !c->shape_im) {
         eig_out_free(&e);
@@ -420,8 +461,11 @@ int sm_solve(const sm_model *m, const double *omegas, int n_omegas, sm_progress_
         c->iterations = eo.iterations;
         c->residual = eo.residual;
         c->last_omega = sqrt(eo.last_s);
-        frames_eval(m, q, &L.kin);
-        if ((rc = sweep_equilibrium_out(m, q, &L.kin, c)) < 0)
+        if (m->spatial)
+            sp_eval(m, q, &L.sk);
+        else
+            frames_eval(m, q, &L.kin);
+        if ((rc = sweep_equilibrium_out(m, q, &L, c)) < 0)
             goto fail;
         if (!eo.converged) {
             c->status = SM_CASE_NO_EQUILIBRIUM;

@@ -85,6 +85,8 @@ int tree_choose(int solver, int n, int max_m, int modes)
 
 int tree_use(const sm_model *m)
 {
+    if (m->spatial)
+        return 0; /* the block form is planar (3 frame-pose coordinates) */
     int mx = 0;
     for (int s = 0; s < m->n_subs; s++)
         mx = m->subs[s].m > mx ? m->subs[s].m : mx;

@@ -93,7 +93,7 @@ static int req_build_tables(codec_request *r)
     if (!r->joint_names || !r->section_names)
         return SM_NOMEM;
     r->joint_xy = malloc(2 * (size_t)nj * sizeof(double));
-    r->sections = malloc((size_t)(ns ? ns : 1) * sizeof(sm_section));
+    r->sections = calloc((size_t)(ns ? ns : 1), sizeof(sm_section));
     if (!r->joint_xy || !r->sections)
         return SM_NOMEM;
     for (i = 0; i < nj; i++) {
@@ -125,8 +125,8 @@ static int req_build_structure(codec_request *r)
     size_t i, nm = json_array_size(mems), np = json_array_size(pms);
     int nj = r->st.n_joints, ns = r->st.n_sections;
 
-    r->members = malloc((nm ? nm : 1) * sizeof(sm_member));
-    r->point_masses = np ? malloc(np * sizeof(sm_point_mass)) : NULL;
+    r->members = calloc(nm ? nm : 1, sizeof(sm_member));
+    r->point_masses = np ? calloc(np, sizeof(sm_point_mass)) : NULL;
     if (!r->members || (np && !r->point_masses))
         return SM_NOMEM;
     json_array_foreach(mems, i, x) {

@@ -198,7 +198,7 @@ static void errors(void)
 static void long_chain(int n)
 {
     double *xy = malloc(2 * (size_t)(n + 1) * sizeof(double));
-    sm_member *mem = malloc((size_t)n * sizeof(sm_member));
+    sm_member *mem = calloc((size_t)n, sizeof(sm_member));
     sm_section sec = {7e10, 4e-4, 2e-7, 1.2};
     if (!xy || !mem) {
         TU_CHECK(0, "alloc");

@@ -1,0 +1,65 @@
+/*
+ * fe3.c — space-frame Euler-Bernoulli element matrices (DESIGN.md 7.1, 7.3)
+ * in the element's principal axes (e1 along the element, p2 edgewise, p3
+ * flapwise), DOF order u1 v1 w1 tx1 ty1 tz1 u2 v2 w2 tx2 ty2 tz2, 12x12
+ * column-major.  The two bending planes are the planar element of fe.c: in
+ * the p2 direction on (v, tz) exactly, in the p3 direction on (w, -ty)
+ * (w' = -ty), so a planar member reproduces the planar matrices entry for
+ * entry.
+ */
+#include "spatial.h"
+
+#include <string.h>
+
+/* Planar DOF (u1 v1 phi1 u2 v2 phi2) of each 3D DOF in the p2 plane (edge) and the p3 plane
+ * (flap), with the sign of the rotation; -1: not in that plane. */
+static const int fe3_edge[12] = {-1, 1, -1, -1, -1, 2, -1, 4, -1, -1, -1, 5};
+static const int fe3_flap[12] = {-1, -1, 1, -1, 2, -1, -1, -1, 4, -1, 5, -1};
+static const double fe3_flap_sign[12] = {0, 0, 1, 0, -1, 0, 0, 0, 1, 0, -1, 0};
+
+/* a (12x12) += the bending part of the planar 6x6 p (rows/cols v, phi) in both planes:
+ * pe with the edge map, pf with the flap map (signs on ty). */
+static void fe3_add_planes(const double pe[36], const double pf[36], double a[144])
+{
+    for (int j = 0; j < 12; j++)
+        for (int i = 0; i < 12; i++) {
+            if (fe3_edge[i] >= 0 && fe3_edge[j] >= 0)
+                a[i + 12 * j] += pe[fe3_edge[i] + 6 * fe3_edge[j]];
+            if (fe3_flap[i] >= 0 && fe3_flap[j] >= 0)
+                a[i + 12 * j] += fe3_flap_sign[i] * fe3_flap_sign[j] * pf[fe3_flap[i] + 6 * fe3_flap[j]];
+        }
+}
+
+/* a (12x12) += c [1 -1; -1 1] on the DOF pair (i, i + 6). */
+static void fe3_add_bar(double c, int i, double a[144])
+{
+    a[i + 12 * i] += c;
+    a[(i + 6) + 12 * (i + 6)] += c;
+    a[i + 12 * (i + 6)] -= c;
+    a[(i + 6) + 12 * i] -= c;
+}
+
+void fe3_stiffness(const sm_elem *e, double k[144])
+{
+    double pe[36], pf[36];
+    memset(k, 0, 144 * sizeof(double));
+    fe_stiffness_local(0.0, e->EI_edge, e->l, pe);
+    fe_stiffness_local(0.0, e->EI_flap, e->l, pf);
+    fe3_add_planes(pe, pf, k);
+    fe3_add_bar(e->EA / e->l, 0, k); /* axial: EA/l */
+    fe3_add_bar(e->GJ / e->l, 3, k); /* torsion: GJ/l */
+}
+
+void fe3_geometric(const sm_elem *e, double g[144])
+{
+    double b[16], p[36];
+    memset(g, 0, 144 * sizeof(double));
+    memset(p, 0, sizeof p);
+    fe_geometric_bending(e->l, b); /* eq. 23 on (v1, phi1, v2, phi2) */
+    static const int at[4] = {1, 2, 4, 5};
+    for (int j = 0; j < 4; j++)
+        for (int i = 0; i < 4; i++)
+            p[at[i] + 6 * at[j]] = b[i + 4 * j];
+    fe3_add_planes(p, p, g);
+    fe3_add_bar(e->ip_over_a / e->l, 3, g); /* Wagner: (I_p/A) int tx'^2 */
+}

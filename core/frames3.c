@@ -1,0 +1,358 @@
+/*
+ * frames3.c — kinematics of a spatial model along its frame tree (DESIGN.md
+ * 7.2-7.3): frame poses, point positions and small rotations, the Jacobians
+ * J (translation) and W (hub-frame rotation) of every point, the centrifugal
+ * force g = dT0~/dq and its Jacobian H.
+ *
+ * Poses are computed in complex arithmetic: every quantity is analytic in q
+ * (rot3.c), so H is obtained column by column by a complex step,
+ * H e_j = Im g(q + i h e_j) / h, exact to round-off (no subtractive
+ * cancellation), from the O(n) reverse recursion for g:
+ *   virtual work  dT0~ = sum_p F_p . dr_p + M_p . dtheta_p,
+ *   F_p = m_p P r_p,  M_p = (X_p e_z) x e_z,  X_p = A_p I_p A_p',
+ * accumulated leaves first as the wrench (F, M about R_s) of each subtree.
+ * J and W come from the forward recursion
+ *   dR_c = dR_s + dtheta_s x (A_s w_e) + A_s N^u_e dq_s,
+ *   dtheta_c = dtheta_s + A_s T(psi_e) N^psi_e dq_s.
+ */
+#include "spatial.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Complex step: small enough that h^2 terms vanish against round-off. */
+#define SP_STEP 1e-20
+
+void sp_kin_free(sp_kin *k)
+{
+    free(k->R);
+    free(k->A);
+    free(k->r);
+    free(k->psi);
+    free(k->AT);
+    dm_free(&k->JRT);
+    dm_free(&k->JW);
+    free(k->cq);
+    free(k->cR);
+    free(k->cA);
+    free(k->cF);
+    free(k->cg);
+    free(k->pt_ptr);
+    free(k->pt_idx);
+    free(k->ch_ptr);
+    free(k->ch_idx);
+    memset(k, 0, sizeof *k);
+}
+
+/* Points and children of every substructure, as CSR lists. */
+static int sp_lists(const sm_model *m, sp_kin *k)
+{
+    int S = m->n_subs, P = m->n_pt;
+    k->pt_ptr = calloc((size_t)S + 1, sizeof(int));
+    k->ch_ptr = calloc((size_t)S + 1, sizeof(int));
+    k->pt_idx = malloc((size_t)(P ? P : 1) * sizeof(int));
+    k->ch_idx = malloc((size_t)(S ? S : 1) * sizeof(int));
+    if (!k->pt_ptr || !k->ch_ptr || !k->pt_idx || !k->ch_idx)
+        return SM_NOMEM;
+    for (int p = 0; p < P; p++)
+        if (m->pt[p].sub >= 0)
+            k->pt_ptr[m->pt[p].sub + 1]++;
+    for (int s = 0; s < S; s++)
+        if (m->subs[s].parent >= 0)
+            k->ch_ptr[m->subs[s].parent + 1]++;
+    for (int s = 0; s < S; s++) {
+        k->pt_ptr[s + 1] += k->pt_ptr[s];
+        k->ch_ptr[s + 1] += k->ch_ptr[s];
+    }
+    int *fp = calloc((size_t)S + 1, sizeof(int)), *fc = calloc((size_t)S + 1, sizeof(int));
+    if (!fp || !fc) {
+        free(fp);
+        free(fc);
+        return SM_NOMEM;
+    }
+    for (int p = 0; p < P; p++) {
+        int s = m->pt[p].sub;
+        if (s >= 0)
+            k->pt_idx[k->pt_ptr[s] + fp[s]++] = p;
+    }
+    for (int s = 0; s < S; s++) {
+        int a = m->subs[s].parent;
+        if (a >= 0)
+            k->ch_idx[k->ch_ptr[a] + fc[a]++] = s;
+    }
+    free(fp);
+    free(fc);
+    return SM_OK;
+}
+
+int sp_kin_alloc(const sm_model *m, sp_kin *k, int jac)
+{
+    int n = m->n, S = m->n_subs, P = m->n_pt;
+    memset(k, 0, sizeof *k);
+    k->n = n;
+    k->S = S;
+    k->P = P;
+    k->jac = jac;
+    k->R = dm_vec(3 * (size_t)S);
+    k->A = dm_vec(9 * (size_t)S);
+    k->r = dm_vec(3 * (size_t)P);
+    k->psi = dm_vec(3 * (size_t)P);
+    k->AT = dm_vec(9 * (size_t)P);
+    k->cq = calloc((size_t)n, sizeof(sp_cx));
+    k->cR = calloc(3 * (size_t)S, sizeof(sp_cx));
+    k->cA = calloc(9 * (size_t)S, sizeof(sp_cx));
+    k->cF = calloc(6 * (size_t)S, sizeof(sp_cx));
+    k->cg = calloc((size_t)n, sizeof(sp_cx));
+    if (!k->R || !k->A || !k->r || !k->psi || !k->AT || !k->cq || !k->cR || !k->cA || !k->cF || !k->cg ||
+        sp_lists(m, k) || (jac && (dm_alloc(&k->JRT, n, 6 * S) || dm_alloc(&k->JW, n, 6 * P)))) {
+        sp_kin_free(k);
+        return SM_NOMEM;
+    }
+    return SM_OK;
+}
+
+/* Local deformed position w = ub + N^u q_s and small rotation psi = N^psi q_s of point p. */
+static void sp_local(const sm_model *m, const sp_point *p, const sp_cx *q, sp_cx w[3], sp_cx psi[3])
+{
+    const sm_sub *b = &m->subs[p->sub];
+    const sp_cx *qs = q + b->q0;
+    for (int i = 0; i < 3; i++) {
+        w[i] = p->ub[i];
+        psi[i] = 0;
+    }
+    for (int c = 0; c < b->m; c++) {
+        const double *Nc = p->N + (size_t)p->ldn * c;
+        for (int i = 0; i < 3; i++) {
+            w[i] += Nc[i] * qs[c];
+            psi[i] += Nc[3 + i] * qs[c];
+        }
+    }
+}
+
+/* Frame poses at the complex q into k->cR, k->cA (parents first). */
+static void sp_poses(const sm_model *m, const sp_cx *q, sp_kin *k)
+{
+    for (int s = 0; s < m->n_subs; s++) {
+        const sm_sub *b = &m->subs[s];
+        sp_cx *R = k->cR + 3 * s, *A = k->cA + 9 * s;
+        if (b->parent < 0) {
+            const sm_node *r = &m->nodes[b->root];
+            R[0] = r->x, R[1] = r->y, R[2] = r->z;
+            for (int i = 0; i < 9; i++)
+                A[i] = b->Arel[i];
+            continue;
+        }
+        const sp_cx *Rp = k->cR + 3 * b->parent, *Ap = k->cA + 9 * b->parent;
+        sp_cx w[3], psi[3], aw[3], L[9], AL[9], Ar[9];
+        sp_local(m, &m->pt[b->root], q, w, psi);
+        rot3_mv(Ap, w, aw);
+        for (int i = 0; i < 3; i++)
+            R[i] = Rp[i] + aw[i]; /* R_c = R_s + A_s w_e */
+        rot3_exp(psi, L, NULL);
+        rot3_mul(Ap, L, AL);
+        for (int i = 0; i < 9; i++)
+            Ar[i] = b->Arel[i];
+        rot3_mul(AL, Ar, A); /* A_c = A_s Lambda(psi_e) Arel_c */
+    }
+}
+
+/* gs (m_s) += N^u' (A' F) + N^psi' (T' A' M) for a point of s with rotation psi. */
+static void sp_gen_force(const sm_sub *b, const sp_point *p, const sp_cx A[9], const sp_cx psi[3],
+                         const sp_cx F[3], const sp_cx Mo[3], sp_cx *gs)
+{
+    sp_cx L[9], T[9], f[3], mo[3], t[3];
+    rot3_tmv(A, F, f);
+    rot3_tmv(A, Mo, t);
+    rot3_exp(psi, L, T);
+    rot3_tmv(T, t, mo);
+    for (int c = 0; c < b->m; c++) {
+        const double *Nc = p->N + (size_t)p->ldn * c;
+        gs[c] += Nc[0] * f[0] + Nc[1] * f[1] + Nc[2] * f[2] + Nc[3] * mo[0] + Nc[4] * mo[1] + Nc[5] * mo[2];
+    }
+}
+
+/* g = dT0~/dq at the complex q (k->cq) into k->cg: poses, then the wrench recursion. */
+static void sp_centrifugal_c(const sm_model *m, sp_kin *k)
+{
+    static const sp_cx ez[3] = {0, 0, 1};
+    const sp_cx *q = k->cq;
+    sp_poses(m, q, k);
+    memset(k->cg, 0, (size_t)m->n * sizeof(sp_cx));
+    for (int s = m->n_subs - 1; s >= 0; s--) { /* children first */
+        const sm_sub *b = &m->subs[s];
+        const sp_cx *A = k->cA + 9 * s;
+        sp_cx *Fs = k->cF + 6 * s, *Ms = Fs + 3, *gs = k->cg + b->q0;
+        for (int i = 0; i < 6; i++)
+            Fs[i] = 0;
+        for (int t = k->pt_ptr[s]; t < k->pt_ptr[s + 1]; t++) {
+            const sp_point *p = &m->pt[k->pt_idx[t]];
+            sp_cx w[3], psi[3], aw[3], F[3] = {0, 0, 0}, Mo[3] = {0, 0, 0}, c[3];
+            sp_local(m, p, q, w, psi);
+            rot3_mv(A, w, aw);
+            if (p->mass != 0) { /* F = m P r, r = R + A w */
+                F[0] = p->mass * (k->cR[3 * s] + aw[0]);
+                F[1] = p->mass * (k->cR[3 * s + 1] + aw[1]);
+            }
+            if (p->has_I) { /* M = (X e) x e, X e = A Lambda I Lambda' A' e */
+                sp_cx v[3], u[3], L[9], Ic[9], y[3], z[3];
+                for (int i = 0; i < 9; i++)
+                    Ic[i] = p->I[i];
+                rot3_tmv(A, ez, v);
+                rot3_exp(psi, L, NULL);
+                rot3_tmv(L, v, u);
+                rot3_mv(Ic, u, y);
+                rot3_mv(L, y, z);
+                rot3_mv(A, z, y);
+                rot3_cross(y, ez, Mo);
+            }
+            sp_gen_force(b, p, A, psi, F, Mo, gs);
+            rot3_cross(aw, F, c); /* wrench about R_s */
+            for (int i = 0; i < 3; i++) {
+                Fs[i] += F[i];
+                Ms[i] += Mo[i] + c[i];
+            }
+        }
+        for (int t = k->ch_ptr[s]; t < k->ch_ptr[s + 1]; t++) {
+            int ch = k->ch_idx[t];
+            const sp_point *p = &m->pt[m->subs[ch].root];
+            const sp_cx *Fc = k->cF + 6 * ch, *Mc = Fc + 3;
+            sp_cx w[3], psi[3], aw[3], c[3];
+            sp_local(m, p, q, w, psi);
+            rot3_mv(A, w, aw);
+            sp_gen_force(b, p, A, psi, Fc, Mc, gs);
+            rot3_cross(aw, Fc, c);
+            for (int i = 0; i < 3; i++) {
+                Fs[i] += Fc[i];
+                Ms[i] += Mc[i] + c[i];
+            }
+        }
+    }
+}
+
+void sp_centrifugal(const sm_model *m, const double *q, sp_kin *k, double *g)
+{
+    for (int i = 0; i < m->n; i++)
+        k->cq[i] = q[i];
+    sp_centrifugal_c(m, k);
+    for (int i = 0; i < m->n; i++)
+        g[i] = creal(k->cg[i]);
+}
+
+void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat *H)
+{
+    int n = m->n;
+    for (int i = 0; i < n; i++)
+        k->cq[i] = q[i];
+    for (int j = 0; j < n; j++) {
+        double h = SP_STEP * fmax(1.0, fabs(q[j]));
+        k->cq[j] = q[j] + _Complex_I * h;
+        sp_centrifugal_c(m, k);
+        for (int i = 0; i < n; i++)
+            DM(H, i, j) = cimag(k->cg[i]) / h;
+        k->cq[j] = q[j];
+    }
+}
+
+/* JRT columns of frame c from its parent s (forward recursion in the header). */
+static void sp_jac_frame(const sm_model *m, sp_kin *k, int c)
+{
+    const sm_sub *b = &m->subs[c], *ps = &m->subs[b->parent];
+    const sp_point *p = &m->pt[b->root];
+    const double *A = k->A + 9 * b->parent;
+    int n = m->n, e = b->root;
+    double *JRc = &DM(&k->JRT, 0, 6 * c), *JRs = &DM(&k->JRT, 0, 6 * b->parent);
+    double *JTc = JRc + 3 * (size_t)n, *JTs = JRs + 3 * (size_t)n;
+    double a[3]; /* A_s w_e = r_e - R_s */
+    for (int i = 0; i < 3; i++)
+        a[i] = k->r[3 * e + i] - k->R[3 * b->parent + i];
+    for (int x = 0; x < n; x++) {
+        const double t0 = JTs[x], t1 = JTs[n + x], t2 = JTs[2 * (size_t)n + x];
+        JRc[x] = JRs[x] + t1 * a[2] - t2 * a[1]; /* dtheta x a */
+        JRc[n + x] = JRs[n + x] + t2 * a[0] - t0 * a[2];
+        JRc[2 * (size_t)n + x] = JRs[2 * (size_t)n + x] + t0 * a[1] - t1 * a[0];
+        JTc[x] = t0;
+        JTc[n + x] = t1;
+        JTc[2 * (size_t)n + x] = t2;
+    }
+    const double *AT = k->AT + 9 * e;
+    for (int j = 0; j < ps->m; j++) {
+        const double *Nc = p->N + (size_t)p->ldn * j;
+        for (int i = 0; i < 3; i++) {
+            JRc[(size_t)n * i + ps->q0 + j] += A[i] * Nc[0] + A[i + 3] * Nc[1] + A[i + 6] * Nc[2];
+            JTc[(size_t)n * i + ps->q0 + j] += AT[i] * Nc[3] + AT[i + 3] * Nc[4] + AT[i + 6] * Nc[5];
+        }
+    }
+}
+
+/* JW columns of point p of frame s. */
+static void sp_jac_point(const sm_model *m, sp_kin *k, int pi)
+{
+    const sp_point *p = &m->pt[pi];
+    const sm_sub *b = &m->subs[p->sub];
+    int n = m->n, s = p->sub;
+    const double *A = k->A + 9 * s, *AT = k->AT + 9 * pi;
+    double *Jp = &DM(&k->JW, 0, 6 * pi), *Wp = Jp + 3 * (size_t)n;
+    const double *JRs = &DM(&k->JRT, 0, 6 * s), *JTs = JRs + 3 * (size_t)n;
+    double a[3];
+    for (int i = 0; i < 3; i++)
+        a[i] = k->r[3 * pi + i] - k->R[3 * s + i];
+    for (int x = 0; x < n; x++) {
+        const double t0 = JTs[x], t1 = JTs[n + x], t2 = JTs[2 * (size_t)n + x];
+        Jp[x] = JRs[x] + t1 * a[2] - t2 * a[1];
+        Jp[n + x] = JRs[n + x] + t2 * a[0] - t0 * a[2];
+        Jp[2 * (size_t)n + x] = JRs[2 * (size_t)n + x] + t0 * a[1] - t1 * a[0];
+        Wp[x] = t0;
+        Wp[n + x] = t1;
+        Wp[2 * (size_t)n + x] = t2;
+    }
+    for (int j = 0; j < b->m; j++) {
+        const double *Nc = p->N + (size_t)p->ldn * j;
+        for (int i = 0; i < 3; i++) {
+            Jp[(size_t)n * i + b->q0 + j] += A[i] * Nc[0] + A[i + 3] * Nc[1] + A[i + 6] * Nc[2];
+            Wp[(size_t)n * i + b->q0 + j] += AT[i] * Nc[3] + AT[i + 3] * Nc[4] + AT[i + 6] * Nc[5];
+        }
+    }
+}
+
+void sp_eval(const sm_model *m, const double *q, sp_kin *k)
+{
+    for (int i = 0; i < m->n; i++)
+        k->cq[i] = q[i];
+    sp_poses(m, k->cq, k);
+    for (int i = 0; i < 3 * m->n_subs; i++)
+        k->R[i] = creal(k->cR[i]);
+    for (int i = 0; i < 9 * m->n_subs; i++)
+        k->A[i] = creal(k->cA[i]);
+    for (int pi = 0; pi < m->n_pt; pi++) {
+        const sp_point *p = &m->pt[pi];
+        double *r = k->r + 3 * pi, *ps = k->psi + 3 * pi, *AT = k->AT + 9 * pi;
+        if (p->sub < 0) { /* the clamp */
+            memcpy(r, p->ub, 3 * sizeof(double));
+            memset(ps, 0, 3 * sizeof(double));
+            memset(AT, 0, 9 * sizeof(double));
+            continue;
+        }
+        sp_cx w[3], psi[3], aw[3], L[9], T[9], At[9];
+        sp_local(m, p, k->cq, w, psi);
+        rot3_mv(k->cA + 9 * p->sub, w, aw);
+        rot3_exp(psi, L, T);
+        rot3_mul(k->cA + 9 * p->sub, T, At);
+        for (int i = 0; i < 3; i++) {
+            r[i] = creal(k->cR[3 * p->sub + i] + aw[i]);
+            ps[i] = creal(psi[i]);
+        }
+        for (int i = 0; i < 9; i++)
+            AT[i] = creal(At[i]);
+    }
+    if (!k->jac)
+        return;
+    dm_zero(&k->JRT);
+    dm_zero(&k->JW);
+    for (int s = 0; s < m->n_subs; s++)
+        if (m->subs[s].parent >= 0)
+            sp_jac_frame(m, k, s);
+    for (int pi = 0; pi < m->n_pt; pi++)
+        if (m->pt[pi].sub >= 0)
+            sp_jac_point(m, k, pi);
+}

@@ -1,0 +1,146 @@
+/*
+ * rot3.c — 3x3 rotations for the spatial path (spatial.h): the exponential
+ * map Lambda(psi) = exp(skew psi) of DESIGN.md 7.2 and its left tangent T
+ * (d Lambda = skew(T d psi) Lambda), written so that every function is
+ * analytic in psi (powers of psi.psi, no conjugates, series near zero):
+ * frames3.c differentiates the kinematics by complex steps through them.
+ */
+#include "spatial.h"
+
+#include <math.h>
+#include <string.h>
+
+/* Series switch: below it sin(t)/t, (1 - cos t)/t^2 and (t - sin t)/t^3 come from their Taylor
+ * series in t2 = t^2 (terms through t^10: truncation below 1e-22 relative). */
+#define ROT3_SERIES 1e-2
+
+/* c1 = sin t / t, c2 = (1 - cos t)/t^2, c3 = (t - sin t)/t^3 as functions of t2 = t^2. */
+static void rot3_coeffs(sp_cx t2, sp_cx *c1, sp_cx *c2, sp_cx *c3)
+{
+    if (cabs(t2) < ROT3_SERIES) {
+        /* alternating series: sum (-t2)^k / (2k+1)!, / (2k+2)!, / (2k+3)! */
+        sp_cx p = 1, a = 0, b = 0, c = 0;
+        double f1 = 1, f2 = 2, f3 = 6; /* (2k+1)!, (2k+2)!, (2k+3)! */
+        for (int k = 0; k < 6; k++) {
+            a += p / f1;
+            b += p / f2;
+            c += p / f3;
+            p *= -t2;
+            f1 *= (2 * k + 2) * (2 * k + 3);
+            f2 *= (2 * k + 3) * (2 * k + 4);
+            f3 *= (2 * k + 4) * (2 * k + 5);
+        }
+        *c1 = a;
+        *c2 = b;
+        *c3 = c;
+        return;
+    }
+    sp_cx t = csqrt(t2), s = csin(t), co = ccos(t);
+    *c1 = s / t;
+    *c2 = (1 - co) / t2;
+    *c3 = (t - s) / (t2 * t);
+}
+
+/* K = skew(p) and K2 = skew(p)^2 (column-major). */
+static void rot3_skew2(const sp_cx p[3], sp_cx K[9], sp_cx K2[9])
+{
+    K[0] = 0, K[1] = p[2], K[2] = -p[1];
+    K[3] = -p[2], K[4] = 0, K[5] = p[0];
+    K[6] = p[1], K[7] = -p[0], K[8] = 0;
+    /* skew(p)^2 = p p' - (p.p) I */
+    sp_cx pp = p[0] * p[0] + p[1] * p[1] + p[2] * p[2];
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 3; i++)
+            K2[i + 3 * j] = p[i] * p[j] - (i == j ? pp : 0);
+}
+
+void rot3_exp(const sp_cx psi[3], sp_cx L[9], sp_cx T[9])
+{
+    sp_cx K[9], K2[9], c1, c2, c3;
+    sp_cx t2 = psi[0] * psi[0] + psi[1] * psi[1] + psi[2] * psi[2];
+    rot3_coeffs(t2, &c1, &c2, &c3);
+    rot3_skew2(psi, K, K2);
+    for (int i = 0; i < 9; i++) {
+        sp_cx id = i % 4 == 0 ? 1 : 0;
+        /* Rodrigues: Lambda = I + sin t/t K + (1 - cos t)/t^2 K^2 */
+        L[i] = id + c1 * K[i] + c2 * K2[i];
+        /* left tangent: T = I + (1 - cos t)/t^2 K + (t - sin t)/t^3 K^2 */
+        if (T)
+            T[i] = id + c2 * K[i] + c3 * K2[i];
+    }
+}
+
+void rot3_mul(const sp_cx a[9], const sp_cx b[9], sp_cx c[9])
+{
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 3; i++)
+            c[i + 3 * j] = a[i] * b[3 * j] + a[i + 3] * b[3 * j + 1] + a[i + 6] * b[3 * j + 2];
+}
+
+void rot3_tmul(const sp_cx a[9], const sp_cx b[9], sp_cx c[9])
+{
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 3; i++)
+            c[i + 3 * j] = a[3 * i] * b[3 * j] + a[3 * i + 1] * b[3 * j + 1] + a[3 * i + 2] * b[3 * j + 2];
+}
+
+void rot3_mv(const sp_cx a[9], const sp_cx x[3], sp_cx y[3])
+{
+    for (int i = 0; i < 3; i++)
+        y[i] = a[i] * x[0] + a[i + 3] * x[1] + a[i + 6] * x[2];
+}
+
+void rot3_tmv(const sp_cx a[9], const sp_cx x[3], sp_cx y[3])
+{
+    for (int i = 0; i < 3; i++)
+        y[i] = a[3 * i] * x[0] + a[3 * i + 1] * x[1] + a[3 * i + 2] * x[2];
+}
+
+void rot3_cross(const sp_cx a[3], const sp_cx b[3], sp_cx c[3])
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+void rot3_mul_r(const double a[9], const double b[9], double c[9])
+{
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 3; i++)
+            c[i + 3 * j] = a[i] * b[3 * j] + a[i + 3] * b[3 * j + 1] + a[i + 6] * b[3 * j + 2];
+}
+
+void rot3_tmul_r(const double a[9], const double b[9], double c[9])
+{
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 3; i++)
+            c[i + 3 * j] = a[3 * i] * b[3 * j] + a[3 * i + 1] * b[3 * j + 1] + a[3 * i + 2] * b[3 * j + 2];
+}
+
+void rot3_log(const double R[9], double v[3])
+{
+    /* skew part: (R - R')/2 = sin t/t skew(v); cos t = (tr R - 1)/2 */
+    double w[3] = {0.5 * (R[5] - R[7]), 0.5 * (R[6] - R[2]), 0.5 * (R[1] - R[3])};
+    double s = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    double c = 0.5 * (R[0] + R[4] + R[8] - 1.0);
+    double t = atan2(s, c);
+    if (c > -0.9) {
+        double f = s > 1e-300 ? t / s : 1.0;
+        for (int i = 0; i < 3; i++)
+            v[i] = f * w[i];
+        return;
+    }
+    /* near pi: the axis from the symmetric part, (R + R')/2 = cos t I + (1 - cos t) a a' */
+    int k = R[0] >= R[4] && R[0] >= R[8] ? 0 : R[4] >= R[8] ? 1 : 2;
+    double a[3];
+    for (int i = 0; i < 3; i++)
+        a[i] = 0.5 * (R[i + 3 * k] + R[k + 3 * i]) - (i == k ? c : 0);
+    double na = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    if (!(na > 0)) {
+        memset(v, 0, 3 * sizeof(double));
+        return;
+    }
+    double sg = a[0] * w[0] + a[1] * w[1] + a[2] * w[2] < 0 ? -1.0 : 1.0;
+    for (int i = 0; i < 3; i++)
+        v[i] = sg * t * a[i] / na;
+}

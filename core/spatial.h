@@ -1,0 +1,150 @@
+/*
+ * spatial.h — the spatial (3D) path of the core, DESIGN.md 7 (not installed).
+ *
+ * A spatial model keeps the topology of the planar one (mesh.c: nodes,
+ * elements, substructures, attachments) and adds, per node, 6 DOF (u, v, w
+ * and the small rotation psi, frame coordinates) and rotary inertia.  The
+ * modules:
+ *   rot3.c    3x3 rotations: Rodrigues exp, its left tangent, log (complex, so
+ *             that every kinematic quantity is analytic in q)
+ *   fe3.c     space-frame element matrices (stiffness, consistent mass, geometric)
+ *   mesh3.c   checks of the spatial input, element axes, nodal rotary inertia,
+ *             frame orientations
+ *   modes3.c  complete component-mode bases (+ static attachment modes under
+ *             modes_per_frame), element maps T_e, d_e, the points
+ *   frames3.c poses along the frame tree, J and W, the centrifugal force g and
+ *             its Jacobian H (complex step: exact to round-off)
+ *   lin3.c    F(q), the Newton tangent, M*, C*, K*, nodal outputs
+ * The Newton continuation (equilibrium.c), the eigen-analysis (eigen.c) and
+ * the sweep (sweep.c) are shared with the planar path.
+ *
+ * Conventions: hub frame, e_z the spin axis; 3x3 matrices column-major
+ * (a[i + 3 j]); a frame s has origin R_s and orientation A_s (columns = frame
+ * axes in the hub frame); point p of s: r_p = R_s + A_s w_p, w_p = ub_p + N^u_p q_s,
+ * psi_p = N^psi_p q_s, orientation A_s Lambda(psi_p); a child c at node e of
+ * s: R_c = r_e, A_c = A_s Lambda(psi_e) Arel_c (DESIGN.md 7.2).
+ */
+#ifndef SM_SPATIAL_H
+#define SM_SPATIAL_H
+
+#include "internal.h"
+
+#include <complex.h>
+/* complex.h's I would clash with the field I of sm_section and sp_point: the imaginary unit is
+ * written _Complex_I in the spatial files. */
+#undef I
+
+typedef double complex sp_cx;
+
+/* A point that a frame carries: an FE node (shapes, lumped mass) or a quadrature point. */
+typedef struct sp_point {
+    int sub;            /* substructure whose frame carries it; -1 for the clamp node (fixed) */
+    int node;           /* FE node, or -1 for a quadrature point */
+    double ub[3];       /* undeformed position in the frame, m (hub position for the clamp) */
+    double mass;        /* kg (0: carries no mass) */
+    double I[9];        /* rotary inertia at rest in frame axes, kg m^2 */
+    int has_I;          /* 1 when I is not all zero */
+    const double *N;    /* 6 x m_s rows (u, v, w, psi_x, psi_y, psi_z), column stride ldn */
+    int ldn;
+} sp_point;
+
+/* ------------------------------------------------------------- rot3.c */
+/** L = Lambda(psi) = exp(skew psi) and T = its left tangent (d Lambda = skew(T d psi) Lambda);
+ *  T may be NULL.  Analytic in psi (series near zero), so complex steps go through. */
+void rot3_exp(const sp_cx psi[3], sp_cx L[9], sp_cx T[9]);
+/** c = a b (3x3). */
+void rot3_mul(const sp_cx a[9], const sp_cx b[9], sp_cx c[9]);
+/** c = a' b (3x3). */
+void rot3_tmul(const sp_cx a[9], const sp_cx b[9], sp_cx c[9]);
+/** y = a x (3x3 times 3). */
+void rot3_mv(const sp_cx a[9], const sp_cx x[3], sp_cx y[3]);
+/** y = a' x. */
+void rot3_tmv(const sp_cx a[9], const sp_cx x[3], sp_cx y[3]);
+/** c = a x b. */
+void rot3_cross(const sp_cx a[3], const sp_cx b[3], sp_cx c[3]);
+/** Rotation vector (rad) of the real rotation matrix R (log map), |v| <= pi. */
+void rot3_log(const double R[9], double v[3]);
+/** Real 3x3 helpers: c = a b, c = a' b. */
+void rot3_mul_r(const double a[9], const double b[9], double c[9]);
+void rot3_tmul_r(const double a[9], const double b[9], double c[9]);
+
+/* -------------------------------------------------------------- fe3.c */
+/* Element DOF order: u1 v1 w1 tx1 ty1 tz1 u2 v2 w2 tx2 ty2 tz2 in the element's principal axes
+ * (e1, p2, p3); 12x12 column-major. */
+
+/** k = space-frame stiffness: EA/l, GJ/l, bending in p2 (EI_edge, with tz) and in p3 (EI_flap,
+ *  with ty; w' = -ty). */
+void fe3_stiffness(const sm_elem *e, double k[144]);
+/** g = geometric stiffness per unit axial force: the planar bending block of eq. 23 on (v, tz)
+ *  and on (w, -ty), and the Wagner term (I_p/A)/l [1 -1; -1 1] on tx (DESIGN.md 7.3). */
+void fe3_geometric(const sm_elem *e, double g[144]);
+
+/* ------------------------------------------------------------ mesh3.c */
+/** Spatial checks of st (sections, twist, flap direction, z, point-mass inertia, options),
+ *  as mesh_check does for the planar data; the same diag conventions. */
+int mesh3_check(const sm_structure *st, const sm_options *o, sm_diag *d);
+/** Planar structure: the spatial-only fields must be absent (zero); SM_OK or SM_INVALID_INPUT. */
+int mesh3_check_planar(const sm_structure *st, sm_diag *d);
+/** Element axes and sections, nodal rotary inertia (after mesh_nodes).  Returns SM_OK or
+ *  SM_INVALID_INPUT (a member without a usable flapwise direction: diag names it). */
+int mesh3_elements(sm_model *m, const sm_structure *st, sm_diag *d);
+/** Frame orientations A0, Arel and the undeformed local positions ubar (3 per free node),
+ *  after mesh_subs. */
+void mesh3_subs(sm_model *m);
+
+/* ----------------------------------------------------------- modes3.c */
+/** modes_count for a spatial substructure (complete basis: 6 F; truncated: + 6 per attachment). */
+int modes3_count(const sm_options *o, const sm_sub *b, int *nm, int *na);
+/** modes_build for a spatial model: bases, K_s, T_e, d_e, the points m->pt.  Same returns. */
+int modes3_build(sm_model *m, sm_progress_fn cb, void *user, sm_diag *d);
+
+/* ---------------------------------------------------------- frames3.c */
+/* Kinematic state of a spatial model at q. */
+typedef struct sp_kin {
+    int n, S, P;        /* coordinates, substructures, points */
+    double *R, *A;      /* 3 S frame origins, 9 S orientations */
+    double *r, *psi;    /* 3 P point positions (hub), 3 P small rotations (frame axes) */
+    double *AT;         /* 9 P: A_s T(psi_p), the map from d psi_p to the hub rotation */
+    dmat JRT;           /* n x 6S: columns 6s+i = (d R_s,i / dq)', 6s+3+i = (d theta_s,i / dq)' */
+    dmat JW;            /* n x 6P: columns 6p+i = (d r_p,i / dq)', 6p+3+i = (d theta_p,i / dq)'
+                           (theta: the hub-frame rotation) */
+    int jac;            /* 1 when JRT and JW are allocated */
+    int *pt_ptr, *pt_idx; /* points of frame s: pt_idx[pt_ptr[s] .. pt_ptr[s+1]) */
+    int *ch_ptr, *ch_idx; /* child frames of s, likewise */
+    /* complex scratch of the centrifugal recursion */
+    sp_cx *cq, *cR, *cA, *cF, *cg; /* n, 3S, 9S, 6S (subtree wrench), n */
+} sp_kin;
+
+/** Allocate k for m; jac: also the dense Jacobians JRT, JW (O(n (S + P))).  SM_OK or SM_NOMEM. */
+int sp_kin_alloc(const sm_model *m, sp_kin *k, int jac);
+/** Free and zero k; safe on a zeroed one. */
+void sp_kin_free(sp_kin *k);
+/** Poses and points at q (real); with k->jac also JRT and JW. */
+void sp_eval(const sm_model *m, const double *q, sp_kin *k);
+/** g (n) = d T0~/dq, T0~ = sum_p 1/2 m_p |P r_p|^2 + 1/2 e_z' A_p I_p A_p' e_z (DESIGN.md 7.3):
+ *  the centrifugal force is Omega^2 g.  Uses the complex scratch of k. */
+void sp_centrifugal(const sm_model *m, const double *q, sp_kin *k, double *g);
+/** H (n x n) = dg/dq at q, column by column by complex step (exact to round-off). */
+void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat *H);
+
+/* ------------------------------------------------------------- lin3.c */
+/** f += f_g(q) = sum_e P_e T_e' G_e T_e q_s (the 3D G of fe3_geometric). */
+void lin3_geometric_force(const sm_model *m, const double *q, double *f);
+/** Kt += d f_g / dq; frozen: P_e held at P_e(q). work: >= 12 max m_s doubles. */
+void lin3_geometric_tangent(const sm_model *m, const double *q, int frozen, dmat *Kt, double *work);
+/** M = M* = sum_p m_p J_p' J_p + W_p' X_p W_p at k (jac), X_p the hub inertia. Y: n x 6P scratch. */
+void lin3_mass(const sm_model *m, const sp_kin *k, dmat *M, dmat *Y);
+/** C = C* = Omega sum_p (2 m_p J_p' S J_p + W_p' Y_p W_p), S = skew(e_z),
+ *  Y_p = -skew(X_p e_z) + X_p S + S X_p (skew).  Y: n x 6P scratch. */
+void lin3_gyro(const sm_model *m, const sp_kin *k, double omega, dmat *C, dmat *Y);
+/** Kt = K + d f_g/dq - s H at q, frozen as lin3_geometric_tangent; H (n x n) receives dg/dq
+ *  (untouched when s = 0).  Uses the complex scratch of k.  work: >= 12 max m_s doubles. */
+void lin3_tangent(const sm_model *m, const double *q, sp_kin *k, double s, int frozen, dmat *Kt, dmat *H,
+                  double *work);
+/** nodes (6 n_nodes) = x, y, z and the rotation vector of each node's triad (DESIGN.md 7.3);
+ *  returns the largest |psi| (rotation relative to the own frame) and its node in *at. */
+double lin3_nodes(const sm_model *m, const sp_kin *k, double *nodes, int *at);
+/** y (6 n_nodes) = (J_k x, W_k x) per node at k (jac). */
+void lin3_nodal(const sm_model *m, const sp_kin *k, const double *x, double *y);
+
+#endif
