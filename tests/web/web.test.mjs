@@ -6,6 +6,7 @@
 //   SPINMODALD              the daemon executable
 //   SPINMODAL_NODE_MODULES  node_modules holding playwright-core (clients/web's npm dir)
 //   SPINMODAL_SCREENSHOTS   where screenshots are written
+//   SPINMODAL_EXAMPLES      the repository's examples/ (the spatial examples the page loads)
 //   CHROMIUM                browser executable (default /usr/bin/chromium)
 //   SPINMODAL_TEST_CLI, SPINMODAL_TEST_TIME_FACTOR, SPINMODAL_TEST_TIMEOUT
 //                           time budgets, as in tests/e2e/timescale.py: every wait
@@ -26,6 +27,7 @@ import {createRequire} from 'node:module';
 const DAEMON = process.env.SPINMODALD;
 const NODE_MODULES = process.env.SPINMODAL_NODE_MODULES || '';
 const SHOTS = process.env.SPINMODAL_SCREENSHOTS || path.join(process.cwd(), 'screenshots');
+const EXAMPLES = process.env.SPINMODAL_EXAMPLES || new URL('../../examples', import.meta.url).pathname;
 const CHROMIUM = process.env.CHROMIUM || '/usr/bin/chromium';
 const SKIP = 77;
 
@@ -179,6 +181,217 @@ async function messageOf(page, locator) {
     const m = id && document.getElementById(id.split(' ')[0]);
     return m ? m.textContent : '';
   });
+}
+
+/** Coordinates of the member lines of the structure drawing. */
+function memberLines(page) {
+  return page.$$eval('#structure-svg line.member', (ls) => ls.map((l) => ['x1', 'y1', 'x2', 'y2']
+    .map((a) => Number(l.getAttribute(a)))));
+}
+
+/** Drag across the middle of an svg by (dx, dy) px, in steps as a hand would. */
+async function drag(page, sel, dx, dy) {
+  const loc = page.locator(sel);
+  await loc.scrollIntoViewIfNeeded();
+  const b = await loc.boundingBox();
+  const x = b.x + b.width / 2, y = b.y + b.height / 2;
+  await page.mouse.move(x, y);
+  await page.mouse.down();
+  await page.mouse.move(x + dx, y + dy, {steps: 8});
+  await page.mouse.up();
+}
+
+/** Points "x y" of an SVG path ("M x y L x y …"). */
+function pathPoints(d) {
+  const v = (d.match(/-?\d+(\.\d+)?(e-?\d+)?/g) || []).map(Number);
+  const out = [];
+  for (let i = 0; i + 1 < v.length; i += 2) out.push([v[i], v[i + 1]]);
+  return out;
+}
+
+/**
+ * Spatial structures (DESIGN.md 7) through the real page and daemon: each
+ * spatial example loads from examples/, is drawn in 3D, turns when dragged
+ * and back with Reset, solves; the flapping blade's first mode at rest (a flap
+ * mode) moves the drawn nodes out of the hub plane by what the result says;
+ * a table and a JSON edit of a spatial request keep its spatial data and solve.
+ */
+async function spatial(page, base) {
+  const cases = [
+    {key: 'flapping-blade', file: 'flapping-blade.json', members: 1, elements: 24, speeds: 6},
+    {key: 'out-of-plane-arm', file: 'out-of-plane-arm.json', members: 2, elements: 32, speeds: 1},
+  ];
+  for (const c of cases) {
+    const want = JSON.parse(fs.readFileSync(path.join(EXAMPLES, c.file), 'utf8'));
+    await page.selectOption('#example', c.key);
+    ok(/Spatial/.test(await page.textContent('#example-desc')), `${c.key}: the example list describes it`,
+      await page.textContent('#example-desc'));
+    await page.click('#load-example');
+    const doc = await page.evaluate(() => JSON.parse(window.__spinmodal.request));
+    ok(JSON.stringify(doc) === JSON.stringify(want), `${c.key}: the page loads examples/${c.file}`,
+      JSON.stringify(doc).slice(0, 200));
+    ok(await page.isChecked('#spatial') && await page.isChecked('#view-3d'),
+      `${c.key}: shown as a spatial model, in the 3D view`);
+    const view = await page.evaluate(() => window.__spinmodal.view());
+    const lines0 = await memberLines(page);
+    ok(view.structure === '3d' && lines0.length === c.members, `${c.key}: the 3D view draws ${c.members} member(s)`,
+      `${view.structure}, ${lines0.length}`);
+    ok(await page.locator('#structure-svg .triad line').count() === 3, `${c.key}: the x, y, z triad is drawn`);
+    if (c.key === 'out-of-plane-arm') {
+      // the mast C -> P (along z) stands up on the screen: z is up in every view the user can reach
+      const [x1, y1, x2, y2] = lines0[1];
+      ok(y1 - y2 > 40 && Math.abs(x2 - x1) < 0.2 * (y1 - y2), 'out-of-plane-arm: the mast along z is drawn upright',
+        JSON.stringify(lines0[1]));
+      ok(await page.getByLabel('z of joint P (m)').inputValue() === '2' &&
+        await page.getByLabel('flap direction (x, y, z) of member 2').inputValue() === '1, 0, 0',
+      'out-of-plane-arm: z and the flap direction in the tables');
+    }
+
+    // turning the view: dragging changes the drawing, Reset brings it back
+    await drag(page, '#structure-svg', 120, 40);
+    const turned = await page.evaluate(() => window.__spinmodal.view());
+    const lines1 = await memberLines(page);
+    ok(turned.az !== view.az && turned.el !== view.el && JSON.stringify(lines1) !== JSON.stringify(lines0),
+      `${c.key}: dragging turns the view (az ${view.az} -> ${turned.az}, el ${view.el} -> ${turned.el})`,
+      JSON.stringify([lines0[0], lines1[0]]));
+    await shot(page, `07-${c.key}-turned.png`);
+    await page.click('#view-reset');
+    ok(JSON.stringify(await memberLines(page)) === JSON.stringify(lines0), `${c.key}: Reset view restores the drawing`);
+
+    // solve with the real daemon
+    await page.click('#submit');
+    const done = await waitFor(page, () => ['done', 'failed', 'canceled', 'rejected'].includes(document.body.dataset.jobState),
+      null, `the ${c.key} job`, 180000);
+    const state = await page.evaluate(() => document.body.dataset.jobState);
+    if (!ok(done && state === 'done', `${c.key}: the spatial job runs to done`,
+      `${state}: ${await page.textContent('#job-status')}; ${JSON.stringify(await page.evaluate(() =>
+        window.__spinmodal.errors()))}`.slice(0, 600))) {
+      continue;
+    }
+    const job = await page.evaluate(() => window.__spinmodal.job);
+    const result = await (await fetch(`${base}/v1/analyses/${job.id}/result`)).json();
+    ok(result.model && result.model.spatial === true && result.model.dof_per_node === 6 &&
+      result.cases.length === c.speeds, `${c.key}: the result is spatial (6 values per node), ${c.speeds} speed(s)`,
+    JSON.stringify(result.model));
+    ok(await waitFor(page, () => window.__spinmodal.result && document.getElementById('equilibrium-path'), null,
+      'the steady shape'), `${c.key}: the steady shape is drawn`);
+    const eqSegs = ((await page.getAttribute('#structure-svg #equilibrium-path', 'd')) || '').split('L').length - 1;
+    ok(eqSegs === c.elements, `${c.key}: steady shape: one segment per element`, String(eqSegs));
+    const modeRows = await page.locator('#freq-table tbody tr').count();
+    ok(modeRows === c.speeds, `${c.key}: frequency table: one row per speed`, String(modeRows));
+    ok(await waitFor(page, () => window.__spinmodal.anim().view === '3d' && window.__spinmodal.anim().drawn, null,
+      'the 3D mode view'), `${c.key}: the mode shape is animated in 3D`);
+
+    if (c.key === 'flapping-blade') await flapMode(page, result);
+    await shot(page, `08-${c.key}-result.png`);
+
+    // the mode view turns too, and with it the structure drawing (one camera)
+    const m0 = await page.evaluate(() => window.__spinmodal.anim());
+    const s0 = await memberLines(page);
+    await page.click('#mode-play'); // paused: only the turn can change the path
+    const p0 = await page.evaluate(() => window.__spinmodal.anim().path);
+    await drag(page, '#mode-svg', -90, 30);
+    const p1 = await page.evaluate(() => window.__spinmodal.anim().path);
+    ok(p1 !== p0 && JSON.stringify(await memberLines(page)) !== JSON.stringify(s0),
+      `${c.key}: dragging the mode view turns both views`, `${m0.frame}`);
+    await page.click('#mode-view-reset');
+    await page.click('#mode-play');
+  }
+
+  // a spatial request edited in the tables and as JSON keeps its spatial data and solves
+  await page.selectOption('#example', 'out-of-plane-arm');
+  await page.click('#load-example');
+  await page.getByLabel('z of joint P (m)').fill('2.5');
+  await page.getByLabel('EI_flap (N·m²) of section sq').fill('15000');
+  let doc = await page.evaluate(() => JSON.parse(window.__spinmodal.request));
+  const sq = doc.structure.sections.sq;
+  ok(JSON.stringify(doc.structure.joints.P) === '[3,0,2.5]' && sq.EI_flap === 15000 && sq.GJ === 10758 &&
+    sq.flap_inertia === 1.549e-4 && !('E' in sq) && JSON.stringify(doc.structure.members[1].flap_direction) === '[1,0,0]',
+  'spatial table edits keep z, the spatial section data and the flap direction', JSON.stringify(doc.structure));
+  const text = (await page.inputValue('#json')).replace(/("id": "mast"[^}]*"elements": )16/, '$112');
+  await page.fill('#json', text);
+  doc = await page.evaluate(() => window.__spinmodal.doc);
+  ok(doc.structure.members[1].elements === 12 && await page.getByLabel('elements of member 2').inputValue() === '12',
+    'a JSON edit of a spatial request updates the tables');
+  await page.click('#submit');
+  await waitFor(page, () => ['done', 'failed', 'canceled', 'rejected'].includes(document.body.dataset.jobState), null,
+    'the edited spatial job', 180000);
+  const st = await page.evaluate(() => [document.body.dataset.jobState, window.__spinmodal.result &&
+    window.__spinmodal.result.model]);
+  ok(st[0] === 'done' && st[1] && st[1].nodes === 1 + 16 + 12 && st[1].spatial === true,
+    'the edited spatial request solves (1 + 16 + 12 nodes)', JSON.stringify(st));
+  if (st[0] === 'done') {
+    ok(await waitFor(page, (n) => window.__spinmodal.anim().drawn && window.__spinmodal.anim().drawn.world.length === n,
+      29, 'the mode of the edited arm'), 'its modes are drawn for the edited mesh');
+  }
+  await shot(page, '09-out-of-plane-arm-edited.png');
+
+  // back to a planar example: the planar view again
+  await page.selectOption('#example', 'angled-90');
+  await page.click('#load-example');
+  ok(await page.evaluate(() => window.__spinmodal.view().structure) === 'plane' && !await page.isChecked('#spatial'),
+    'a planar example after a spatial one: planar tables and the hub-plane view');
+}
+
+/**
+ * The flapping blade's first mode at rest is a flap mode (z): the animated
+ * drawing moves its nodes out of the hub plane by amp·(re·cos θ − im·sin θ)
+ * of the result's shape rows, and #mode-path is the projection drawn.
+ */
+async function flapMode(page, result) {
+  const ci = result.cases.findIndex((k) => k.omega === 0);
+  const c0 = result.cases[ci];
+  const m = c0.modes[0];
+  const dz = Math.max(...m.shape.re.map((r, k) => Math.hypot(r[2], m.shape.im[k][2])));
+  const dxy = Math.max(...m.shape.re.map((r, k) => Math.hypot(r[0], r[1], m.shape.im[k][0], m.shape.im[k][1])));
+  ok(m.shape.re[0].length === 6 && dz > 10 * dxy, 'flapping-blade: the first mode at rest is a flap mode (API shape)',
+    `max |dz| ${dz}, max |dx, dy| ${dxy}`);
+  await page.selectOption('#mode-speed', String(ci));
+  await page.selectOption('#mode-index', '0');
+  ok(await waitFor(page, () => /^mode 1 at Ω = 0 rad\/s/.test(document.getElementById('mode-desc').textContent), null,
+    'mode 1 at rest'), 'flapping-blade: mode 1 at 0 rad/s selected', await page.textContent('#mode-desc'));
+  // frames of the animation as drawn, until the tip has been well out of the plane and has
+  // travelled on the screen (a cycle takes 2 s; the budget allows for a slow machine)
+  const seen = [];
+  const deadline = Date.now() + budgetMs(20000);
+  const base = c0.equilibrium.nodes;
+  let out = 0;
+  const tipY = [];
+  const travel = () => (tipY.length ? Math.max(...tipY) - Math.min(...tipY) : 0);
+  while (Date.now() < deadline) {
+    const a = await page.evaluate(() => window.__spinmodal.anim());
+    if (a.drawn) {
+      seen.push(a);
+      out = Math.max(out, ...a.drawn.world.map((p, k) => Math.abs(p[2] - base[k][2]) / a.drawn.amp));
+      tipY.push(a.drawn.screen[a.drawn.screen.length - 1][1]);
+      if (out > 0.5 * dz && travel() > 20) break;
+    }
+    await sleep(50);
+  }
+  const last = seen[seen.length - 1];
+  ok(last && out > 0.5 * dz, 'flapping-blade: the animated flap mode moves nodes out of the hub plane',
+    `max |z - z_steady| / amp = ${out}, shape max |dz| = ${dz}`);
+  if (!last) return;
+  // the drawn nodes are the result's: base + amp·(re·cos θ − im·sin θ), translations dx, dy, dz
+  let err = 0;
+  const cs = Math.cos(last.drawn.theta), sn = Math.sin(last.drawn.theta);
+  last.drawn.world.forEach((p, k) => {
+    for (let j = 0; j < 3; j++) {
+      const w = c0.equilibrium.nodes[k][j] + last.drawn.amp * (m.shape.re[k][j] * cs - m.shape.im[k][j] * sn);
+      err = Math.max(err, Math.abs(p[j] - w));
+    }
+  });
+  ok(err <= 1e-9 * (1 + last.drawn.amp), 'flapping-blade: drawn node positions are the result\'s shape at the drawn phase',
+    `max error ${err} m`);
+  // what #mode-path draws is the projection of those nodes (the blade is one chain of 24 elements)
+  const pts = pathPoints(last.path);
+  const perr = pts.length === last.drawn.screen.length
+    ? Math.max(...pts.map((p, k) => Math.hypot(p[0] - last.drawn.screen[k][0], p[1] - last.drawn.screen[k][1]))) : Infinity;
+  ok(perr <= 0.01, 'flapping-blade: #mode-path is the projection of the drawn nodes', `${pts.length} points, ${perr} px`);
+  // and the motion is visible: the tip moves on the screen (z is up in the home view)
+  ok(travel() > 20, 'flapping-blade: the tip moves up and down on the screen',
+    `${Math.min(...tipY).toFixed(1)}…${Math.max(...tipY).toFixed(1)} px over ${seen.length} frames`);
+  await shot(page, '08-flapping-blade-mode1.png');
 }
 
 async function run() {
@@ -418,7 +631,29 @@ async function run() {
       const n = await page.locator('#structure-svg line.member').count();
       ok(n >= 1, `example ${key} drawn`, String(n));
     }
+    ok(await page.evaluate(() => window.__spinmodal.view().structure) === 'plane', 'a planar example is drawn in the hub plane');
     await shot(page, '05-branched.png');
+    await page.check('#view-3d');
+    ok(await page.evaluate(() => window.__spinmodal.view().structure) === '3d' &&
+      await page.locator('#structure-svg line.member').count() === 3, 'the 3D switch draws a planar structure in 3D');
+    await page.uncheck('#view-3d');
+    ok(await page.evaluate(() => window.__spinmodal.view().structure) === 'plane', 'and back in the hub plane');
+    // the spatial switch: exact conversions only (EA = E·A, EI_edge = E·I), and back
+    await page.check('#spatial');
+    let trunk = (await page.evaluate(() => window.__spinmodal.doc)).structure.sections.trunk;
+    ok(trunk.EA === 4.2e7 && trunk.EI_edge === 28000 && trunk.mass_per_length === 1.8 && !('E' in trunk) &&
+      !('EI_flap' in trunk) && await page.getByLabel('GJ (N·m²) of section trunk').inputValue() === '' &&
+      await page.locator('#joints thead th', {hasText: 'z (m)'}).count() === 1 &&
+      await page.evaluate(() => window.__spinmodal.view().structure) === '3d',
+    'the spatial switch: EA = E·A, EI_edge = E·I, EI_flap and GJ left to fill in, z column, 3D view',
+    JSON.stringify(trunk));
+    await page.uncheck('#spatial');
+    trunk = (await page.evaluate(() => window.__spinmodal.doc)).structure.sections.trunk;
+    ok(JSON.stringify(trunk) === JSON.stringify({E: 7e10, A: 6e-4, I: 4e-7, mass_per_length: 1.8}) &&
+      await page.evaluate(() => window.__spinmodal.view().structure) === 'plane',
+    'and back: the planar section as it was, the hub-plane view', JSON.stringify(trunk));
+
+    await spatial(page, base);
 
     // without POST /v1/validate (an older daemon: 404), errors come from the submission
     const page2 = await context.newPage();

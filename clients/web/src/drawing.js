@@ -1,18 +1,20 @@
 // drawing.js — SVG drawings of the structure (joints, members, clamp, hub
 // axis, frames, point masses, the steady deflected shape) and of an animated
 // mode shape.  These are drawings, not charts: the Campbell diagram is uPlot.
+// This is the planar view (the hub plane x-y, seen along the spin axis); a
+// spatial structure is drawn by view3d.js, which shares the helpers below.
 
 const NS = 'http://www.w3.org/2000/svg';
 const W = 600, H = 360, PAD = 34;
 
-function el(name, attrs = {}, parent = null) {
+export function el(name, attrs = {}, parent = null) {
   const e = document.createElementNS(NS, name);
   for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, String(v));
   if (parent) parent.appendChild(e);
   return e;
 }
 
-function clear(svg) {
+export function clear(svg) {
   while (svg.firstChild) svg.removeChild(svg.firstChild);
 }
 
@@ -37,12 +39,12 @@ function mapper(points) {
   return f;
 }
 
-function r2(v) {
+export function r2(v) {
   return Math.round(v * 100) / 100;
 }
 
 /** "M x y L x y ..." of the elements with node positions pos(k) -> [x, y] (px). */
-function elemPath(elems, pos) {
+export function elemPath(elems, pos) {
   let d = '';
   let last = -1;
   for (const e of elems) {
@@ -72,7 +74,7 @@ function hubAxis(g, f, hubRadius) {
   t.textContent = 'Ω';
 }
 
-function defs(svg) {
+export function defs(svg) {
   const d = el('defs', {}, svg);
   const m = el('marker', {id: 'arrow', viewBox: '0 0 10 10', refX: 8, refY: 5, markerWidth: 6, markerHeight: 6,
     orient: 'auto-start-reverse'}, d);
@@ -104,12 +106,14 @@ export function drawStructure(svg, st, mesh, opts = {}) {
   const eq = opts.equilibrium && mesh.ok && opts.equilibrium.length === mesh.nodes.length ? opts.equilibrium : null;
   if (eq) for (const n of eq) pts.push([n[0], n[1]]);
   const clampXY = mesh.joints[st && st.clamp];
-  if (clampXY) pts.push([-Math.hypot(...clampXY), -Math.hypot(...clampXY)], [Math.hypot(...clampXY), Math.hypot(...clampXY)]);
+  const hubR = clampXY ? Math.hypot(clampXY[0], clampXY[1]) : 0; // a joint may carry z (seen from above)
+  if (clampXY) pts.push([-hubR, -hubR], [hubR, hubR]);
   const f = mapper(pts.length ? pts : [[1, 1]]);
   svg.dataset.scale = String(f.scale);
+  svg.dataset.view = 'plane';
 
   const g = el('g', {}, svg);
-  hubAxis(g, f, clampXY ? Math.hypot(...clampXY) : 0);
+  hubAxis(g, f, hubR);
 
   // members (undeformed)
   for (const [a, b, i] of mesh.lines) {
@@ -186,6 +190,7 @@ export function drawStructure(svg, st, mesh, opts = {}) {
 export function modeView(svg, mesh, eq, shape, amp) {
   clear(svg);
   defs(svg);
+  svg.dataset.view = 'plane';
   const n = mesh.nodes.length;
   const re = shape && Array.isArray(shape.re) ? shape.re : null;
   const im = shape && Array.isArray(shape.im) ? shape.im : null;

@@ -5,8 +5,29 @@
 // The tables edit the rows of request.js in place and call onChange(kind):
 // 'value' (a value changed: no re-render needed), 'names' (a name changed:
 // the select lists are refreshed), 'rows' (rows added or removed: re-render).
+//
+// A spatial structure (rows.spatial, DESIGN.md 7) shows more columns: z of the
+// joints, the spatial section data (EA, EI_flap, EI_edge, GJ, μ, flap and edge
+// inertia), a member's twist and flap direction, a point mass's inertia.
 
-import {ptr, freshName} from './request.js';
+import {ptr, freshName, convertRows, PLANAR_SECTION_KEYS, SPATIAL_SECTION_KEYS} from './request.js';
+
+/** Column headings and control labels of the section fields. */
+const SECTION_LABEL = {
+  E: ['E (Pa)', 'E (Pa)'],
+  A: ['A (m²)', 'A (m²)'],
+  I: ['I (m⁴)', 'I (m⁴)'],
+  mass_per_length: ['μ (kg/m)', 'mass per length (kg/m)'],
+  EA: ['EA (N)', 'EA (N)'],
+  EI_flap: ['EI<sub>flap</sub> (N·m²)', 'EI_flap (N·m²)'],
+  EI_edge: ['EI<sub>edge</sub> (N·m²)', 'EI_edge (N·m²)'],
+  GJ: ['GJ (N·m²)', 'GJ (N·m²)'],
+  flap_inertia: ['i<sub>flap</sub> (kg·m)', 'flap inertia (kg·m)'],
+  edge_inertia: ['i<sub>edge</sub> (kg·m)', 'edge inertia (kg·m)'],
+};
+
+const ACTIONS = '<th scope="col"><span class="vh">Actions</span></th>';
+const th = (t, title) => `<th scope="col"${title ? ` title="${title}"` : ''}>${t}</th>`;
 
 function h(tag, attrs = {}, ...kids) {
   const e = document.createElement(tag);
@@ -77,6 +98,12 @@ export class StructureEditor {
       this.getRows().clamp = this.clamp.value;
       this.onChange('value');
     });
+    this.spatial = doc.getElementById('spatial');
+    this.spatial.addEventListener('change', () => {
+      convertRows(this.getRows(), this.spatial.checked);
+      this.render();
+      this.onChange('rows');
+    });
     doc.getElementById('add-joint').addEventListener('click', () => this.addJoint());
     doc.getElementById('add-section').addEventListener('click', () => this.addSection());
     doc.getElementById('add-member').addEventListener('click', () => this.addMember());
@@ -91,8 +118,28 @@ export class StructureEditor {
     return this.getRows()[kind].map((r) => r.name);
   }
 
+  /** The column headings of the tables for a planar or a spatial structure. */
+  renderHeads(spatial) {
+    const head = (sel, html) => {
+      const tr = this.doc.querySelector(sel + ' thead tr');
+      if (tr.innerHTML !== html) tr.innerHTML = html;
+    };
+    head('#joints', th('Name') + th('x (m)') + th('y (m)') +
+      (spatial ? th('z (m)', 'along the spin axis; empty: 0') : '') + ACTIONS);
+    head('#sections', th('Name') + (spatial ? SPATIAL_SECTION_KEYS : PLANAR_SECTION_KEYS)
+      .map((k) => th(SECTION_LABEL[k][0], k)).join('') + ACTIONS);
+    head('#members', th('Id') + th('From') + th('To') + th('Section') + th('Elements') +
+      (spatial ? th('Twist (°)', 'twist_deg: about the member axis; empty: 0') +
+        th('Flap direction', 'flap_direction [x, y, z]; empty: the default (the part of z normal to the member)') : '') +
+      ACTIONS);
+    head('#point-masses', th('Joint') + th('Mass (kg)') +
+      (spatial ? th('Inertia (kg·m²)', 'inertia [Ixx, Iyy, Izz] about the hub axes; empty: none') : '') + ACTIONS);
+  }
+
   render() {
     const rows = this.getRows();
+    this.renderHeads(rows.spatial);
+    this.spatial.checked = rows.spatial;
     for (const tb of Object.values(this.t)) tb.textContent = '';
     rows.joints.forEach((r, i) => this.t.joints.append(this.jointRow(r, i)));
     rows.sections.forEach((r, i) => this.t.sections.append(this.sectionRow(r, i)));
@@ -135,10 +182,14 @@ export class StructureEditor {
   }
 
   jointRow(r) {
+    const spatial = this.getRows().spatial;
     const name = textInput(r.name, `name of joint ${r.name}`, {class: 'name'});
     const x = textInput(r.x, `x of joint ${r.name} (m)`, {inputmode: 'decimal', class: 'num'});
     const y = textInput(r.y, `y of joint ${r.name} (m)`, {inputmode: 'decimal', class: 'num'});
+    const z = spatial ? textInput(r.z, `z of joint ${r.name} (m)`, {inputmode: 'decimal', class: 'num', placeholder: '0'})
+      : null;
     const tr = h('tr', {}, cell(name, ''), cell(this.bind(x, r, 'x'), '0'), cell(this.bind(y, r, 'y'), '1'),
+      z ? cell(this.bind(z, r, 'z'), '2') : null,
       this.removeButton(`remove joint ${r.name}`, () => this.remove('joints', r)));
     setRowPointers(tr, ptr('structure', 'joints', r.name));
     name.addEventListener('input', () => {
@@ -158,6 +209,7 @@ export class StructureEditor {
       setRowPointers(tr, ptr('structure', 'joints', nu));
       x.setAttribute('aria-label', `x of joint ${nu} (m)`);
       y.setAttribute('aria-label', `y of joint ${nu} (m)`);
+      if (z) z.setAttribute('aria-label', `z of joint ${nu} (m)`);
       this.refreshSelects();
       this.onChange('names');
     });
@@ -166,10 +218,13 @@ export class StructureEditor {
 
   sectionRow(r) {
     const name = textInput(r.name, `name of section ${r.name}`, {class: 'name'});
-    const f = (key, label, suffix) => cell(this.bind(textInput(r[key], `${label} of section ${r.name}`,
-      {inputmode: 'decimal', class: 'num'}), r, key), suffix);
-    const tr = h('tr', {}, cell(name, ''), f('E', 'E (Pa)', 'E'), f('A', 'A (m²)', 'A'), f('I', 'I (m⁴)', 'I'),
-      f('mu', 'mass per length (kg/m)', 'mass_per_length'),
+    const inputs = [];
+    const f = (key) => {
+      const input = textInput(r.v[key], `${SECTION_LABEL[key][1]} of section ${r.name}`, {inputmode: 'decimal', class: 'num'});
+      inputs.push([input, key]);
+      return cell(this.bind(input, r.v, key), key);
+    };
+    const tr = h('tr', {}, cell(name, ''), ...Object.keys(r.v).map(f),
       this.removeButton(`remove section ${r.name}`, () => this.remove('sections', r)));
     setRowPointers(tr, ptr('structure', 'sections', r.name));
     name.addEventListener('input', () => {
@@ -180,6 +235,7 @@ export class StructureEditor {
         for (const m of rows.members) if (m.section === old) m.section = nu;
       }
       setRowPointers(tr, ptr('structure', 'sections', nu));
+      for (const [input, key] of inputs) input.setAttribute('aria-label', `${SECTION_LABEL[key][1]} of section ${nu}`);
       this.refreshSelects();
       this.onChange('names');
     });
@@ -204,9 +260,16 @@ export class StructureEditor {
       return s;
     };
     const el = textInput(r.elements, `elements of ${label}`, {inputmode: 'numeric', class: 'num short'});
+    const spatial = this.getRows().spatial;
+    const tw = spatial ? textInput(r.twist, `twist (degrees) of ${label}`, {inputmode: 'decimal', class: 'num short',
+      placeholder: '0'}) : null;
+    const fd = spatial ? textInput(r.fdir, `flap direction (x, y, z) of ${label}`, {class: 'num', placeholder: 'default'})
+      : null;
     const tr = h('tr', {}, cell(id, 'id'), cell(sel('from', joints, 'from joint'), 'from'),
       cell(sel('to', joints, 'to joint'), 'to'), cell(sel('section', sections, 'section'), 'section'),
       cell(this.bind(el, r, 'elements'), 'elements'),
+      tw ? cell(this.bind(tw, r, 'twist'), 'twist_deg') : null,
+      fd ? cell(this.bind(fd, r, 'fdir'), 'flap_direction') : null,
       this.removeButton(`remove ${label}`, () => this.remove('members', r)));
     setRowPointers(tr, ptr('structure', 'members', i));
     return tr;
@@ -220,7 +283,10 @@ export class StructureEditor {
       this.onChange('value');
     });
     const m = textInput(r.mass, `mass of ${label} (kg)`, {inputmode: 'decimal', class: 'num'});
+    const inr = this.getRows().spatial ? textInput(r.inertia, `inertia (Ixx, Iyy, Izz) of ${label} (kg·m²)`,
+      {class: 'num', placeholder: 'none'}) : null;
     const tr = h('tr', {}, cell(s, 'joint'), cell(this.bind(m, r, 'mass'), 'mass'),
+      inr ? cell(this.bind(inr, r, 'inertia'), 'inertia') : null,
       this.removeButton(`remove ${label}`, () => this.remove('point_masses', r)));
     setRowPointers(tr, ptr('structure', 'point_masses', i));
     return tr;
@@ -246,7 +312,8 @@ export class StructureEditor {
   addJoint() {
     const rows = this.getRows();
     const last = rows.joints[rows.joints.length - 1];
-    rows.joints.push({name: freshName('J', this.names('joints')), x: last ? last.x : '0', y: last ? last.y : '0'});
+    rows.joints.push({name: freshName('J', this.names('joints')), x: last ? last.x : '0', y: last ? last.y : '0',
+      z: last ? last.z : '', more: []});
     this.render();
     this.onChange('rows');
     this.focusLast(this.t.joints);
@@ -254,8 +321,11 @@ export class StructureEditor {
 
   addSection() {
     const rows = this.getRows();
-    const s = rows.sections[0] || {E: '7e10', A: '4e-4', I: '2e-7', mu: '1.2'};
-    rows.sections.push({name: freshName('s', this.names('sections')), E: s.E, A: s.A, I: s.I, mu: s.mu, extra: {}});
+    const s = rows.sections[0] || (rows.spatial
+      ? {v: {EA: '1.08444e8', EI_flap: '14000', EI_edge: '14000', GJ: '10758', mass_per_length: '1.2',
+        flap_inertia: '1.549e-4', edge_inertia: '1.549e-4'}}
+      : {v: {E: '7e10', A: '4e-4', I: '2e-7', mass_per_length: '1.2'}});
+    rows.sections.push({name: freshName('s', this.names('sections')), v: {...s.v}, had: {}, extra: {}});
     this.render();
     this.onChange('rows');
     this.focusLast(this.t.sections);
@@ -266,7 +336,7 @@ export class StructureEditor {
     const j = this.names('joints');
     rows.members.push({id: freshName('m', rows.members.map((m) => m.id)), hasId: true,
       from: j[j.length - 2] ?? rows.clamp, to: j[j.length - 1] ?? '', section: this.names('sections')[0] ?? '',
-      elements: '8', extra: {}});
+      elements: '8', twist: '', fdir: '', extra: {}});
     this.render();
     this.onChange('rows');
     this.focusLast(this.t.members);
@@ -275,7 +345,7 @@ export class StructureEditor {
   addMass() {
     const rows = this.getRows();
     const j = this.names('joints');
-    rows.point_masses.push({joint: j[j.length - 1] ?? '', mass: '0.1', extra: {}});
+    rows.point_masses.push({joint: j[j.length - 1] ?? '', mass: '0.1', inertia: '', extra: {}});
     rows.hasPointMasses = true;
     this.render();
     this.onChange('rows');

@@ -1,9 +1,13 @@
-// examples.js — structures to start from.  The β = 90° angled beam and the
-// straight blade are the repository's examples/*.json (bundled at build
-// time); β = 0° and 45° move the free end P of the same two 5 m beams.
+// examples.js — structures to start from.  The β = 90° angled beam, the
+// straight blade and the two spatial structures (DESIGN.md 7) are the
+// repository's examples/*.json (bundled at build time); β = 0° and 45° move
+// the free end P of the same two 5 m beams.  Each has a one-line description
+// (the title of its entry in the list, and the text beside it).
 
 import angled90 from '../../../examples/angled-beam-90.json';
 import blade from '../../../examples/straight-blade.json';
+import flapping from '../../../examples/flapping-blade.json';
+import arm3d from '../../../examples/out-of-plane-arm.json';
 
 function clone(v) {
   return JSON.parse(JSON.stringify(v));
@@ -39,9 +43,18 @@ const branched = {
 };
 
 export const EXAMPLES = [
-  {key: 'angled-90', label: 'Angled beam, β = 90° (Kim & Yoo)', doc: () => angled(90)},
-  {key: 'angled-45', label: 'Angled beam, β = 45°', doc: () => angled(45)},
-  {key: 'angled-0', label: 'Angled beam, β = 0° (straight 10 m)', doc: () => angled(0)},
-  {key: 'blade', label: 'Straight blade with tip mass', doc: () => clone(blade)},
-  {key: 'branched', label: 'Branched frame (Y)', doc: () => clone(branched)},
+  {key: 'angled-90', label: 'Angled beam, β = 90° (Kim & Yoo)', doc: () => angled(90),
+    desc: 'Two 5 m aluminium beams at a right angle in the hub plane (the paper\'s case).'},
+  {key: 'angled-45', label: 'Angled beam, β = 45°', doc: () => angled(45),
+    desc: 'The same two beams with the second one at 45°.'},
+  {key: 'angled-0', label: 'Angled beam, β = 0° (straight 10 m)', doc: () => angled(0),
+    desc: 'The same two beams in line: a straight 10 m beam.'},
+  {key: 'blade', label: 'Straight blade with tip mass', doc: () => clone(blade),
+    desc: 'A 5 m blade from a 0.5 m hub with a 0.2 kg tip mass, planar.'},
+  {key: 'branched', label: 'Branched frame (Y)', doc: () => clone(branched),
+    desc: 'A trunk that splits into two arms with end masses, planar.'},
+  {key: 'flapping-blade', label: 'Flapping blade (3D)', doc: () => clone(flapping),
+    desc: 'Spatial: a 10 m blade from a 0.5 m hub, flap, lead-lag and torsion; sweep 0…10 rad/s.'},
+  {key: 'out-of-plane-arm', label: 'Out-of-plane arm (3D)', doc: () => clone(arm3d),
+    desc: 'Spatial: a 3 m radial arm with a 2 m mast along the spin axis at its end.'},
 ];

@@ -2,12 +2,16 @@
 // sync and validated as the user types, analysis options, job submission
 // with progress and cancel, results (frequency table, Campbell diagram, mode
 // animation, downloads).  Served by spinmodald at / (server/DAEMON.md).
+// Planar structures are drawn in the hub plane (drawing.js); spatial ones
+// (DESIGN.md 7) in a 3D view the user turns (view3d.js), shared by the
+// structure drawing and the mode animation.
 
 import './style.css';
 import {DEFAULTS, prettyJSON, structureToRows, rowsToStructure, speedsForm, speedsValue, cellValue,
-  fmtNum, parentPtr, sig} from './request.js';
+  fmtNum, parentPtr, sig, isSpatial} from './request.js';
 import {buildMesh} from './mesh.js';
 import {drawStructure, modeView} from './drawing.js';
+import {drawStructure3d, modeView3d, attachOrbit, homeCamera, PRESETS} from './view3d.js';
 import {campbellChart} from './campbell.js';
 import {StructureEditor} from './editor.js';
 import {EXAMPLES} from './examples.js';
@@ -28,6 +32,8 @@ const S = {
   pollGen: 0,
   result: null,        // {id, request (doc), result, mesh}
   anim: {frame: 0, running: true, raf: 0, t0: 0, view: null},
+  view3d: null,        // the 3D switch: null = automatic (3D for a spatial structure), true, false
+  cam: homeCamera(),   // the 3D camera {az, el} (degrees), shared by both drawings
 };
 
 // ---------------------------------------------------------------- sync
@@ -365,15 +371,87 @@ function draw() {
       eqLabel = `steady shape at Ω = ${sig(c.omega)} rad/s (${c.status})`;
     }
   }
-  drawStructure($('structure-svg'), st, mesh, {frames: $('show-frames').checked, nodes: $('show-nodes').checked,
-    equilibrium, eqLabel});
+  const in3d = structureIn3d();
+  const opts = {frames: $('show-frames').checked, nodes: $('show-nodes').checked, equilibrium, eqLabel};
+  const svg = $('structure-svg');
+  if (in3d) drawStructure3d(svg, st, mesh, S.cam, opts);
+  else drawStructure(svg, st, mesh, opts);
   const n = Object.keys(mesh.joints).length, m = mesh.lines.length;
-  $('structure-desc').textContent = mesh.ok
+  $('structure-desc').textContent = (mesh.ok
     ? `${n} joints, ${m} members, ${mesh.elems.length} elements, ${mesh.frames.length} frames` +
       (equilibrium ? `; blue: ${eqLabel}` : '')
-    : `${n} joints, ${m} members drawn (${mesh.reason || 'incomplete'})`;
+    : `${n} joints, ${m} members drawn (${mesh.reason || 'incomplete'})`) +
+    (in3d ? '. 3D view, z (the spin axis) up; frames: red e1 along the member, blue e3 the flap normal; ' +
+      'dashed grey: shadows on the hub plane. Drag (or arrow keys) to turn, Home or double click to reset.' : '');
+  viewControls();
 }
 for (const id of ['show-frames', 'show-nodes', 'show-equilibrium']) $(id).addEventListener('change', draw);
+
+// ------------------------------------------------------------- 3D view
+
+/** Is the structure drawn in 3D?  The switch, else whether the structure is spatial. */
+function structureIn3d() {
+  return S.view3d ?? !!(S.rows && S.rows.spatial);
+}
+
+/** Is the mode shape drawn in 3D?  The switch, else whether the solved request or its result is spatial. */
+function modeIn3d() {
+  const R = S.result;
+  if (!R) return false;
+  return S.view3d ?? (isSpatial(R.request && R.request.structure) || (R.result.model || {}).spatial === true);
+}
+
+/** The 3D switch, the view presets and the reset buttons follow the views shown. */
+function viewControls() {
+  const s3 = structureIn3d(), m3 = modeIn3d();
+  $('view-3d').checked = s3;
+  $('view-preset').hidden = !s3;
+  $('view-reset').hidden = !s3;
+  $('mode-view-reset').hidden = !m3;
+  const key = Object.keys(PRESETS).find((k) => PRESETS[k].az === S.cam.az && PRESETS[k].el === S.cam.el);
+  $('view-preset').value = key || '';
+  for (const [svg, on] of [[$('structure-svg'), s3], [$('mode-svg'), m3]]) {
+    if (on) svg.setAttribute('tabindex', '0');
+    else svg.removeAttribute('tabindex');
+  }
+}
+
+/** The camera changed: redraw both views (the animation keeps its phase). */
+function cameraChanged() {
+  draw();
+  if (S.result && modeIn3d()) buildModeView();
+}
+attachOrbit($('structure-svg'), () => S.cam, cameraChanged);
+attachOrbit($('mode-svg'), () => S.cam, cameraChanged);
+// switching the model between planar and spatial (editor.js) lets the view follow it again
+$('spatial').addEventListener('change', () => {
+  S.view3d = null;
+  draw();
+});
+$('view-3d').addEventListener('change', () => {
+  S.view3d = $('view-3d').checked;
+  draw();
+  if (S.result) buildModeView();
+});
+for (const id of ['view-reset', 'mode-view-reset']) {
+  $(id).addEventListener('click', () => {
+    Object.assign(S.cam, homeCamera());
+    cameraChanged();
+  });
+}
+for (const [k, p] of Object.entries(PRESETS)) {
+  const o = document.createElement('option');
+  o.value = k;
+  o.textContent = p.label;
+  $('view-preset').append(o);
+}
+$('view-preset').addEventListener('change', () => {
+  const p = PRESETS[$('view-preset').value];
+  if (!p) return;
+  S.cam.az = p.az;
+  S.cam.el = p.el;
+  cameraChanged();
+});
 
 // --------------------------------------------------------------- examples
 
@@ -381,13 +459,22 @@ for (const ex of EXAMPLES) {
   const o = document.createElement('option');
   o.value = ex.key;
   o.textContent = ex.label;
+  o.title = ex.desc;
   $('example').append(o);
 }
 $('load-example').addEventListener('click', () => loadExample($('example').value));
+function exampleDesc() {
+  const ex = EXAMPLES.find((e) => e.key === $('example').value);
+  $('example-desc').textContent = ex ? ex.desc : '';
+}
+$('example').addEventListener('change', exampleDesc);
 
 function loadExample(key) {
   const ex = EXAMPLES.find((e) => e.key === key) || EXAMPLES[0];
   $('example').value = ex.key;
+  exampleDesc();
+  S.view3d = null;
+  Object.assign(S.cam, homeCamera());
   S.serverErrors = [];
   S.sweepError = null;
   setDoc(ex.doc(), 'example');
@@ -675,19 +762,35 @@ function startMode() {
     desc.textContent = R && !R.mesh.ok ? `cannot draw: ${R.mesh.reason}` : '';
     return;
   }
-  const eq = c.equilibrium && Array.isArray(c.equilibrium.nodes) ? c.equilibrium.nodes : null;
-  const amp = Number($('mode-amp').value);
-  S.anim.view = modeView(svg, R.mesh, eq, m && m.shape, amp);
+  buildModeView();
   S.anim.omega = m ? m.frequency_rad_s : 0;
   if (!m) desc.textContent = `no modes at Ω = ${sig(c.omega)} rad/s (${c.status})`;
   else if (!m.shape) desc.textContent = 'no mode shapes in this result (turn "mode shapes" on and solve again)';
   else {
     desc.textContent = `mode ${k + 1} at Ω = ${sig(c.omega)} rad/s: ω = ${sig(m.frequency_rad_s)} rad/s ` +
       `(${sig(m.frequency_hz)} Hz)` + (m.shape.im ? ', complex (gyroscopic): u(t) = Re((re + i·im)·e^{iωt})' : '') +
-      '. Grey: undeformed; blue line: steady shape; animated: the mode, one cycle every 2 s.';
+      '. Grey: undeformed; blue line: steady shape; animated: the mode, one cycle every 2 s' +
+      (modeIn3d() ? '; faint: its shadow on the hub plane. Drag to turn the view.' : '.');
   }
   svg.dataset.mode = String(k);
   svg.dataset.case = $('mode-speed').value;
+}
+
+/** (Re)build the mode view of the selected case and mode, in the plane or in 3D, at the current phase. */
+function buildModeView() {
+  const R = S.result;
+  const c = selectedCase();
+  const svg = $('mode-svg');
+  S.anim.view = null;
+  if (!R || !R.mesh.ok || !c) return;
+  const k = Number($('mode-index').value) || 0;
+  const m = c.modes ? c.modes[k] : null;
+  const eq = c.equilibrium && Array.isArray(c.equilibrium.nodes) ? c.equilibrium.nodes : null;
+  const amp = Number($('mode-amp').value);
+  S.anim.view = modeIn3d() ? modeView3d(svg, R.mesh, eq, m && m.shape, amp, S.cam)
+    : modeView(svg, R.mesh, eq, m && m.shape, amp);
+  if (S.anim.view.ok && typeof S.anim.theta === 'number') S.anim.view.frame(S.anim.theta);
+  viewControls();
 }
 
 function tick(ts) {
@@ -741,7 +844,12 @@ window.__spinmodal = {
   },
   campbell: () => chart.plotted(),
   anim: () => ({frame: S.anim.frame, running: S.anim.running, theta: S.anim.theta,
-    path: ($('mode-path') && $('mode-path').getAttribute('d')) || ''}),
+    path: ($('mode-path') && $('mode-path').getAttribute('d')) || '',
+    view: $('mode-svg').dataset.view || '',
+    // the 3D view's last frame as drawn: {theta, amp, world: [[x, y, z]…], screen: [[X, Y]…]} per node
+    drawn: S.anim.view && S.anim.view.last ? S.anim.view.last() : null}),
+  view: () => ({structure: $('structure-svg').dataset.view || '', mode: $('mode-svg').dataset.view || '',
+    az: S.cam.az, el: S.cam.el}),
   errors: () => S.localErrors.map((e) => ({pointer: e.pointer ?? null, message: e.message}))
     .concat(S.serverErrors.map((e) => ({...e}))),
   validateAvailable: () => api.validateAvailable(),

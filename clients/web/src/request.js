@@ -151,38 +151,90 @@ function text(v) {
   return JSON.stringify(v);
 }
 
+// Section fields (DESIGN.md 1.1 and 7.3).  The tables show the planar columns
+// or the spatial ones (EA form); a section's other keys (the E, G, A, I_flap,
+// I_edge, J form of a spatial section, stations, …) are kept as they are.
+export const PLANAR_SECTION_KEYS = ['E', 'A', 'I', 'mass_per_length'];
+export const SPATIAL_SECTION_KEYS = ['EA', 'EI_flap', 'EI_edge', 'GJ', 'mass_per_length', 'flap_inertia',
+  'edge_inertia'];
+/** Keys that make a section spatial (DESIGN.md 7.3: "a request is spatial when its sections are spatial"). */
+const SPATIAL_ONLY = ['EA', 'EI_flap', 'EI_edge', 'GJ', 'G', 'I_flap', 'I_edge', 'J', 'flap_inertia', 'edge_inertia'];
+
+/**
+ * Is the structure spatial (3D)?  Its sections are spatial, or it uses a field
+ * only a spatial request may carry ([x, y, z] joints, twist_deg, flap_direction,
+ * point-mass inertia): shown as spatial so that field can be edited (the daemon
+ * then says what it needs).
+ */
+export function isSpatial(st) {
+  if (!isObj(st)) return false;
+  if (isObj(st.sections) && Object.values(st.sections).some((o) => isObj(o) && SPATIAL_ONLY.some((k) => k in o))) {
+    return true;
+  }
+  if (isObj(st.joints) && Object.values(st.joints).some((v) => Array.isArray(v) && v.length === 3)) return true;
+  if (Array.isArray(st.members) && st.members.some((m) => isObj(m) && ('twist_deg' in m || 'flap_direction' in m))) {
+    return true;
+  }
+  return Array.isArray(st.point_masses) && st.point_masses.some((p) => isObj(p) && 'inertia' in p);
+}
+
+/** A short list of numbers as a cell's text: [1, 0, 0] -> "1, 0, 0" (anything else as JSON). */
+function listText(v) {
+  if (v === undefined) return '';
+  if (Array.isArray(v) && v.every((x) => typeof x === 'number')) return v.map(fmtNum).join(', ');
+  return text(v);
+}
+
+/** The JSON value of a list cell: "1, 0, 0" or "[1, 0, 0]" -> [1, 0, 0] (items as cellValue). */
+export function listValue(t) {
+  const s = String(t).trim().replace(/^\[/, '').replace(/\]$/, '');
+  return s.split(/[\s,;]+/).filter((x) => x !== '').map(cellValue);
+}
+
+function sectionRow(name, o, spatial) {
+  const keys = spatial ? SPATIAL_SECTION_KEYS : PLANAR_SECTION_KEYS;
+  const v = {}, had = {};
+  for (const k of keys) {
+    v[k] = text(o[k]);
+    had[k] = k in o;
+  }
+  return {name, v, had, extra: pick(o, keys)};
+}
+
 /**
  * Editable rows of a request's structure (tolerant: whatever the JSON holds
  * is shown as text, so a half-typed request still fills the tables).
+ * rows.spatial says which columns the tables show (isSpatial of the structure).
  */
 export function structureToRows(st) {
   const s = isObj(st) ? st : {};
-  const rows = {joints: [], sections: [], members: [], point_masses: [], clamp: '', extra: {}};
+  const spatial = isSpatial(s);
+  const rows = {spatial, joints: [], sections: [], members: [], point_masses: [], clamp: '', extra: {}};
   if (isObj(s.joints)) {
     for (const [name, xy] of Object.entries(s.joints)) {
       const a = Array.isArray(xy) ? xy : [];
-      rows.joints.push({name, x: text(a[0]), y: text(a[1])});
+      rows.joints.push({name, x: text(a[0]), y: text(a[1]), z: a.length > 2 ? text(a[2]) : '',
+        more: a.length > 3 ? a.slice(3) : []});
     }
   }
   if (isObj(s.sections)) {
-    for (const [name, sec] of Object.entries(s.sections)) {
-      const o = isObj(sec) ? sec : {};
-      rows.sections.push({name, E: text(o.E), A: text(o.A), I: text(o.I), mu: text(o.mass_per_length),
-        extra: pick(o, ['E', 'A', 'I', 'mass_per_length'])});
-    }
+    for (const [name, sec] of Object.entries(s.sections)) rows.sections.push(sectionRow(name, isObj(sec) ? sec : {}, spatial));
   }
   if (Array.isArray(s.members)) {
     for (const m of s.members) {
       const o = isObj(m) ? m : {};
       rows.members.push({id: text(o.id), hasId: 'id' in o, from: text(o.from), to: text(o.to),
         section: text(o.section), elements: text(o.elements),
-        extra: pick(o, ['id', 'from', 'to', 'section', 'elements'])});
+        twist: text(o.twist_deg), hadTwist: 'twist_deg' in o,
+        fdir: listText(o.flap_direction), hadFdir: 'flap_direction' in o,
+        extra: pick(o, ['id', 'from', 'to', 'section', 'elements', 'twist_deg', 'flap_direction'])});
     }
   }
   if (Array.isArray(s.point_masses)) {
     for (const p of s.point_masses) {
       const o = isObj(p) ? p : {};
-      rows.point_masses.push({joint: text(o.joint), mass: text(o.mass), extra: pick(o, ['joint', 'mass'])});
+      rows.point_masses.push({joint: text(o.joint), mass: text(o.mass),
+        inertia: listText(o.inertia), hadInertia: 'inertia' in o, extra: pick(o, ['joint', 'mass', 'inertia'])});
     }
   }
   rows.clamp = text(s.clamp);
@@ -191,14 +243,29 @@ export function structureToRows(st) {
   return rows;
 }
 
+/** An optional cell: written when it holds text or the request had the key. */
+function optional(out, key, t, had, value = cellValue) {
+  if (t !== '' || had) out[key] = value(t);
+}
+
 /** The request's structure object from the rows. */
 export function rowsToStructure(rows) {
   const joints = {};
-  for (const j of rows.joints) joints[j.name] = [cellValue(j.x), cellValue(j.y)];
+  for (const j of rows.joints) {
+    joints[j.name] = [cellValue(j.x), cellValue(j.y)];
+    if (j.z !== '' || (j.more && j.more.length)) joints[j.name].push(cellValue(j.z), ...(j.more || []));
+  }
   const sections = {};
   for (const s of rows.sections) {
-    sections[s.name] = {E: cellValue(s.E), A: cellValue(s.A), I: cellValue(s.I),
-      mass_per_length: cellValue(s.mu), ...s.extra};
+    const o = {};
+    for (const [k, t] of Object.entries(s.v)) {
+      // the planar columns are always written (the daemon names an empty one); a
+      // spatial column only when it holds text or the section had it (so a section
+      // in the E, G, A, I_flap, I_edge, J form does not gain empty EA-form keys)
+      if (!rows.spatial || k === 'mass_per_length') o[k] = cellValue(t);
+      else optional(o, k, t, s.had[k]);
+    }
+    sections[s.name] = Object.assign(o, s.extra);
   }
   const members = rows.members.map((m) => {
     const o = {};
@@ -207,14 +274,76 @@ export function rowsToStructure(rows) {
     o.to = m.to;
     o.section = m.section;
     o.elements = cellValue(m.elements);
+    optional(o, 'twist_deg', m.twist, m.hadTwist);
+    optional(o, 'flap_direction', m.fdir, m.hadFdir, listValue);
     return Object.assign(o, m.extra);
   });
   const st = {joints, sections, members};
   if (rows.point_masses.length || rows.hasPointMasses) {
-    st.point_masses = rows.point_masses.map((p) => ({joint: p.joint, mass: cellValue(p.mass), ...p.extra}));
+    st.point_masses = rows.point_masses.map((p) => {
+      const o = {joint: p.joint, mass: cellValue(p.mass)};
+      optional(o, 'inertia', p.inertia, p.hadInertia, listValue);
+      return Object.assign(o, p.extra);
+    });
   }
   st.clamp = rows.clamp;
   return Object.assign(st, rows.extra);
+}
+
+const num = (t) => {
+  const v = cellValue(t);
+  return typeof v === 'number' ? v : null;
+};
+const prod = (a, b) => (a !== null && b !== null ? fmtNum(Number((a * b).toPrecision(12))) : '');
+
+/**
+ * Switch the rows between a planar and a spatial model (the "spatial" switch).
+ * To spatial: EA = E·A and EI_edge = E·I (the planar bending is in the plane:
+ * edgewise); EI_flap and GJ are left for the user (nothing in a planar section
+ * says them; the daemon names them).  To planar: the E, A, I the section had
+ * when it was made spatial here (if EA and EI_edge were not edited since),
+ * else those of a section in the E, G, A, I_flap, I_edge, J form (I = I_edge),
+ * else empty; the z coordinates,
+ * twists, flap directions and point-mass inertias are dropped (a planar request
+ * cannot carry them).  mass_per_length and unknown keys stay.
+ */
+export function convertRows(rows, spatial) {
+  if (rows.spatial === spatial) return;
+  rows.spatial = spatial;
+  for (const s of rows.sections) {
+    const mu = s.v.mass_per_length ?? '';
+    if (spatial) {
+      const E = num(s.v.E), A = num(s.v.A), I = num(s.v.I);
+      for (const k of ['E', 'A', 'I']) delete s.extra[k];
+      const v = {EA: prod(E, A), EI_flap: '', EI_edge: prod(E, I), GJ: '', mass_per_length: mu, flap_inertia: '',
+        edge_inertia: ''};
+      s.memo = {E: s.v.E, A: s.v.A, I: s.v.I, EA: v.EA, EI_edge: v.EI_edge};
+      s.v = v;
+      s.had = {};
+    } else {
+      const x = s.extra, m = s.memo;
+      s.v = m && m.EA === s.v.EA && m.EI_edge === s.v.EI_edge
+        ? {E: m.E, A: m.A, I: m.I, mass_per_length: mu}
+        : {E: text(x.E), A: text(x.A), I: text(x.I_edge), mass_per_length: mu};
+      s.had = {};
+      delete s.memo;
+      for (const k of SPATIAL_ONLY) delete x[k];
+    }
+  }
+  if (!spatial) {
+    for (const j of rows.joints) {
+      j.z = '';
+      j.more = [];
+    }
+    for (const m of rows.members) {
+      m.twist = m.fdir = '';
+      m.hadTwist = m.hadFdir = false;
+    }
+    for (const p of rows.point_masses) {
+      p.inertia = '';
+      p.hadInertia = false;
+    }
+  }
 }
 
 /** A name not yet used among names: prefix + first free number. */
