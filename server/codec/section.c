@@ -204,7 +204,8 @@ static void sec_products(val_ctx *v, const char *ptr, const double *val)
 }
 
 /*
- * The optional inertias of a spatial section: given (> 0), or the defaults
+ * The optional inertias of a spatial section: given (>= 0: zero is a massless rotation, which
+ * the eigen-analysis condenses exactly, DESIGN.md 7.4), or the defaults
  * mu*EI/EA (stiffness form: val = EA, EI_flap, EI_edge, GJ, mu) or mu*I/A
  * (material form: val = E, G, A, I_flap, I_edge, J, mu) written out.
  * base_ok says whether val holds valid numbers for the defaults.
@@ -220,7 +221,7 @@ static void sec_inertias(val_ctx *v, const json_t *sec, const char *ptr, sec_for
         double def;
         const char *key = sec_inertia_keys[k];
         if (json_object_get(sec, key)) {
-            have[k] = field_real(v, sec, key, ptr, c, FIELD_POSITIVE, " (kg m)", &given[k]);
+            have[k] = field_real(v, sec, key, ptr, c, FIELD_NONNEG, " (kg m)", &given[k]);
             continue;
         }
         if (!base_ok)
@@ -241,7 +242,7 @@ static void sec_inertias(val_ctx *v, const json_t *sec, const char *ptr, sec_for
         field_set(v, c, key, json_real(def));
     }
     /* stiffness form: I_p/A = (flap_inertia + edge_inertia)/mass_per_length */
-    if (f == SEC_STIFFNESS && have[0] && have[1] && base_ok &&
+    if (f == SEC_STIFFNESS && have[0] && have[1] && base_ok && given[0] + given[1] != 0 &&
         !sec_usable((given[0] + given[1]) / mu))
         field_error(v, ptr,
                     "I_p/A = (flap_inertia + edge_inertia)/mass_per_length = %g (the torsional "

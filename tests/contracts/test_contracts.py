@@ -141,7 +141,7 @@ SCHEMA_REJECTS = [
     "section-material-with-I", "section-stiffness-missing-GJ", "section-material-missing-J",
     "section-planar-with-inertia", "twist-with-planar", "flap-direction-with-planar",
     "point-mass-inertia-with-planar", "paper-basis-spatial", "twist-string", "spatial-EA-zero",
-    "spatial-GJ-negative", "spatial-flap-inertia-zero", "spatial-edge-inertia-negative",
+    "spatial-GJ-negative", "spatial-flap-inertia-negative", "spatial-edge-inertia-negative",
     "spatial-EI-flap-null", "flap-direction-zero", "flap-direction-two-numbers",
     "flap-direction-string", "point-mass-inertia-negative", "point-mass-inertia-number",
 ]
@@ -623,7 +623,7 @@ def t_negative():
         ("flap_direction [0, 0, 0]", lambda r: r["structure"]["members"][0].__setitem__("flap_direction", [0, 0.0, 0])),
         ("a negative point-mass inertia", lambda r: r["structure"]["point_masses"][0].__setitem__("inertia", [0, -1, 0])),
         ("the paper basis", lambda r: r["analysis"].__setitem__("substructure_modes", "paper")),
-        ("edge_inertia 0", lambda r: r["structure"]["sections"]["b"].__setitem__("edge_inertia", 0)),
+        ("edge_inertia -1e-4", lambda r: r["structure"]["sections"]["b"].__setitem__("edge_inertia", -1e-4)),
     ]:
         bad = copy.deepcopy(sp_req)
         edit(bad)
