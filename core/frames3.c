@@ -157,18 +157,28 @@ static void sp_poses(const sm_model *m, const sp_cx *q, sp_kin *k)
     }
 }
 
-/* gs (m_s) += N^u' (A' F) + N^psi' (T' A' M) for a point of s with rotation psi. */
-static void sp_gen_force(const sm_sub *b, const sp_point *p, const sp_cx A[9], const sp_cx psi[3],
-                         const sp_cx F[3], const sp_cx Mo[3], sp_cx *gs)
+/*
+ * A force F and moment Mo (hub frame) acting at point p of frame s, at aw = A_s w_p from R_s:
+ * gs (m_s) += N^u' (A' F) + N^psi' (T' A' Mo), and the wrench of s about R_s += (F, Mo + aw x F).
+ * T = T(psi_p); NULL when Mo is zero (a point without rotary inertia).
+ */
+static void sp_apply(const sm_sub *b, const sp_point *p, const sp_cx A[9], const sp_cx T[9], const sp_cx aw[3],
+                     const sp_cx F[3], const sp_cx Mo[3], sp_cx *gs, sp_cx *Fs, sp_cx *Ms)
 {
-    sp_cx L[9], T[9], f[3], mo[3], t[3];
+    sp_cx f[3], mo[3] = {0, 0, 0}, t[3], c[3];
     rot3_tmv(A, F, f);
-    rot3_tmv(A, Mo, t);
-    rot3_exp(psi, L, T);
-    rot3_tmv(T, t, mo);
-    for (int c = 0; c < b->m; c++) {
-        const double *Nc = p->N + (size_t)p->ldn * c;
-        gs[c] += Nc[0] * f[0] + Nc[1] * f[1] + Nc[2] * f[2] + Nc[3] * mo[0] + Nc[4] * mo[1] + Nc[5] * mo[2];
+    if (T) {
+        rot3_tmv(A, Mo, t);
+        rot3_tmv(T, t, mo);
+    }
+    for (int j = 0; j < b->m; j++) {
+        const double *Nc = p->N + (size_t)p->ldn * j;
+        gs[j] += Nc[0] * f[0] + Nc[1] * f[1] + Nc[2] * f[2] + Nc[3] * mo[0] + Nc[4] * mo[1] + Nc[5] * mo[2];
+    }
+    rot3_cross(aw, F, c);
+    for (int i = 0; i < 3; i++) {
+        Fs[i] += F[i];
+        Ms[i] += Mo[i] + c[i];
     }
 }
 
@@ -187,7 +197,7 @@ static void sp_centrifugal_c(const sm_model *m, sp_kin *k)
             Fs[i] = 0;
         for (int t = k->pt_ptr[s]; t < k->pt_ptr[s + 1]; t++) {
             const sp_point *p = &m->pt[k->pt_idx[t]];
-            sp_cx w[3], psi[3], aw[3], F[3] = {0, 0, 0}, Mo[3] = {0, 0, 0}, c[3];
+            sp_cx w[3], psi[3], aw[3], F[3] = {0, 0, 0}, Mo[3] = {0, 0, 0}, L[9], T[9];
             sp_local(m, p, q, w, psi);
             rot3_mv(A, w, aw);
             if (p->mass != 0) { /* F = m P r, r = R + A w */
@@ -195,37 +205,28 @@ static void sp_centrifugal_c(const sm_model *m, sp_kin *k)
                 F[1] = p->mass * (k->cR[3 * s + 1] + aw[1]);
             }
             if (p->has_I) { /* M = (X e) x e, X e = A Lambda I Lambda' A' e */
-                sp_cx v[3], u[3], L[9], Ic[9], y[3], z[3];
+                sp_cx v[3], u[3], Ic[9], y[3], z[3];
                 for (int i = 0; i < 9; i++)
                     Ic[i] = p->I[i];
+                rot3_exp(psi, L, T);
                 rot3_tmv(A, ez, v);
-                rot3_exp(psi, L, NULL);
                 rot3_tmv(L, v, u);
                 rot3_mv(Ic, u, y);
                 rot3_mv(L, y, z);
                 rot3_mv(A, z, y);
                 rot3_cross(y, ez, Mo);
             }
-            sp_gen_force(b, p, A, psi, F, Mo, gs);
-            rot3_cross(aw, F, c); /* wrench about R_s */
-            for (int i = 0; i < 3; i++) {
-                Fs[i] += F[i];
-                Ms[i] += Mo[i] + c[i];
-            }
+            sp_apply(b, p, A, p->has_I ? T : NULL, aw, F, Mo, gs, Fs, Ms);
         }
-        for (int t = k->ch_ptr[s]; t < k->ch_ptr[s + 1]; t++) {
+        for (int t = k->ch_ptr[s]; t < k->ch_ptr[s + 1]; t++) { /* the subtree wrench of each child */
             int ch = k->ch_idx[t];
             const sp_point *p = &m->pt[m->subs[ch].root];
             const sp_cx *Fc = k->cF + 6 * ch, *Mc = Fc + 3;
-            sp_cx w[3], psi[3], aw[3], c[3];
+            sp_cx w[3], psi[3], aw[3], L[9], T[9];
             sp_local(m, p, q, w, psi);
             rot3_mv(A, w, aw);
-            sp_gen_force(b, p, A, psi, Fc, Mc, gs);
-            rot3_cross(aw, Fc, c);
-            for (int i = 0; i < 3; i++) {
-                Fs[i] += Fc[i];
-                Ms[i] += Mc[i] + c[i];
-            }
+            rot3_exp(psi, L, T);
+            sp_apply(b, p, A, T, aw, Fc, Mc, gs, Fs, Ms);
         }
     }
 }
@@ -254,65 +255,41 @@ void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat
     }
 }
 
-/* JRT columns of frame c from its parent s (forward recursion in the header). */
-static void sp_jac_frame(const sm_model *m, sp_kin *k, int c)
+/*
+ * J, W (n x 3 each, ld n) of a point at offset a = x - R_s from the origin of frame s, carried
+ * by s: the rigid transport of the frame's pose Jacobians (dR_s + dtheta_s x a, dtheta_s) plus
+ * the point's own columns in q_s: A_s N^u (translation), AT = A_s T(psi) times N^psi (rotation).
+ * Used for child frames (x = their origin) and for points alike.
+ */
+static void sp_jac_carry(const sm_model *m, const sp_kin *k, int s, const sp_point *p, const double *AT,
+                         const double a[3], double *J, double *W)
 {
-    const sm_sub *b = &m->subs[c], *ps = &m->subs[b->parent];
-    const sp_point *p = &m->pt[b->root];
-    const double *A = k->A + 9 * b->parent;
-    int n = m->n, e = b->root;
-    double *JRc = &DM(&k->JRT, 0, 6 * c), *JRs = &DM(&k->JRT, 0, 6 * b->parent);
-    double *JTc = JRc + 3 * (size_t)n, *JTs = JRs + 3 * (size_t)n;
-    double a[3]; /* A_s w_e = r_e - R_s */
-    for (int i = 0; i < 3; i++)
-        a[i] = k->r[3 * e + i] - k->R[3 * b->parent + i];
+    int n = m->n;
+    const sm_sub *b = &m->subs[s];
+    const double *A = k->A + 9 * s, *JRs = &DM(&k->JRT, 0, 6 * s), *JTs = JRs + 3 * (size_t)n;
     for (int x = 0; x < n; x++) {
         const double t0 = JTs[x], t1 = JTs[n + x], t2 = JTs[2 * (size_t)n + x];
-        JRc[x] = JRs[x] + t1 * a[2] - t2 * a[1]; /* dtheta x a */
-        JRc[n + x] = JRs[n + x] + t2 * a[0] - t0 * a[2];
-        JRc[2 * (size_t)n + x] = JRs[2 * (size_t)n + x] + t0 * a[1] - t1 * a[0];
-        JTc[x] = t0;
-        JTc[n + x] = t1;
-        JTc[2 * (size_t)n + x] = t2;
-    }
-    const double *AT = k->AT + 9 * e;
-    for (int j = 0; j < ps->m; j++) {
-        const double *Nc = p->N + (size_t)p->ldn * j;
-        for (int i = 0; i < 3; i++) {
-            JRc[(size_t)n * i + ps->q0 + j] += A[i] * Nc[0] + A[i + 3] * Nc[1] + A[i + 6] * Nc[2];
-            JTc[(size_t)n * i + ps->q0 + j] += AT[i] * Nc[3] + AT[i + 3] * Nc[4] + AT[i + 6] * Nc[5];
-        }
-    }
-}
-
-/* JW columns of point p of frame s. */
-static void sp_jac_point(const sm_model *m, sp_kin *k, int pi)
-{
-    const sp_point *p = &m->pt[pi];
-    const sm_sub *b = &m->subs[p->sub];
-    int n = m->n, s = p->sub;
-    const double *A = k->A + 9 * s, *AT = k->AT + 9 * pi;
-    double *Jp = &DM(&k->JW, 0, 6 * pi), *Wp = Jp + 3 * (size_t)n;
-    const double *JRs = &DM(&k->JRT, 0, 6 * s), *JTs = JRs + 3 * (size_t)n;
-    double a[3];
-    for (int i = 0; i < 3; i++)
-        a[i] = k->r[3 * pi + i] - k->R[3 * s + i];
-    for (int x = 0; x < n; x++) {
-        const double t0 = JTs[x], t1 = JTs[n + x], t2 = JTs[2 * (size_t)n + x];
-        Jp[x] = JRs[x] + t1 * a[2] - t2 * a[1];
-        Jp[n + x] = JRs[n + x] + t2 * a[0] - t0 * a[2];
-        Jp[2 * (size_t)n + x] = JRs[2 * (size_t)n + x] + t0 * a[1] - t1 * a[0];
-        Wp[x] = t0;
-        Wp[n + x] = t1;
-        Wp[2 * (size_t)n + x] = t2;
+        J[x] = JRs[x] + t1 * a[2] - t2 * a[1]; /* dtheta x a */
+        J[n + x] = JRs[n + x] + t2 * a[0] - t0 * a[2];
+        J[2 * (size_t)n + x] = JRs[2 * (size_t)n + x] + t0 * a[1] - t1 * a[0];
+        W[x] = t0;
+        W[n + x] = t1;
+        W[2 * (size_t)n + x] = t2;
     }
     for (int j = 0; j < b->m; j++) {
         const double *Nc = p->N + (size_t)p->ldn * j;
         for (int i = 0; i < 3; i++) {
-            Jp[(size_t)n * i + b->q0 + j] += A[i] * Nc[0] + A[i + 3] * Nc[1] + A[i + 6] * Nc[2];
-            Wp[(size_t)n * i + b->q0 + j] += AT[i] * Nc[3] + AT[i + 3] * Nc[4] + AT[i + 6] * Nc[5];
+            J[(size_t)n * i + b->q0 + j] += A[i] * Nc[0] + A[i + 3] * Nc[1] + A[i + 6] * Nc[2];
+            W[(size_t)n * i + b->q0 + j] += AT[i] * Nc[3] + AT[i + 3] * Nc[4] + AT[i + 6] * Nc[5];
         }
     }
+}
+
+/* The offset a = r_p - R_s of point pi from the origin of its frame. */
+static void sp_offset(const sp_kin *k, int pi, int s, double a[3])
+{
+    for (int i = 0; i < 3; i++)
+        a[i] = k->r[3 * pi + i] - k->R[3 * s + i];
 }
 
 void sp_eval(const sm_model *m, const double *q, sp_kin *k)
@@ -349,10 +326,21 @@ void sp_eval(const sm_model *m, const double *q, sp_kin *k)
         return;
     dm_zero(&k->JRT);
     dm_zero(&k->JW);
-    for (int s = 0; s < m->n_subs; s++)
-        if (m->subs[s].parent >= 0)
-            sp_jac_frame(m, k, s);
-    for (int pi = 0; pi < m->n_pt; pi++)
-        if (m->pt[pi].sub >= 0)
-            sp_jac_point(m, k, pi);
+    double a[3];
+    for (int c = 0; c < m->n_subs; c++) { /* child frames at node e of their parent: R_c = r_e */
+        int s = m->subs[c].parent, e = m->subs[c].root;
+        if (s < 0)
+            continue;
+        double *JRc = &DM(&k->JRT, 0, 6 * c);
+        sp_offset(k, e, s, a);
+        sp_jac_carry(m, k, s, &m->pt[e], k->AT + 9 * e, a, JRc, JRc + 3 * (size_t)m->n);
+    }
+    for (int pi = 0; pi < m->n_pt; pi++) {
+        int s = m->pt[pi].sub;
+        if (s < 0)
+            continue;
+        double *Jp = &DM(&k->JW, 0, 6 * pi);
+        sp_offset(k, pi, s, a);
+        sp_jac_carry(m, k, s, &m->pt[pi], k->AT + 9 * pi, a, Jp, Jp + 3 * (size_t)m->n);
+    }
 }

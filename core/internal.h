@@ -141,7 +141,8 @@ int mesh_build(sm_model *m, const sm_structure *st, sm_diag *diag);
 
 /* ------------------------------------------------------------- modes.c */
 /**
- * The component-mode basis of every substructure of m (after mesh_build):
+ * The component-mode basis of every substructure of m (after mesh_build; a spatial model's
+ * through modes3_sub and modes3_points of spatial.h):
  * N, K_s, T_e, d_e, G_e, the coordinate offsets q0 and m->n, and the mass
  * points m->mp.  Everything allocated belongs to m (sm_model_free).  Returns
  * SM_OK, SM_NOMEM, SM_SINGULAR (a substructure stiffness or mass matrix that

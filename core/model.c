@@ -125,7 +125,7 @@ int sm_model_build(sm_model **out, const sm_structure *st, const sm_options *opt
     *out = NULL;
     if (rc < 0)
         return model_fail(d, rc);
-    if ((rc = m->spatial ? modes3_build(m, cb, user, d) : modes_build(m, cb, user, d)) < 0) {
+    if ((rc = modes_build(m, cb, user, d)) < 0) {
         sm_model_free(m);
         return model_fail(d, rc);
     }

@@ -18,7 +18,7 @@
  * bending block of G_e; and the mass points (nodes, or Gauss points of every
  * element for consistent mass, plus point masses).
  */
-#include "internal.h"
+#include "spatial.h"
 
 #include <lapacke.h>
 #include <math.h>
@@ -413,6 +413,27 @@ static int modes_mass_points(sm_model *m)
     return SM_OK;
 }
 
+/* Basis, K_s, T_e and d_e of planar substructure b. */
+static int modes_sub(const sm_model *m, sm_sub *b)
+{
+    int D = 3 * b->nfree;
+    dmat K = {0}, M = {0};
+    int rc = dm_alloc(&K, D, D);
+    if (rc == SM_OK && m->opt.mass == SM_MASS_CONSISTENT)
+        rc = dm_alloc(&M, D, D);
+    if (rc == SM_OK) {
+        modes_assemble(m, b, &K, &M);
+        rc = m->opt.mass == SM_MASS_CONSISTENT ? modes_consistent(m, b, &K, &M) : modes_lumped(m, b, &K);
+    }
+    if (rc == SM_OK)
+        rc = modes_reduced_stiffness(b, &K);
+    if (rc == SM_OK)
+        rc = modes_elements(m, b);
+    dm_free(&K);
+    dm_free(&M);
+    return rc;
+}
+
 int modes_build(sm_model *m, sm_progress_fn cb, void *user, sm_diag *d)
 {
     int rc = SM_OK, q0 = 0;
@@ -425,28 +446,13 @@ int modes_build(sm_model *m, sm_progress_fn cb, void *user, sm_diag *d)
             return SM_CANCELED;
         }
         sm_sub *b = &m->subs[s];
-        int D = 3 * b->nfree;
-        dmat K = {0}, M = {0};
-        rc = dm_alloc(&K, D, D);
-        if (rc == SM_OK && m->opt.mass == SM_MASS_CONSISTENT)
-            rc = dm_alloc(&M, D, D);
-        if (rc == SM_OK) {
-            modes_assemble(m, b, &K, &M);
-            rc = m->opt.mass == SM_MASS_CONSISTENT ? modes_consistent(m, b, &K, &M)
-                                                   : modes_lumped(m, b, &K);
-        }
-        if (rc == SM_OK)
-            rc = modes_reduced_stiffness(b, &K);
-        if (rc == SM_OK)
-            rc = modes_elements(m, b);
+        rc = m->spatial ? modes3_sub(m, b) : modes_sub(m, b); /* spatial: modes3.c */
         b->q0 = q0;
         q0 += b->m;
-        dm_free(&K);
-        dm_free(&M);
     }
     m->n = q0;
     if (rc == SM_OK)
-        rc = modes_mass_points(m);
+        rc = m->spatial ? modes3_points(m) : modes_mass_points(m);
     if (rc < 0 && rc != SM_NOMEM)
         return modes_fail(d, rc, "could not compute the component modes of a substructure");
     if (rc == SM_NOMEM)

@@ -156,6 +156,16 @@ static void modes3_to_frame(const double A0[9], const double Ih[9], double If[9]
     rot3_mul_r(t, A0, If);
 }
 
+/* I (frame axes) = the torsional inertia (i_flap + i_edge) wl about the element axis e1 (the
+ * first column of E), for a Gauss point of weight wl (m) of consistent mass. */
+static void modes3_torsion_inertia(const sm_elem *e, const double E[9], double wl, double I[9])
+{
+    double ip = (e->i_flap + e->i_edge) * wl;
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            I[r + 3 * c] = E[r] * ip * E[c];
+}
+
 /* Kbar and Mbar of substructure b (D = 6F). */
 static void modes3_assemble(const sm_model *m, const sm_sub *b, dmat *K, dmat *M)
 {
@@ -165,20 +175,13 @@ static void modes3_assemble(const sm_model *m, const sm_sub *b, dmat *K, dmat *M
         modes3_add_element(m, b, e, K);
         if (!consistent)
             continue;
-        double E[9], S[72], I[9] = {0}, Ie[9];
+        double E[9], S[72], Ie[9];
         int idx[2] = {modes3_dof(m, b, e->n1), modes3_dof(m, b, e->n2)};
         modes3_axes(b, e, E);
         for (int g = 0; g < MODES3_GAUSS; g++) {
             double xi = 0.5 * (1.0 + modes3_gx[g]), wl = 0.5 * modes3_gw[g] * e->l;
             modes3_interp(e, E, xi, S);
-            I[0] = (e->i_flap + e->i_edge) * wl; /* torsional inertia about e1 */
-            double t[9];
-            for (int r = 0; r < 9; r++) /* Ie = E diag(I0, 0, 0) E' */
-                t[r] = 0;
-            for (int r = 0; r < 3; r++)
-                for (int c = 0; c < 3; c++)
-                    t[r + 3 * c] = E[r] * I[0] * E[c];
-            memcpy(Ie, t, sizeof Ie);
+            modes3_torsion_inertia(e, E, wl, Ie);
             modes3_add_point_mass(S, idx, e->mu * wl, Ie, M);
         }
     }
@@ -335,7 +338,7 @@ static int modes3_elements(const sm_model *m, sm_sub *b)
 }
 
 /* The points: FE nodes first (index = node), then the Gauss points of consistent mass. */
-static int modes3_points(sm_model *m)
+int modes3_points(sm_model *m)
 {
     int consistent = m->opt.mass == SM_MASS_CONSISTENT;
     m->n_pt = m->n_nodes + (consistent ? MODES3_GAUSS * m->n_elems : 0);
@@ -394,9 +397,7 @@ static int modes3_points(sm_model *m)
                 for (int i = 0; i < 3; i++)
                     p->ub[i] = u[0][i] + xi * (u[1][i] - u[0][i]);
                 p->mass = e->mu * wl;
-                for (int r = 0; r < 3; r++)
-                    for (int c = 0; c < 3; c++)
-                        p->I[r + 3 * c] = E[r] * (e->i_flap + e->i_edge) * wl * E[c];
+                modes3_torsion_inertia(e, E, wl, p->I);
                 p->N = Nq;
                 p->ldn = 6;
             }
@@ -409,43 +410,22 @@ inertia:
     return SM_OK;
 }
 
-int modes3_build(sm_model *m, sm_progress_fn cb, void *user, sm_diag *d)
+int modes3_sub(const sm_model *m, sm_sub *b)
 {
-    int rc = SM_OK, q0 = 0;
-    for (int s = 0; s < m->n_subs && rc == SM_OK; s++) {
-        if (cb && s > 0 && cb(user, s, m->n_subs)) {
-            d->status = SM_CANCELED;
-            snprintf(d->message, sizeof d->message,
-                     "canceled while building the component modes (%d of %d frames done)", s, m->n_subs);
-            return SM_CANCELED;
-        }
-        sm_sub *b = &m->subs[s];
-        int D = 6 * b->nfree;
-        dmat K = {0}, M = {0};
-        rc = dm_alloc(&K, D, D);
-        if (rc == SM_OK)
-            rc = dm_alloc(&M, D, D);
-        if (rc == SM_OK) {
-            modes3_assemble(m, b, &K, &M);
-            rc = modes3_basis(m, b, &K, &M);
-        }
-        if (rc == SM_OK)
-            rc = modes3_reduced_stiffness(b, &K);
-        if (rc == SM_OK)
-            rc = modes3_elements(m, b);
-        b->q0 = q0;
-        q0 += b->m;
-        dm_free(&K);
-        dm_free(&M);
-    }
-    m->n = q0;
+    int D = 6 * b->nfree;
+    dmat K = {0}, M = {0};
+    int rc = dm_alloc(&K, D, D);
     if (rc == SM_OK)
-        rc = modes3_points(m);
-    if (rc < 0 && d) {
-        d->status = rc;
-        snprintf(d->message, sizeof d->message, "%s",
-                 rc == SM_NOMEM ? "out of memory while building the component modes"
-                                : "could not compute the component modes of a substructure");
+        rc = dm_alloc(&M, D, D);
+    if (rc == SM_OK) {
+        modes3_assemble(m, b, &K, &M);
+        rc = modes3_basis(m, b, &K, &M);
     }
+    if (rc == SM_OK)
+        rc = modes3_reduced_stiffness(b, &K);
+    if (rc == SM_OK)
+        rc = modes3_elements(m, b);
+    dm_free(&K);
+    dm_free(&M);
     return rc;
 }

@@ -95,8 +95,11 @@ void mesh3_subs(sm_model *m);
 /* ----------------------------------------------------------- modes3.c */
 /** modes_count for a spatial substructure (complete basis: 6 F; truncated: + 6 per attachment). */
 int modes3_count(const sm_options *o, const sm_sub *b, int *nm, int *na);
-/** modes_build for a spatial model: bases, K_s, T_e, d_e, the points m->pt.  Same returns. */
-int modes3_build(sm_model *m, sm_progress_fn cb, void *user, sm_diag *d);
+/** Basis, K_s, T_e and d_e of spatial substructure b (modes_build calls it per substructure).
+ *  Returns SM_OK, SM_NOMEM, SM_SINGULAR or SM_LAPACK_FAILED. */
+int modes3_sub(const sm_model *m, sm_sub *b);
+/** The points m->pt of a spatial model, after every modes3_sub.  SM_OK or SM_NOMEM. */
+int modes3_points(sm_model *m);
 
 /* ---------------------------------------------------------- frames3.c */
 /* Kinematic state of a spatial model at q. */
