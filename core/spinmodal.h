@@ -77,7 +77,44 @@ typedef struct sm_section {
     double i_flap, i_edge;
     /* I_p/A of the torsional (Wagner) geometric stiffness P (I_p/A) int theta_x'^2, m^2, >= 0 */
     double ip_over_a;
+    /* spatial, DESIGN.md 8: offsets from the member axis, m, along the section's principal axes
+     * (index 0 along p2, edgewise/chordwise; 1 along p3, flapwise), finite, default 0:
+     * cg = centre of mass (the mass moments i_flap, i_edge are about it), sc = shear centre
+     * (bending and torsion act about it), tc = tension centre (the axial stiffness acts there) */
+    double cg[2], sc[2], tc[2];
 } sm_section;
+
+/** Bits of sm_member.station_mask: the quantities the stations of a member give. */
+enum sm_station_field {
+    SM_ST_MU = 1u << 0,
+    SM_ST_EA = 1u << 1,
+    SM_ST_EI_FLAP = 1u << 2,
+    SM_ST_EI_EDGE = 1u << 3,
+    SM_ST_GJ = 1u << 4,
+    SM_ST_I_FLAP = 1u << 5,
+    SM_ST_I_EDGE = 1u << 6,
+    SM_ST_IP_OVER_A = 1u << 7,
+    SM_ST_TWIST = 1u << 8,
+    SM_ST_INERTIA_TWIST = 1u << 9,
+    SM_ST_CG = 1u << 10,
+    SM_ST_SC = 1u << 11,
+    SM_ST_TC = 1u << 12
+};
+
+/** A station along a member (DESIGN.md 8): the section quantities at span fraction s (0 at the
+ *  member's `from` joint, 1 at `to`).  Between stations every quantity is linear in s and each
+ *  element takes the integral mean over its length.  Only the fields named by the member's
+ *  station_mask are read; the others come from the member's section (twist: member.twist;
+ *  inertia twist: the structural twist). */
+typedef struct sm_station {
+    double s;
+    double mu, EA, EI_flap, EI_edge, GJ, i_flap, i_edge, ip_over_a; /* as in sm_section */
+    double twist;          /* rad, as sm_member.twist */
+    double inertia_twist;  /* rad: angle of the principal axes of the mass moments (i_flap about
+                              the first, i_edge about the second), right-handed about e1 from
+                              (e2, e3) like twist */
+    double cg[2], sc[2], tc[2]; /* as in sm_section */
+} sm_station;
 
 /** A straight member between two joints, split into equal elements. */
 typedef struct sm_member {
@@ -90,6 +127,11 @@ typedef struct sm_member {
     double e3[3];  /* a direction for e3 (hub frame, any length, not along the member), or all
                       zero for the default of DESIGN.md 7.1 (the part of the hub axis z normal to
                       e1; for a member along z, the part of the radial direction) */
+    /* spatial only, DESIGN.md 8: n_stations 0 (none: the section is uniform) or >= 2 stations,
+     * s strictly increasing from 0 to 1; station_mask the sm_station_field bits they give */
+    int n_stations;
+    const sm_station *stations;
+    unsigned station_mask;
 } sm_member;
 
 /** A point mass attached to a joint (adds to the lumped/consistent mass). */
@@ -97,7 +139,12 @@ typedef struct sm_point_mass {
     int joint;     /* joint index */
     double mass;   /* kg, >= 0 */
     double inertia[3]; /* spatial only: rotary inertia about the hub axes x, y, z through the
-                          joint, kg m^2, >= 0 (planar: must be zero) */
+                          centre of mass, kg m^2, >= 0 (planar: must be zero) */
+    double products[3]; /* spatial only: products of inertia Ixy, Iyz, Izx (the tensor's
+                           off-diagonal entries, hub axes), kg m^2; the tensor must be positive
+                           semi-definite */
+    double offset[3];   /* spatial only: centre of mass from the joint, hub frame at rest, m; it
+                           turns with the joint's node */
 } sm_point_mass;
 
 /** The structure.  Arrays are borrowed; sm_model_new copies what it needs. */
@@ -247,6 +294,13 @@ int sm_model_node_position(const sm_model *m, int node, double xy[2]);
 
 /** Undeformed position of FE node k in 3D: xyz[0..2] (z = 0 for a planar model). */
 int sm_model_node_position3(const sm_model *m, int node, double xyz[3]);
+
+/** Principal axes of FE node k at rest (hub frame): the columns of axes (column-major 3x3) are
+ *  e1 (along the member, from -> to), p2 (edgewise) and p3 (flapwise) with the structural twist
+ *  interpolated at the node; for a joint, those of the first member that reaches it.  *member and
+ *  *s (either may be NULL) receive that member and the node's span fraction on it.  Spatial models
+ *  only.  Returns SM_OK or SM_INVALID_INPUT (planar model, k out of range). */
+int sm_model_node_axes(const sm_model *m, int node, double axes[9], int *member, double *s);
 
 /* ---------------------------------------------------------------- solve */
 
