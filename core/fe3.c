@@ -39,15 +39,53 @@ static void fe3_add_bar(double c, int i, double a[144])
     a[(i + 6) + 12 * i] -= c;
 }
 
+/*
+ * k = T' k T for the rigid link from the member axis to an axis at the offset (0, d2, d3)
+ * (principal axes): at each end the displacement there is u + theta x d, so
+ *   u_x' = u_x + d3 ty - d2 tz,  u_y' = u_y - d3 tx,  u_z' = u_z + d2 tx,  rotations unchanged.
+ */
+static void fe3_offset(double k[144], double d2, double d3)
+{
+    if (d2 == 0.0 && d3 == 0.0)
+        return;
+    double T[144] = {0}, t[144];
+    for (int i = 0; i < 12; i++)
+        T[i + 12 * i] = 1.0;
+    for (int h = 0; h < 12; h += 6) {
+        T[(h + 0) + 12 * (h + 4)] = d3;
+        T[(h + 0) + 12 * (h + 5)] = -d2;
+        T[(h + 1) + 12 * (h + 3)] = -d3;
+        T[(h + 2) + 12 * (h + 3)] = d2;
+    }
+    for (int j = 0; j < 12; j++) /* t = k T */
+        for (int i = 0; i < 12; i++) {
+            double v = 0;
+            for (int r = 0; r < 12; r++)
+                v += k[i + 12 * r] * T[r + 12 * j];
+            t[i + 12 * j] = v;
+        }
+    for (int j = 0; j < 12; j++) /* k = T' t */
+        for (int i = 0; i < 12; i++) {
+            double v = 0;
+            for (int r = 0; r < 12; r++)
+                v += T[r + 12 * i] * t[r + 12 * j];
+            k[i + 12 * j] = v;
+        }
+}
+
 void fe3_stiffness(const sm_elem *e, double k[144])
 {
-    double pe[36], pf[36];
+    double pe[36], pf[36], ka[144] = {0};
     memset(k, 0, 144 * sizeof(double));
     fe_stiffness_local(0.0, e->EI_edge, e->l, pe);
     fe_stiffness_local(0.0, e->EI_flap, e->l, pf);
     fe3_add_planes(pe, pf, k);
-    fe3_add_bar(e->EA / e->l, 0, k); /* axial: EA/l */
     fe3_add_bar(e->GJ / e->l, 3, k); /* torsion: GJ/l */
+    fe3_offset(k, e->sc[0], e->sc[1]); /* bending and torsion about the shear centre (DESIGN.md 8) */
+    fe3_add_bar(e->EA / e->l, 0, ka); /* axial: EA/l at the tension centre */
+    fe3_offset(ka, e->tc[0], e->tc[1]);
+    for (int i = 0; i < 144; i++)
+        k[i] += ka[i];
 }
 
 void fe3_geometric(const sm_elem *e, double g[144])

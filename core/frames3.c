@@ -31,6 +31,7 @@ void sp_kin_free(sp_kin *k)
     free(k->r);
     free(k->psi);
     free(k->AT);
+    free(k->dh);
     dm_free(&k->JRT);
     dm_free(&k->JW);
     free(k->cq);
@@ -99,12 +100,13 @@ int sp_kin_alloc(const sm_model *m, sp_kin *k, int jac)
     k->r = dm_vec(3 * (size_t)P);
     k->psi = dm_vec(3 * (size_t)P);
     k->AT = dm_vec(9 * (size_t)P);
+    k->dh = dm_vec(3 * (size_t)P);
     k->cq = calloc((size_t)n, sizeof(sp_cx));
     k->cR = calloc(3 * (size_t)S, sizeof(sp_cx));
     k->cA = calloc(9 * (size_t)S, sizeof(sp_cx));
     k->cF = calloc(6 * (size_t)S, sizeof(sp_cx));
     k->cg = calloc((size_t)n, sizeof(sp_cx));
-    if (!k->R || !k->A || !k->r || !k->psi || !k->AT || !k->cq || !k->cR || !k->cA || !k->cF || !k->cg ||
+    if (!k->R || !k->A || !k->r || !k->psi || !k->AT || !k->dh || !k->cq || !k->cR || !k->cA || !k->cF || !k->cg ||
         sp_lists(m, k) || (jac && (dm_alloc(&k->JRT, n, 6 * S) || dm_alloc(&k->JW, n, 6 * P)))) {
         sp_kin_free(k);
         return SM_NOMEM;
@@ -200,23 +202,34 @@ static void sp_centrifugal_c(const sm_model *m, sp_kin *k)
             sp_cx w[3], psi[3], aw[3], F[3] = {0, 0, 0}, Mo[3] = {0, 0, 0}, L[9], T[9];
             sp_local(m, p, q, w, psi);
             rot3_mv(A, w, aw);
-            if (p->mass != 0) { /* F = m P r, r = R + A w */
-                F[0] = p->mass * (k->cR[3 * s] + aw[0]);
-                F[1] = p->mass * (k->cR[3 * s + 1] + aw[1]);
+            if (p->has_I || p->has_c)
+                rot3_exp(psi, L, T);
+            if (p->mass != 0) { /* F = m P r, r = R + A w (+ dh = A Lambda c for an offset mass) */
+                sp_cx dh[3] = {0, 0, 0};
+                if (p->has_c) {
+                    sp_cx cc[3] = {p->c[0], p->c[1], p->c[2]}, lc[3];
+                    rot3_mv(L, cc, lc);
+                    rot3_mv(A, lc, dh);
+                }
+                F[0] = p->mass * (k->cR[3 * s] + aw[0] + dh[0]);
+                F[1] = p->mass * (k->cR[3 * s + 1] + aw[1] + dh[1]);
+                if (p->has_c) /* F acts at the offset: its moment about the node, F.dr = (dh x F).dtheta */
+                    rot3_cross(dh, F, Mo);
             }
-            if (p->has_I) { /* M = (X e) x e, X e = A Lambda I Lambda' A' e */
-                sp_cx v[3], u[3], Ic[9], y[3], z[3];
+            if (p->has_I) { /* M += (X e) x e, X e = A Lambda I Lambda' A' e */
+                sp_cx v[3], u[3], Ic[9], y[3], z[3], mr[3];
                 for (int i = 0; i < 9; i++)
                     Ic[i] = p->I[i];
-                rot3_exp(psi, L, T);
                 rot3_tmv(A, ez, v);
                 rot3_tmv(L, v, u);
                 rot3_mv(Ic, u, y);
                 rot3_mv(L, y, z);
                 rot3_mv(A, z, y);
-                rot3_cross(y, ez, Mo);
+                rot3_cross(y, ez, mr);
+                for (int i = 0; i < 3; i++)
+                    Mo[i] += mr[i];
             }
-            sp_apply(b, p, A, p->has_I ? T : NULL, aw, F, Mo, gs, Fs, Ms);
+            sp_apply(b, p, A, p->has_I || p->has_c ? T : NULL, aw, F, Mo, gs, Fs, Ms);
         }
         for (int t = k->ch_ptr[s]; t < k->ch_ptr[s + 1]; t++) { /* the subtree wrench of each child */
             int ch = k->ch_idx[t];
@@ -262,7 +275,7 @@ void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat
  * Used for child frames (x = their origin) and for points alike.
  */
 static void sp_jac_carry(const sm_model *m, const sp_kin *k, int s, const sp_point *p, const double *AT,
-                         const double a[3], double *J, double *W)
+                         const double a[3], const double *dh, double *J, double *W)
 {
     int n = m->n;
     const sm_sub *b = &m->subs[s];
@@ -278,9 +291,16 @@ static void sp_jac_carry(const sm_model *m, const sp_kin *k, int s, const sp_poi
     }
     for (int j = 0; j < b->m; j++) {
         const double *Nc = p->N + (size_t)p->ldn * j;
+        double wj[3];
         for (int i = 0; i < 3; i++) {
             J[(size_t)n * i + b->q0 + j] += A[i] * Nc[0] + A[i + 3] * Nc[1] + A[i + 6] * Nc[2];
-            W[(size_t)n * i + b->q0 + j] += AT[i] * Nc[3] + AT[i + 3] * Nc[4] + AT[i + 6] * Nc[5];
+            wj[i] = AT[i] * Nc[3] + AT[i + 3] * Nc[4] + AT[i + 6] * Nc[5];
+            W[(size_t)n * i + b->q0 + j] += wj[i];
+        }
+        if (dh) { /* an offset mass: its own rotation carries the offset, dtheta x dh */
+            J[b->q0 + j] += wj[1] * dh[2] - wj[2] * dh[1];
+            J[(size_t)n + b->q0 + j] += wj[2] * dh[0] - wj[0] * dh[2];
+            J[2 * (size_t)n + b->q0 + j] += wj[0] * dh[1] - wj[1] * dh[0];
         }
     }
 }
@@ -303,7 +323,8 @@ void sp_eval(const sm_model *m, const double *q, sp_kin *k)
         k->A[i] = creal(k->cA[i]);
     for (int pi = 0; pi < m->n_pt; pi++) {
         const sp_point *p = &m->pt[pi];
-        double *r = k->r + 3 * pi, *ps = k->psi + 3 * pi, *AT = k->AT + 9 * pi;
+        double *r = k->r + 3 * pi, *ps = k->psi + 3 * pi, *AT = k->AT + 9 * pi, *dh = k->dh + 3 * pi;
+        memset(dh, 0, 3 * sizeof(double));
         if (p->sub < 0) { /* the clamp */
             memcpy(r, p->ub, 3 * sizeof(double));
             memset(ps, 0, 3 * sizeof(double));
@@ -315,8 +336,15 @@ void sp_eval(const sm_model *m, const double *q, sp_kin *k)
         rot3_mv(k->cA + 9 * p->sub, w, aw);
         rot3_exp(psi, L, T);
         rot3_mul(k->cA + 9 * p->sub, T, At);
+        if (p->has_c) {
+            sp_cx cc[3] = {p->c[0], p->c[1], p->c[2]}, lc[3], d[3];
+            rot3_mv(L, cc, lc);
+            rot3_mv(k->cA + 9 * p->sub, lc, d);
+            for (int i = 0; i < 3; i++)
+                dh[i] = creal(d[i]);
+        }
         for (int i = 0; i < 3; i++) {
-            r[i] = creal(k->cR[3 * p->sub + i] + aw[i]);
+            r[i] = creal(k->cR[3 * p->sub + i] + aw[i]) + dh[i];
             ps[i] = creal(psi[i]);
         }
         for (int i = 0; i < 9; i++)
@@ -333,7 +361,7 @@ void sp_eval(const sm_model *m, const double *q, sp_kin *k)
             continue;
         double *JRc = &DM(&k->JRT, 0, 6 * c);
         sp_offset(k, e, s, a);
-        sp_jac_carry(m, k, s, &m->pt[e], k->AT + 9 * e, a, JRc, JRc + 3 * (size_t)m->n);
+        sp_jac_carry(m, k, s, &m->pt[e], k->AT + 9 * e, a, NULL, JRc, JRc + 3 * (size_t)m->n);
     }
     for (int pi = 0; pi < m->n_pt; pi++) {
         int s = m->pt[pi].sub;
@@ -341,6 +369,7 @@ void sp_eval(const sm_model *m, const double *q, sp_kin *k)
             continue;
         double *Jp = &DM(&k->JW, 0, 6 * pi);
         sp_offset(k, pi, s, a);
-        sp_jac_carry(m, k, s, &m->pt[pi], k->AT + 9 * pi, a, Jp, Jp + 3 * (size_t)m->n);
+        sp_jac_carry(m, k, s, &m->pt[pi], k->AT + 9 * pi, a, m->pt[pi].has_c ? k->dh + 3 * pi : NULL, Jp,
+                     Jp + 3 * (size_t)m->n);
     }
 }

@@ -35,6 +35,13 @@ typedef struct sm_node {
     double rot[9];      /* lumped rotary inertia tensor about the node, hub axes at rest, kg m^2
                            (section tributaries + point-mass inertia), column-major 3x3 */
     double point_rot[9]; /* point-mass inertia alone (consistent mass keeps only this) */
+    double first[3];    /* first moment of the lumped mass about the node, hub axes at rest,
+                           kg m (section centres of mass and point-mass offsets, DESIGN.md 8);
+                           rot is about the node, so it includes the parallel-axis terms */
+    double point_first[3]; /* the point masses' part alone (consistent mass) */
+    double ax[9];       /* principal axes at rest (sm_model_node_axes) */
+    int member;         /* the member those axes belong to */
+    double span;        /* the node's span fraction on it */
 } sm_node;
 
 /* FE element (2 nodes, 3 DOF each), oriented away from the clamp. */
@@ -51,6 +58,9 @@ typedef struct sm_elem {
     double GJ, EI_edge, EI_flap; /* torsion; bending in the p2 and p3 directions */
     double i_flap, i_edge;       /* mass moments per length about p2, p3, kg m */
     double ip_over_a;            /* Wagner ratio I_p/A, m^2 */
+    double sc[2], tc[2];         /* shear and tension centre offsets along (p2, p3), m (p2 as in
+                                    ax: it turns with the element's direction) */
+    double cg[3];                /* centre-of-mass offset from the axis, hub axes at rest, m */
 } sm_elem;
 
 /* A point that carries mass (lumped node, or quadrature point for consistent mass). */

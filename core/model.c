@@ -195,3 +195,16 @@ int sm_model_node_position(const sm_model *m, int node, double xy[2])
     xy[1] = m->nodes[node].y;
     return SM_OK;
 }
+
+int sm_model_node_axes(const sm_model *m, int node, double axes[9], int *member, double *s)
+{
+    if (!m->spatial || node < 0 || node >= m->n_nodes || m->nodes[node].member < 0)
+        return SM_INVALID_INPUT;
+    const sm_node *nd = &m->nodes[node];
+    memcpy(axes, nd->ax, sizeof nd->ax);
+    if (member)
+        *member = nd->member;
+    if (s)
+        *s = nd->span;
+    return SM_OK;
+}

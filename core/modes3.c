@@ -331,8 +331,14 @@ static int modes3_elements(const sm_model *m, sm_sub *b)
                         DM(&b->T, 12 * j + 6 * h + 3 * g + i, c) = E[3 * i] * x[0] + E[3 * i + 1] * x[1] + E[3 * i + 2] * x[2];
                     }
         }
-        for (int c = 0; c < mm; c++)
-            b->d[(size_t)j * mm + c] = e->EA / e->l * (DM(&b->T, 12 * j + 6, c) - DM(&b->T, 12 * j, c));
+        for (int c = 0; c < mm; c++) {
+            double u2 = DM(&b->T, 12 * j + 6, c), u1 = DM(&b->T, 12 * j, c);
+            if (e->tc[0] != 0.0 || e->tc[1] != 0.0) { /* the strain of the tension centre */
+                u2 += e->tc[1] * DM(&b->T, 12 * j + 10, c) - e->tc[0] * DM(&b->T, 12 * j + 11, c);
+                u1 += e->tc[1] * DM(&b->T, 12 * j + 4, c) - e->tc[0] * DM(&b->T, 12 * j + 5, c);
+            }
+            b->d[(size_t)j * mm + c] = e->EA / e->l * (u2 - u1);
+        }
     }
     return SM_OK;
 }
@@ -340,8 +346,12 @@ static int modes3_elements(const sm_model *m, sm_sub *b)
 /* The points: FE nodes first (index = node), then the Gauss points of consistent mass. */
 int modes3_points(sm_model *m)
 {
-    int consistent = m->opt.mass == SM_MASS_CONSISTENT;
-    m->n_pt = m->n_nodes + (consistent ? MODES3_GAUSS * m->n_elems : 0);
+    int consistent = m->opt.mass == SM_MASS_CONSISTENT, n_off = 0;
+    for (int k = 0; k < m->n_nodes; k++) {
+        const double *f = consistent ? m->nodes[k].point_first : m->nodes[k].first;
+        n_off += m->nodes[k].sub >= 0 && (f[0] != 0.0 || f[1] != 0.0 || f[2] != 0.0);
+    }
+    m->n_pt = m->n_nodes + (consistent ? MODES3_GAUSS * m->n_elems : 0) + n_off;
     m->pt = calloc((size_t)m->n_pt, sizeof(sp_point));
     if (!m->pt)
         return SM_NOMEM;
@@ -361,9 +371,36 @@ int modes3_points(sm_model *m)
         p->N = b->N.a + 6 * nd->local;
         p->ldn = b->N.rows;
     }
+    int np = m->n_nodes;
+    if (consistent)
+        np += MODES3_GAUSS * m->n_elems;
+    for (int k = 0; k < m->n_nodes; k++) { /* offset masses (DESIGN.md 8): the node keeps the
+                                              rotary inertia about the centre of mass */
+        const sm_node *nd = &m->nodes[k];
+        const double *f = consistent ? nd->point_first : nd->first;
+        if (nd->sub < 0 || (f[0] == 0.0 && f[1] == 0.0 && f[2] == 0.0))
+            continue;
+        sp_point *p = &m->pt[k], *o = &m->pt[np++];
+        double c[3] = {f[0] / p->mass, f[1] / p->mass, f[2] / p->mass}, par[9] = {0}, cf[9];
+        double c2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                par[i + 3 * j] = p->mass * ((i == j ? c2 : 0.0) - c[i] * c[j]);
+        modes3_to_frame(m->subs[nd->sub].A0, par, cf);
+        for (int i = 0; i < 9; i++)
+            p->I[i] -= cf[i]; /* parallel axes: about the centre of mass */
+        *o = *p;
+        o->node = -1;
+        memset(o->I, 0, sizeof o->I);
+        const double *A0 = m->subs[nd->sub].A0;
+        for (int i = 0; i < 3; i++) /* frame axes at rest */
+            o->c[i] = A0[3 * i] * c[0] + A0[3 * i + 1] * c[1] + A0[3 * i + 2] * c[2];
+        o->has_c = 1;
+        p->mass = 0.0;
+    }
     if (!consistent)
         goto inertia;
-    int np = m->n_nodes;
+    np = m->n_nodes;
     for (int s = 0; s < m->n_subs; s++) {
         sm_sub *b = &m->subs[s];
         int mm = b->m, D = 6 * b->nfree;
@@ -398,6 +435,12 @@ int modes3_points(sm_model *m)
                     p->ub[i] = u[0][i] + xi * (u[1][i] - u[0][i]);
                 p->mass = e->mu * wl;
                 modes3_torsion_inertia(e, E, wl, p->I);
+                if (e->cg[0] != 0.0 || e->cg[1] != 0.0 || e->cg[2] != 0.0) {
+                    const double *A0 = b->A0;
+                    for (int i = 0; i < 3; i++)
+                        p->c[i] = A0[3 * i] * e->cg[0] + A0[3 * i + 1] * e->cg[1] + A0[3 * i + 2] * e->cg[2];
+                    p->has_c = 1;
+                }
                 p->N = Nq;
                 p->ldn = 6;
             }

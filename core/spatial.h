@@ -44,6 +44,10 @@ typedef struct sp_point {
     double mass;        /* kg (0: carries no mass) */
     double I[9];        /* rotary inertia at rest in frame axes, kg m^2 */
     int has_I;          /* 1 when I is not all zero */
+    double c[3];        /* offset of the mass from the node it moves with, frame axes at rest, m:
+                           it is at w + Lambda(psi) c (a section centre of mass or a point-mass
+                           offset, DESIGN.md 8) */
+    int has_c;          /* 1 when c is not zero */
     const double *N;    /* 6 x m_s rows (u, v, w, psi_x, psi_y, psi_z), column stride ldn */
     int ldn;
 } sp_point;
@@ -108,6 +112,7 @@ typedef struct sp_kin {
     double *R, *A;      /* 3 S frame origins, 9 S orientations */
     double *r, *psi;    /* 3 P point positions (hub), 3 P small rotations (frame axes) */
     double *AT;         /* 9 P: A_s T(psi_p), the map from d psi_p to the hub rotation */
+    double *dh;         /* 3 P: A_s Lambda(psi_p) c_p, the hub offset of an offset mass (0 else) */
     dmat JRT;           /* n x 6S: columns 6s+i = (d R_s,i / dq)', 6s+3+i = (d theta_s,i / dq)' */
     dmat JW;            /* n x 6P: columns 6p+i = (d r_p,i / dq)', 6p+3+i = (d theta_p,i / dq)'
                            (theta: the hub-frame rotation) */

@@ -28,7 +28,8 @@ static void check(double err, double tol, const char *what)
     printf("%s %-62s relative error %.2e (tol %.0e)\n", ok ? "ok  " : "FAIL", what, err, tol);
 }
 
-/* The structure: hub radius 0.5, a precone twisted blade O-A-B and a branch A-C out of plane. */
+/* The structure: hub radius 0.5, a precone twisted blade O-A-B and a branch A-C out of plane
+ * (with stations), offsets of masses and elastic centres. */
 static sm_model *build(const sm_options *o)
 {
     static double xy[8] = {0.5, 0, 3.5, 0.2, 6.5, 0.1, 3.6, 1.5};
@@ -48,6 +49,23 @@ static sm_model *build(const sm_options *o)
         mem[i].twist = 0.3 * (i + 1);
     }
     pm.joint = 2, pm.mass = 1.5, pm.inertia[0] = 0.02, pm.inertia[1] = 0.05, pm.inertia[2] = 0.01;
+    /* blade data (DESIGN.md 8): an offset point mass with products of inertia, section centres of
+     * mass, shear and tension centres off the axis, and stations along the branch */
+    pm.offset[0] = 0.1, pm.offset[1] = -0.2, pm.offset[2] = 0.15, pm.products[0] = 0.004, pm.products[2] = -0.003;
+    sec[0].cg[0] = 0.05, sec[0].cg[1] = 0.02, sec[0].sc[0] = -0.03, sec[0].tc[1] = 0.01;
+    static sm_station sta[3];
+    memset(sta, 0, sizeof sta);
+    for (int j = 0; j < 3; j++) {
+        sta[j].s = 0.5 * j;
+        sta[j].mu = 2.0 - 0.5 * j;
+        sta[j].EI_flap = 9000 - 2000 * j;
+        sta[j].twist = 0.1 + 0.2 * j * j;
+        sta[j].inertia_twist = 0.2 - 0.1 * j;
+        sta[j].cg[0] = 0.04 * j, sta[j].cg[1] = -0.01 * j;
+        sta[j].sc[1] = 0.02 * j;
+    }
+    mem[2].n_stations = 3, mem[2].stations = sta;
+    mem[2].station_mask = SM_ST_MU | SM_ST_EI_FLAP | SM_ST_TWIST | SM_ST_INERTIA_TWIST | SM_ST_CG | SM_ST_SC;
     sm_structure st;
     memset(&st, 0, sizeof st);
     st.n_joints = 4, st.joint_xy = xy, st.joint_z = z, st.n_sections = 2, st.sections = sec;
