@@ -103,26 +103,16 @@ static int imp_space(char c)
     return c == ' ' || c == '\t' || c == '\f' || c == '\v';
 }
 
-int imp_split(const char *s, size_t n, const char *seps, int keep_empty, imp_tok *t, int max)
+int imp_split(const char *s, size_t n, const char *seps, imp_tok *t, int max)
 {
-    size_t i = 0;
+    size_t i = 0, b, e;
     int count = 0;
 
     for (;;) {
-        size_t b, e;
-        while (i < n && imp_space(s[i]))
+        while (i < n && (imp_space(s[i]) || (s[i] != '\0' && strchr(seps, s[i]))))
             i++;
         if (i >= n)
             break;
-        if (strchr(seps, s[i]) && s[i] != '\0') {
-            if (keep_empty) { /* an empty field before this separator */
-                if (count < max)
-                    t[count].s = s + i, t[count].n = 0;
-                count++;
-            }
-            i++;
-            continue;
-        }
         if (s[i] == '\'' || s[i] == '"') {
             char q = s[i++];
             b = i;
@@ -137,24 +127,11 @@ int imp_split(const char *s, size_t n, const char *seps, int keep_empty, imp_tok
                 i++;
             e = i;
         }
-        if (count < max)
-            t[count].s = s + b, t[count].n = e - b;
-        count++;
-        while (i < n && imp_space(s[i]))
-            i++;
-        if (i < n && s[i] != '\0' && strchr(seps, s[i])) {
-            i++;
-            if (keep_empty) { /* an empty last field after a trailing separator */
-                size_t k = i;
-                while (k < n && imp_space(s[k]))
-                    k++;
-                if (k >= n) {
-                    if (count < max)
-                        t[count].s = s + k, t[count].n = 0;
-                    count++;
-                }
-            }
+        if (count < max) {
+            t[count].s = s + b;
+            t[count].n = e - b;
         }
+        count++;
     }
     return count;
 }

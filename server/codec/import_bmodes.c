@@ -59,7 +59,9 @@ static int bm_tok(bm_in *b, const char *field, imp_tok *t)
 {
     if (!imp_next_nonblank(&b->r))
         return bm_ends(b, field);
-    imp_split(b->r.s, b->r.n, ",", 0, t, 1);
+    t->s = b->r.s;
+    t->n = 0; /* a line of separators only: "missing value" */
+    imp_split(b->r.s, b->r.n, ",", t, 1);
     return SM_OK;
 }
 
@@ -202,7 +204,7 @@ static int bm_mesh(bm_in *b, bm_main *m, json_t *el_loc)
     while (got < m->nselt + 1) {
         if (!imp_next_nonblank(&b->r))
             return bm_ends(b, "el_loc");
-        n = imp_split(b->r.s, b->r.n, ",", 0, t, IMP_MAX_TOKENS);
+        n = imp_split(b->r.s, b->r.n, ",", t, IMP_MAX_TOKENS);
         if (n > IMP_MAX_TOKENS)
             n = IMP_MAX_TOKENS;
         for (i = 0; i < n && got < m->nselt + 1; i++, got++) {
@@ -243,7 +245,7 @@ static int bm_sections(bm_in *b, const bm_main *m, imp_table *t)
             return imp_fail(b->d, b->file, b->r.line + 1, "sec_loc",
                             "the file ends before station %ld of %ld (truncated?)", i + 1,
                             n_secs);
-        n = imp_split(b->r.s, b->r.n, ",", 0, tok, BM_COLUMNS + 1);
+        n = imp_split(b->r.s, b->r.n, ",", tok, BM_COLUMNS + 1);
         if (n < BM_COLUMNS)
             return imp_fail(b->d, b->file, b->r.line, col[n],
                             "missing: the row has %d columns, expected %d", n, BM_COLUMNS);

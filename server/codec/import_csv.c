@@ -51,6 +51,38 @@ static const struct {
 };
 #define CSV_NCOLS ((int)(sizeof(csv_cols) / sizeof(csv_cols[0])))
 
+/*
+ * Split a CSV line at commas (only: a field may hold spaces, "EI_flap [N
+ * m^2]"), each field trimmed and unquoted; at most max stored, the count
+ * returned.
+ */
+static int csv_split(const char *s, size_t n, imp_tok *t, int max)
+{
+    size_t i = 0;
+    int count = 0;
+
+    for (;;) {
+        size_t b = i, e;
+        while (i < n && s[i] != ',')
+            i++;
+        e = i;
+        while (b < e && (s[b] == ' ' || s[b] == '\t'))
+            b++;
+        while (e > b && (s[e - 1] == ' ' || s[e - 1] == '\t'))
+            e--;
+        if (e - b >= 2 && s[b] == '"' && s[e - 1] == '"')
+            b++, e--;
+        if (count < max) {
+            t[count].s = s + b;
+            t[count].n = e - b;
+        }
+        count++;
+        if (i >= n)
+            return count;
+        i++; /* the comma */
+    }
+}
+
 /* Next line with content, '#' comments cut: 1, or 0 at the end. */
 static int csv_next(imp_reader *r)
 {
@@ -161,7 +193,7 @@ static int csv_header(imp_reader *r, import_diag *d, int *col, int *ncol)
     if (!csv_next(r))
         return imp_fail(d, file, r->line + 1, "header",
                         "the file has no header row (station keys separated by commas)");
-    n = imp_split(r->s, r->n, ",", 1, f, CSV_MAX_COLUMNS + 1);
+    n = csv_split(r->s, r->n, f, CSV_MAX_COLUMNS + 1);
     if (n > CSV_MAX_COLUMNS)
         return imp_fail(d, file, r->line, "header", "more than %d columns", CSV_MAX_COLUMNS);
     for (c = 0; c < n; c++) {
@@ -191,7 +223,7 @@ static int csv_rows(imp_reader *r, import_diag *d, const int *col, int ncol, imp
         t->mask |= 1u << (csv_cols[col[c]].key == CSV_R ? IK_S : csv_cols[col[c]].key);
     while (csv_next(r)) {
         imp_station *s;
-        n = imp_split(r->s, r->n, ",", 1, f, CSV_MAX_COLUMNS + 1);
+        n = csv_split(r->s, r->n, f, CSV_MAX_COLUMNS + 1);
         if (n < ncol)
             return imp_fail(d, file, r->line, csv_cols[col[n]].name,
                             "missing: the row has %d columns, expected %d", n, ncol);

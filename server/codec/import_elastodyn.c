@@ -90,7 +90,7 @@ static int ed_param(imp_reader *r, import_diag *d, ed_params *p)
     double v;
     int i, st;
 
-    if (imp_split(r->s, r->n, "", 0, t, 2) < 2)
+    if (imp_split(r->s, r->n, "", t, 2) < 2)
         return SM_OK; /* not a parameter line: ignored, as ElastoDyn reads by position */
     if (ed_tok_is(&t[1], "NBlInpSt")) {
         if ((st = imp_value(d, file, r->line, "NBlInpSt", &t[0], IMP_ANY, &v)))
@@ -157,7 +157,7 @@ static int ed_columns(imp_reader *r, import_diag *d, int *col, int *ncol, json_t
     if (!imp_next(r))
         return imp_fail(d, file, r->line + 1, "BlFract",
                         "the file ends before the column names of the table (truncated?)");
-    n = imp_split(r->s, r->n, ",", 0, t, ED_MAX_COLUMNS + 1);
+    n = imp_split(r->s, r->n, ",", t, ED_MAX_COLUMNS + 1);
     if (n > ED_MAX_COLUMNS)
         return imp_fail(d, file, r->line, "columns", "more than %d columns", ED_MAX_COLUMNS);
     for (c = 0; c < n; c++) {
@@ -200,7 +200,7 @@ static int ed_rows(imp_reader *r, import_diag *d, const ed_params *p, const int 
             return imp_fail(d, file, r->line + 1, ed_cols[col[0] >= 0 ? col[0] : 0].name,
                             "the file ends before station %ld of %ld (NBlInpSt; truncated?)",
                             i + 1, p->nst);
-        n = imp_split(r->s, r->n, ",", 0, tok, ED_MAX_COLUMNS + 1);
+        n = imp_split(r->s, r->n, ",", tok, ED_MAX_COLUMNS + 1);
         if (n != ncol) {
             char name[40] = "row";
             if (n < ncol && col[n] >= 0)

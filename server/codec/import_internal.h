@@ -48,11 +48,11 @@ typedef struct imp_tok {
 
 /**
  * Split s[0..n) at whitespace and at any character of seps (may be ""),
- * Fortran style: a token may be quoted with ' or ".  Stores at most max
- * tokens in t; returns how many there are (more than max when cut).
- * With keep_empty, consecutive separators of seps give empty tokens (CSV).
+ * Fortran list-directed style: runs of separators are one, a token may be
+ * quoted with ' or ".  Stores at most max tokens in t; returns how many
+ * there are (more than max when cut).
  */
-int imp_split(const char *s, size_t n, const char *seps, int keep_empty, imp_tok *t, int max);
+int imp_split(const char *s, size_t n, const char *seps, imp_tok *t, int max);
 
 /** Copy a token into dst[cap] (truncated, ASCII: control and other bytes as '?'). */
 void imp_tok_copy(char *dst, size_t cap, const imp_tok *t);
