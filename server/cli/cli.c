@@ -19,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli_import.h"
 #include "codec.h"
 #include "spinmodal.h"
 
@@ -47,6 +48,8 @@ typedef struct cli_args {
 static const char cli_usage_text[] =
     "usage: spinmodal solve [--csv] [--pretty] FILE|-\n"
     "       spinmodal validate [--pretty] FILE|-\n"
+    "       spinmodal import bmodes|elastodyn|csv FILE [--tip-radius R] [--hub-radius H]\n"
+    "                        [--rpm N] [--pretty] [--full]\n"
     "       spinmodal --help | --version\n";
 
 static void cli_help(void)
@@ -55,7 +58,10 @@ static void cli_help(void)
            "commands:\n"
            "  solve FILE|-     solve the JSON request in FILE (- = stdin) and print the\n"
            "                   result JSON on stdout\n"
-           "  validate FILE|-  check a request; print its canonical form and SHA-256\n\n"
+           "  validate FILE|-  check a request; print its canonical form and SHA-256\n"
+           "  import FORMAT FILE  turn a BModes .bmi (+ its section file), an ElastoDyn\n"
+           "                   blade file or a CSV of stations into a request (stdout);\n"
+           "                   ElastoDyn and CSV with s need --tip-radius; see README\n\n"
            "options:\n"
            "  --csv            print the frequency table as CSV instead of JSON\n"
            "  --pretty         indent the JSON output\n"
@@ -285,6 +291,8 @@ int main(int argc, char **argv)
 
     if (argc < 2)
         return cli_usage("a command is required");
+    if (!strcmp(argv[1], "import"))
+        return cli_import_main(argc, argv);
     for (i = 1; i < argc; i++) {
         const char *s = argv[i];
         if (!opts_done && (!strcmp(s, "-h") || !strcmp(s, "--help") || !strcmp(s, "help"))) {

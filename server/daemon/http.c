@@ -43,6 +43,7 @@
 #include <string.h>
 #include <sys/socket.h>
 
+#include "import.h"
 #include "log.h"
 
 /* ------------------------------------------------------ operational routes */
@@ -164,6 +165,9 @@ static void http_route_of(http_req *r, const char *url)
             memcpy(r->id, rest, 64);
             r->id[64] = '\0';
         }
+    } else if (strncmp(url, "/v1/import/", 11) == 0 && import_format_known(url + 11)) {
+        r->route = R_IMPORT;
+        r->tmpl = "/v1/import/{format}";
     } else if (strcmp(url, "/livez") == 0) {
         r->route = R_LIVEZ;
         r->tmpl = "/livez";
@@ -200,6 +204,7 @@ static unsigned http_route_methods(http_route route)
     case R_ANALYSES:
         return M_GET | M_HEAD | M_POST;
     case R_VALIDATE:
+    case R_IMPORT:
         return M_POST;
     case R_ANALYSIS:
         return M_GET | M_HEAD | M_DELETE;
@@ -289,9 +294,10 @@ static enum MHD_Result http_first(struct MHD_Connection *c, http_req *r)
 {
     enum MHD_Result q = MHD_YES;
 
-    if (r->method == M_POST && (r->route == R_ANALYSES || r->route == R_VALIDATE)) {
+    if (r->method == M_POST &&
+        (r->route == R_ANALYSES || r->route == R_VALIDATE || r->route == R_IMPORT)) {
         r->collect = 1;
-        if (!http_post_begin(c, r, &q))
+        if (!(r->route == R_IMPORT ? http_import_begin(c, r, &q) : http_post_begin(c, r, &q)))
             return q;
         return MHD_YES;
     }
@@ -339,6 +345,8 @@ static enum MHD_Result http_handler(void *cls, struct MHD_Connection *c, const c
         return MHD_YES;
     }
     http_guard_answering(h, c);
+    if (r->collect && r->route == R_IMPORT)
+        return http_import_end(c, r);
     return r->collect ? http_post_end(c, r) : http_answer(c, r);
 }
 

@@ -13,7 +13,8 @@
  *   http_reply.c     building responses: headers, problem documents, the
  *                    last-resort 503, small parsers of the request line;
  *   http_guard.c     the deadline for a request's head and body (slow
- *                    clients cannot hold connection slots).
+ *                    clients cannot hold connection slots);
+ *   http_import.c    POST /v1/import/{format}: blade files into requests.
  */
 #ifndef SPINMODAL_HTTP_INTERNAL_H
 #define SPINMODAL_HTTP_INTERNAL_H
@@ -63,7 +64,8 @@ typedef enum http_route {
     R_LIVEZ,
     R_READYZ,
     R_METRICS,
-    R_FILE           /* an embedded file (schemas, OpenAPI, /) */
+    R_FILE,          /* an embedded file (schemas, OpenAPI, /) */
+    R_IMPORT         /* /v1/import/{bmodes|elastodyn|csv} (http_import.c) */
 } http_route;
 
 /* State of the body of a POST. */
@@ -224,6 +226,14 @@ enum MHD_Result http_delete(struct MHD_Connection *c, http_req *r);
 
 /** Phase 3 of a POST: validate the body, then submit or describe it, and answer. */
 enum MHD_Result http_post_end(struct MHD_Connection *c, http_req *r);
+
+/* ----------------------------------------------------------- http_import.c */
+
+/** Phase 1 of POST /v1/import/{format}: as http_post_begin (1 = read the body). */
+int http_import_begin(struct MHD_Connection *c, http_req *r, enum MHD_Result *q);
+
+/** Phase 3 of POST /v1/import/{format}: import the body and answer. */
+enum MHD_Result http_import_end(struct MHD_Connection *c, http_req *r);
 
 /* ------------------------------------------------------------ http_guard.c */
 

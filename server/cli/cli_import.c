@@ -1,0 +1,273 @@
+/*
+ * cli_import.c — `spinmodal import {bmodes|elastodyn|csv} FILE [options]`:
+ * turn a blade file into a request (the importers of server/codec/import.h)
+ * and print it on stdout, ready for `spinmodal solve -`.
+ *
+ * How it fits: cli.c's main() hands every `import` command line here.  This
+ * file reads the files (BModes: the .bmi, then the section-properties file
+ * it names, relative to the .bmi's folder), calls the importer and prints
+ * the request; the importer's warnings (values it had to assume) go to
+ * stderr as "spinmodal: warning: ..." lines.  --full prints the whole import
+ * document {"request", "warnings", "source"} instead (what POST
+ * /v1/import/{format} answers).
+ *
+ * Exit codes: 0 imported, 2 the file is refused (one line
+ * "FILE:LINE: FIELD: what is wrong" on stderr, nothing on stdout), 1 the
+ * main file cannot be read or any other error, 64 usage error.
+ */
+#include "cli_import.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "import.h"
+
+enum { CLI_IMPORT_OK = 0, CLI_IMPORT_FAILED = 1, CLI_IMPORT_INVALID = 2, CLI_IMPORT_USAGE = 64 };
+
+static const char cli_import_usage_text[] =
+    "usage: spinmodal import bmodes FILE.bmi [--rpm N] [--pretty] [--full]\n"
+    "       spinmodal import elastodyn FILE --tip-radius R [--hub-radius H] [--rpm N] "
+    "[--pretty] [--full]\n"
+    "       spinmodal import csv FILE [--tip-radius R] [--hub-radius H] [--rpm N] [--pretty] "
+    "[--full]\n";
+
+/* Command-line settings of `import`. */
+typedef struct cli_import_args {
+    const char *format; /* bmodes, elastodyn, csv */
+    const char *path;   /* the file, "-" = stdin */
+    int pretty;         /* --pretty */
+    int full;           /* --full: the import document, not only the request */
+    import_options opt; /* --tip-radius, --hub-radius, --rpm */
+} cli_import_args;
+
+/* A file read whole; the loader's context for BModes. */
+typedef struct cli_import_files {
+    const char *main_path; /* the .bmi as given */
+    char *sec;             /* the section file's text (malloc'd) */
+} cli_import_files;
+
+static int cli_import_usage(const char *why)
+{
+    fprintf(stderr, "spinmodal: %s\n%s", why, cli_import_usage_text);
+    return CLI_IMPORT_USAGE;
+}
+
+/*
+ * Read all of path ("-" = stdin) into *buf (malloc'd, NUL-terminated), at
+ * most IMPORT_MAX_BYTES: 0, EFBIG when larger, or an errno value.
+ */
+static int cli_import_read(const char *path, char **buf, size_t *len)
+{
+    FILE *f = strcmp(path, "-") ? fopen(path, "rb") : stdin;
+    size_t cap = 65536, n = 0, got;
+    char *b, *nb;
+    int err = 0;
+
+    *buf = NULL;
+    *len = 0;
+    if (!f)
+        return errno ? errno : EIO;
+    b = malloc(cap + 1);
+    if (!b)
+        err = ENOMEM;
+    while (!err) {
+        if (n == cap) {
+            nb = realloc(b, cap * 2 + 1);
+            if (!nb) {
+                err = ENOMEM;
+                break;
+            }
+            b = nb;
+            cap *= 2;
+        }
+        got = fread(b + n, 1, cap - n, f);
+        if (got == 0) {
+            err = ferror(f) ? EIO : 0;
+            break;
+        }
+        n += got;
+        if (n > IMPORT_MAX_BYTES)
+            err = EFBIG;
+    }
+    if (f != stdin)
+        fclose(f);
+    if (err) {
+        free(b);
+        return err;
+    }
+    b[n] = '\0';
+    *buf = b;
+    *len = n;
+    return 0;
+}
+
+/* import_loader: the section file, relative to the folder of the .bmi. */
+static int cli_import_load(void *ctx, const char *name, import_file *out, char *why, size_t cap)
+{
+    cli_import_files *fs = ctx;
+    const char *slash = strrchr(fs->main_path, '/');
+    size_t dir = slash && name[0] != '/' ? (size_t)(slash - fs->main_path) + 1 : 0;
+    char *path = malloc(dir + strlen(name) + 1);
+    size_t len;
+    int err;
+
+    if (!path)
+        return SM_NOMEM;
+    memcpy(path, fs->main_path, dir);
+    strcpy(path + dir, name);
+    err = cli_import_read(path, &fs->sec, &len);
+    free(path);
+    if (err == ENOMEM)
+        return SM_NOMEM;
+    if (err) {
+        snprintf(why, cap, "%s", err == EFBIG ? "larger than 16 MiB" : strerror(err));
+        return SM_INVALID_INPUT;
+    }
+    out->name = NULL;
+    out->text = fs->sec;
+    out->len = len;
+    return SM_OK;
+}
+
+/* A number option's value: 0, or -1 when it is not a finite number. */
+static int cli_import_number(const char *s, double *v)
+{
+    char *end;
+
+    errno = 0;
+    *v = strtod(s, &end);
+    return end == s || *end != '\0' || errno || !isfinite(*v) ? -1 : 0;
+}
+
+/* Parse argv[2..] (argv[1] is "import"); 0, or an exit code. */
+static int cli_import_args_parse(int argc, char **argv, cli_import_args *a)
+{
+    static const char *const num_opts[3] = {"--tip-radius", "--hub-radius", "--rpm"};
+    double *num_dst[3];
+    int i, k, opts_done = 0;
+
+    import_default_options(&a->opt);
+    num_dst[0] = &a->opt.tip_radius;
+    num_dst[1] = &a->opt.hub_radius;
+    num_dst[2] = &a->opt.rpm;
+    for (i = 2; i < argc; i++) {
+        const char *s = argv[i];
+        if (!opts_done && !strcmp(s, "--")) {
+            opts_done = 1;
+            continue;
+        }
+        if (!opts_done && !strcmp(s, "--pretty")) {
+            a->pretty = 1;
+            continue;
+        }
+        if (!opts_done && !strcmp(s, "--full")) {
+            a->full = 1;
+            continue;
+        }
+        for (k = 0; !opts_done && k < 3; k++)
+            if (!strcmp(s, num_opts[k]))
+                break;
+        if (!opts_done && k < 3) {
+            if (i + 1 >= argc || cli_import_number(argv[i + 1], num_dst[k])) {
+                fprintf(stderr, "spinmodal: %s needs a number\n%s", s, cli_import_usage_text);
+                return CLI_IMPORT_USAGE;
+            }
+            i++;
+            continue;
+        }
+        if (!opts_done && s[0] == '-' && s[1] != '\0') {
+            fprintf(stderr, "spinmodal: unknown option '%s'\n%s", s, cli_import_usage_text);
+            return CLI_IMPORT_USAGE;
+        }
+        if (!a->format) {
+            if (!import_format_known(s)) {
+                fprintf(stderr, "spinmodal: unknown import format '%s' (bmodes, elastodyn or "
+                                "csv)\n%s", s, cli_import_usage_text);
+                return CLI_IMPORT_USAGE;
+            }
+            a->format = s;
+        } else if (!a->path) {
+            a->path = s;
+        } else {
+            return cli_import_usage("only one file may be given");
+        }
+    }
+    if (!a->format)
+        return cli_import_usage("a format is required: bmodes, elastodyn or csv");
+    if (!a->path)
+        return cli_import_usage("a file (or - for standard input) is required");
+    return 0;
+}
+
+/* Print the warnings, then the request (or the whole document); an exit code. */
+static int cli_import_print(const cli_import_args *a, const json_t *doc)
+{
+    const json_t *w = json_object_get(doc, "warnings");
+    char *text;
+    size_t i;
+    int ok;
+
+    for (i = 0; i < json_array_size(w); i++)
+        fprintf(stderr, "spinmodal: warning: %s\n", json_string_value(json_array_get(w, i)));
+    text = import_dumps(a->full ? doc : json_object_get(doc, "request"), a->pretty);
+    if (!text) {
+        fprintf(stderr, "spinmodal: out of memory\n");
+        return CLI_IMPORT_FAILED;
+    }
+    ok = fputs(text, stdout) != EOF && fputc('\n', stdout) != EOF && fflush(stdout) == 0;
+    free(text);
+    if (!ok) {
+        fprintf(stderr, "spinmodal: cannot write the request: %s\n", strerror(errno));
+        return CLI_IMPORT_FAILED;
+    }
+    return CLI_IMPORT_OK;
+}
+
+int cli_import_main(int argc, char **argv)
+{
+    cli_import_args a;
+    cli_import_files fs = {NULL, NULL};
+    import_file f;
+    import_diag d;
+    json_t *doc = NULL;
+    char *text = NULL;
+    size_t len = 0;
+    int rc, st, err;
+
+    memset(&a, 0, sizeof(a));
+    if ((rc = cli_import_args_parse(argc, argv, &a)))
+        return rc;
+    err = cli_import_read(a.path, &text, &len);
+    if (err) {
+        fprintf(stderr, "spinmodal: cannot read %s: %s\n",
+                strcmp(a.path, "-") ? a.path : "standard input",
+                err == EFBIG ? "larger than 16 MiB" : strerror(err));
+        return CLI_IMPORT_FAILED;
+    }
+    f.name = strcmp(a.path, "-") ? a.path : "<stdin>";
+    f.text = text;
+    f.len = len;
+    fs.main_path = strcmp(a.path, "-") ? a.path : "";
+    if (!strcmp(a.format, "bmodes"))
+        st = import_bmodes(&doc, &f, cli_import_load, &fs, &a.opt, &d);
+    else if (!strcmp(a.format, "elastodyn"))
+        st = import_elastodyn(&doc, &f, &a.opt, &d);
+    else
+        st = import_csv(&doc, &f, &a.opt, &d);
+    if (st == SM_OK) {
+        rc = cli_import_print(&a, doc);
+    } else if (st == SM_INVALID_INPUT) {
+        fprintf(stderr, "%s\n", d.text);
+        rc = CLI_IMPORT_INVALID;
+    } else {
+        fprintf(stderr, "spinmodal: import: %s\n", sm_strerror(st));
+        rc = CLI_IMPORT_FAILED;
+    }
+    json_decref(doc);
+    free(fs.sec);
+    free(text);
+    return rc;
+}

@@ -1,0 +1,107 @@
+/*
+ * import.h — importers: turn the files engineers already have into a
+ * spinmodal request in the blade form (DESIGN.md section 8, spec 12
+ * section 6).
+ *
+ * Three formats: BModes (a .bmi main file and the section-properties file
+ * it names), an OpenFAST ElastoDyn blade file, and CSV with a header row of
+ * station keys.  Each importer reads text already in memory (no file
+ * system access: the caller loads files, so the CLI and the daemon share
+ * the code) and returns an import document
+ *
+ *     {"request": {"blade": {...}, "frames": "per_element", "analysis": {...}},
+ *      "warnings": ["values assumed, ..."],
+ *      "source": {"format": "bmodes", "file": "...", ...}}
+ *
+ * whose "request" is what `spinmodal solve` takes.  A bad file is refused
+ * with one diagnostic naming the file, the line and the field:
+ * "blade_sec_props.dat:7: axial_stff: not a number (\"abc\")".
+ *
+ * Ownership: the json_t *out is a new reference (json_decref).  Status
+ * codes: SM_OK, SM_INVALID_INPUT (diag filled), SM_NOMEM.
+ */
+#ifndef SPINMODAL_IMPORT_H
+#define SPINMODAL_IMPORT_H
+
+#include <stddef.h>
+
+#include <jansson.h>
+
+#include "spinmodal.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define IMPORT_MAX_STATIONS 10000  /* rows of a station table */
+#define IMPORT_MAX_BYTES ((size_t)16 << 20) /* one input file */
+#define IMPORT_ELEMENTS 48         /* elements of the imported blade */
+#define IMPORT_DEFAULT_MODES 10    /* analysis.modes when the file gives none */
+
+/** One input file: its name for messages and its text (need not be NUL-terminated). */
+typedef struct import_file {
+    const char *name; /* shown in diagnostics, e.g. "blade_sec_props.dat" */
+    const char *text; /* contents, len bytes */
+    size_t len;
+} import_file;
+
+/** What a file may not say, given by the user (CLI options, HTTP query). */
+typedef struct import_options {
+    double tip_radius; /* m, from the spin axis along the blade; NAN = not given */
+    double hub_radius; /* m, >= 0; NAN = not given */
+    double rpm;        /* rev/min, >= 0; NAN = not given (overrides the file's) */
+    int max_modes;     /* cap of analysis.modes (the codec's limit) */
+} import_options;
+
+/** Every option "not given", max_modes the codec's default limit. */
+void import_default_options(import_options *o);
+
+/** Why a file was refused: "FILE:LINE: FIELD: what is wrong" and its parts. */
+typedef struct import_diag {
+    char file[128];   /* file name as given (truncated) */
+    int line;         /* 1-based, 0 = the file as a whole / an option */
+    char field[64];   /* the field or column of the format, or the option */
+    char message[400];/* what is wrong */
+    char text[640];   /* the whole sentence */
+} import_diag;
+
+/**
+ * Loads a file named by another one (BModes: the section-properties file
+ * named in the .bmi, relative to it).  Fills *out (memory owned by ctx,
+ * valid until import_bmodes returns; out->name NULL = the name as written).
+ * Returns SM_OK; SM_INVALID_INPUT with why[cap] saying why it cannot be
+ * read ("No such file or directory"; the importer names the file and the
+ * line that names it); or SM_NOMEM.
+ */
+typedef int (*import_loader)(void *ctx, const char *name, import_file *out, char *why,
+                             size_t cap);
+
+/**
+ * BModes v3: the .bmi main file (beam_type 1, blades only) and the section
+ * properties file it names, loaded through load(ctx, name, ...).
+ */
+int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void *ctx,
+                  const import_options *o, import_diag *d);
+
+/** OpenFAST ElastoDyn blade file; o->tip_radius is required (the file has no length). */
+int import_elastodyn(json_t **out, const import_file *f, const import_options *o,
+                     import_diag *d);
+
+/** CSV with a header row of station keys (units in brackets optional, '#' comments). */
+int import_csv(json_t **out, const import_file *f, const import_options *o, import_diag *d);
+
+/** 1 when name is an import format: "bmodes", "elastodyn" or "csv". */
+int import_format_known(const char *name);
+
+/**
+ * The import document as text, numbers at 15 significant digits (the
+ * importers round every number to that, so the text is exact); malloc'd,
+ * NULL when out of memory.  pretty: indented.
+ */
+char *import_dumps(const json_t *doc, int pretty);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* SPINMODAL_IMPORT_H */

@@ -1,0 +1,388 @@
+/*
+ * import_bmodes.c — BModes v3 input (NREL): the .bmi main file and the
+ * section-properties file it names, into the blade form (spec 12 section 6).
+ *
+ * The .bmi is read by position, line after line, in the order of BModes.f90
+ * (its main program: ReadCom skips a line, ReadVar takes the first token of
+ * the next line with a value); the names in diagnostics are BModes' own
+ * (rot_rpm, hub_rad, ...), whatever the comment on the line says (Test02
+ * writes "romg").  The section file: a title, n_secs, a blank line, column
+ * titles and units, then n_secs rows of 13 numbers.
+ *
+ * Mapping: radius - hub_rad -> length, hub_rad -> hub_radius, precone ->
+ * precone_deg, bl_thp -> pitch_deg, rot_rpm x rpm_mult -> analysis.rpm,
+ * modepr -> analysis.modes (capped), tip mass: cm_loc -> offset [0, cm_loc,
+ * 0], izz/iyy/ixx_tip -> inertia [I11 torsion, I22 flap, I33 lag],
+ * iyz/ixy/izx_tip -> products [I12, I23, I31] (x = lag axis 3, y = flap
+ * axis 2, z = span axis 1); every station property times its multiplier.
+ * nselt and el_loc are kept in "source" only: the blade gets
+ * IMPORT_ELEMENTS equal elements.  Towers (beam_type 2) and hub_conn other
+ * than 1 are refused.
+ */
+#include "import_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define BM_MAX_ELEMENTS 10000 /* nselt */
+#define BM_COLUMNS 13
+
+/* Reading one file of BModes. */
+typedef struct bm_in {
+    imp_reader r;
+    const char *file;
+    import_diag *d;
+} bm_in;
+
+static void bm_init(bm_in *b, const import_file *f, import_diag *d)
+{
+    imp_reader_init(&b->r, f);
+    b->file = f->name;
+    b->d = d;
+}
+
+static int bm_ends(bm_in *b, const char *field)
+{
+    return imp_fail(b->d, b->file, b->r.line + 1, field,
+                    "the file ends here (truncated?): this line is missing");
+}
+
+/* ReadCom: skip one line, whatever it holds. */
+static int bm_com(bm_in *b, const char *what)
+{
+    return imp_next(&b->r) ? SM_OK : bm_ends(b, what);
+}
+
+/* ReadVar: the first token of the next line that is not blank. */
+static int bm_tok(bm_in *b, const char *field, imp_tok *t)
+{
+    if (!imp_next_nonblank(&b->r))
+        return bm_ends(b, field);
+    t->s = b->r.s;
+    t->n = 0; /* a line of separators only: "missing value" */
+    imp_split(b->r.s, b->r.n, ",", t, 1);
+    return SM_OK;
+}
+
+static int bm_num(bm_in *b, const char *field, int kind, double *v)
+{
+    imp_tok t;
+    int st = bm_tok(b, field, &t);
+
+    return st ? st : imp_value(b->d, b->file, b->r.line, field, &t, kind, v);
+}
+
+static int bm_int(bm_in *b, const char *field, long lo, long hi, long *v)
+{
+    double x;
+    int st = bm_num(b, field, IMP_ANY, &x);
+
+    if (st)
+        return st;
+    if (x != floor(x) || x < (double)lo || x > (double)hi)
+        return imp_fail(b->d, b->file, b->r.line, field, "must be an integer in [%ld, %ld] (%.15g)",
+                        lo, hi, x);
+    *v = (long)x;
+    return SM_OK;
+}
+
+/* What the .bmi says. */
+typedef struct bm_main {
+    char title[200];
+    long beam_type, hub_conn, modepr, nselt;
+    double rot_rpm, rpm_mult, radius, hub_rad, precone, bl_thp;
+    double tip[9];  /* tip_mass, cm_loc, cm_axial, ixx, iyy, izz, ixy, izx, iyz */
+    char sec_file[256]; /* as printed (ASCII) */
+    char sec_raw[256];  /* as written, for the loader */
+    int sec_line;       /* line of sec_props_file in the .bmi */
+    double mult[10]; /* sec_mass .. tc_offst multipliers, file order */
+} bm_main;
+
+static const char *const bm_mult_names[10] = {
+    "sec_mass_mult", "flp_iner_mult", "lag_iner_mult", "flp_stff_mult", "edge_stff_mult",
+    "tor_stff_mult", "axial_stff_mult", "cg_offst_mult", "sc_offst_mult", "tc_offst_mult"};
+static const int bm_mult_kinds[10] = {IMP_POSITIVE, IMP_NONNEG,   IMP_NONNEG,   IMP_POSITIVE,
+                                      IMP_POSITIVE, IMP_POSITIVE, IMP_POSITIVE, IMP_ANY,
+                                      IMP_ANY,      IMP_ANY};
+
+/* The general parameters (lines 1-16 of a .bmi). */
+static int bm_general(bm_in *b, bm_main *m)
+{
+    imp_tok t;
+    size_t i = 0;
+    int st;
+
+    if ((st = bm_com(b, "header")) || (st = bm_com(b, "title")))
+        return st;
+    while (i < b->r.n && (b->r.s[i] == ' ' || b->r.s[i] == '\t'))
+        i++;
+    t.s = b->r.s + i;
+    t.n = b->r.n - i;
+    imp_tok_copy(m->title, sizeof(m->title), &t);
+    if ((st = bm_com(b, "blank line")) || (st = bm_com(b, "general parameters")) ||
+        (st = bm_tok(b, "Echo", &t)) || (st = bm_int(b, "beam_type", 1, 9, &m->beam_type)))
+        return st;
+    if (m->beam_type == 2)
+        return imp_fail(b->d, b->file, b->r.line, "beam_type",
+                        "towers are not supported yet (beam_type 2); only blades (1)");
+    if (m->beam_type != 1)
+        return imp_fail(b->d, b->file, b->r.line, "beam_type",
+                        "must be 1 (blade) or 2 (tower) (%ld)", m->beam_type);
+    if ((st = bm_num(b, "rot_rpm", IMP_NONNEG, &m->rot_rpm)) ||
+        (st = bm_num(b, "rpm_mult", IMP_NONNEG, &m->rpm_mult)) ||
+        (st = bm_num(b, "radius", IMP_POSITIVE, &m->radius)) ||
+        (st = bm_num(b, "hub_rad", IMP_NONNEG, &m->hub_rad)))
+        return st;
+    if (!(m->hub_rad < m->radius))
+        return imp_fail(b->d, b->file, b->r.line, "hub_rad",
+                        "must be less than radius %.15g (%.15g)", m->radius, m->hub_rad);
+    if ((st = bm_num(b, "precone", IMP_ANY, &m->precone)) ||
+        (st = bm_num(b, "bl_thp", IMP_ANY, &m->bl_thp)) ||
+        (st = bm_int(b, "hub_conn", 1, 3, &m->hub_conn)))
+        return st;
+    if (m->hub_conn != 1)
+        return imp_fail(b->d, b->file, b->r.line, "hub_conn",
+                        "only 1 (cantilevered) is supported (%ld)", m->hub_conn);
+    if ((st = bm_int(b, "modepr", 1, 100000, &m->modepr)) ||
+        (st = bm_tok(b, "TabDelim", &t)) || (st = bm_tok(b, "mid_node_tw", &t)))
+        return st;
+    return SM_OK;
+}
+
+/* Tip mass, distributed-property identifiers and multipliers. */
+static int bm_props(bm_in *b, bm_main *m)
+{
+    static const char *const tip_names[9] = {"tip_mass", "cm_loc",  "cm_axial",
+                                              "ixx_tip",  "iyy_tip", "izz_tip",
+                                              "ixy_tip",  "izx_tip", "iyz_tip"};
+    static const int tip_kinds[9] = {IMP_NONNEG, IMP_ANY,    IMP_ANY, IMP_NONNEG, IMP_NONNEG,
+                                     IMP_NONNEG, IMP_ANY,    IMP_ANY, IMP_ANY};
+    imp_tok t;
+    long id_mat;
+    int i, st;
+
+    if ((st = bm_com(b, "blank line")) || (st = bm_com(b, "tip mass properties")))
+        return st;
+    for (i = 0; i < 9; i++)
+        if ((st = bm_num(b, tip_names[i], tip_kinds[i], &m->tip[i])))
+            return st;
+    if ((st = bm_com(b, "blank line")) || (st = bm_com(b, "distributed-property identifiers")) ||
+        (st = bm_int(b, "id_mat", 1, 9, &id_mat)))
+        return st;
+    if (id_mat != 1)
+        return imp_fail(b->d, b->file, b->r.line, "id_mat",
+                        "must be 1 (isotropic; BModes has no other) (%ld)", id_mat);
+    if ((st = bm_tok(b, "sec_props_file", &t)))
+        return st;
+    if (t.n == 0 || t.n >= sizeof(m->sec_file))
+        return imp_fail(b->d, b->file, b->r.line, "sec_props_file",
+                        "expected a file name of 1 to %zu characters", sizeof(m->sec_file) - 1);
+    imp_tok_copy(m->sec_file, sizeof(m->sec_file), &t);
+    m->sec_line = b->r.line;
+    memcpy(m->sec_raw, t.s, t.n);
+    m->sec_raw[t.n] = '\0';
+    if ((st = bm_com(b, "blank line")) || (st = bm_com(b, "property scaling factors")))
+        return st;
+    for (i = 0; i < 10; i++)
+        if ((st = bm_num(b, bm_mult_names[i], bm_mult_kinds[i], &m->mult[i])))
+            return st;
+    return SM_OK;
+}
+
+/* nselt and el_loc (nselt + 1 numbers, over as many lines as they take). */
+static int bm_mesh(bm_in *b, bm_main *m, json_t *el_loc)
+{
+    imp_tok t[IMP_MAX_TOKENS];
+    long got = 0;
+    int st, i, n;
+
+    if ((st = bm_com(b, "blank line")) || (st = bm_com(b, "finite element discretization")) ||
+        (st = bm_int(b, "nselt", 1, BM_MAX_ELEMENTS, &m->nselt)) ||
+        (st = bm_com(b, "el_loc comment")))
+        return st;
+    while (got < m->nselt + 1) {
+        if (!imp_next_nonblank(&b->r))
+            return bm_ends(b, "el_loc");
+        n = imp_split(b->r.s, b->r.n, ",", t, IMP_MAX_TOKENS);
+        if (n > IMP_MAX_TOKENS)
+            n = IMP_MAX_TOKENS;
+        for (i = 0; i < n && got < m->nselt + 1; i++, got++) {
+            double v;
+            if ((st = imp_value(b->d, b->file, b->r.line, "el_loc", &t[i], IMP_ANY, &v)))
+                return st;
+            if (json_array_append_new(el_loc, json_real(imp_round(v))))
+                return SM_NOMEM;
+        }
+    }
+    return SM_OK;
+}
+
+/* The section-properties file into t, multipliers applied. */
+static int bm_sections(bm_in *b, const bm_main *m, imp_table *t)
+{
+    static const char *const col[BM_COLUMNS] = {
+        "sec_loc",   "str_tw",    "tw_iner",  "mass_den", "flp_iner", "edge_iner", "flp_stff",
+        "edge_stff", "tor_stff",  "axial_stff", "cg_offst", "sc_offst", "tc_offst"};
+    static const imp_key key[BM_COLUMNS] = {IK_S,       IK_TWIST,   IK_ITWIST, IK_MU,
+                                            IK_I_FLAP,  IK_I_EDGE,  IK_EI_FLAP, IK_EI_EDGE,
+                                            IK_GJ,      IK_EA,      IK_CG_E,   IK_SC_E,
+                                            IK_TC_E};
+    /* multiplier of each column: index into m->mult, -1 = none */
+    static const int mult[BM_COLUMNS] = {-1, -1, -1, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
+    imp_tok tok[BM_COLUMNS + 1];
+    long n_secs, i;
+    int st, c, n;
+
+    if ((st = bm_com(b, "header")) ||
+        (st = bm_int(b, "n_secs", 2, IMPORT_MAX_STATIONS, &n_secs)) ||
+        (st = bm_com(b, "blank line")) || (st = bm_com(b, "column titles")) ||
+        (st = bm_com(b, "column units")))
+        return st;
+    for (i = 0; i < n_secs; i++) {
+        imp_station *s;
+        if (!imp_next_nonblank(&b->r))
+            return imp_fail(b->d, b->file, b->r.line + 1, "sec_loc",
+                            "the file ends before station %ld of %ld (truncated?)", i + 1,
+                            n_secs);
+        n = imp_split(b->r.s, b->r.n, ",", tok, BM_COLUMNS + 1);
+        if (n < BM_COLUMNS)
+            return imp_fail(b->d, b->file, b->r.line, col[n],
+                            "missing: the row has %d columns, expected %d", n, BM_COLUMNS);
+        if (n > BM_COLUMNS)
+            return imp_fail(b->d, b->file, b->r.line, "row",
+                            "%d columns, expected %d (sec_loc ... tc_offst)", n, BM_COLUMNS);
+        if (!(s = imp_table_add(t)))
+            return SM_NOMEM;
+        s->line = b->r.line;
+        for (c = 0; c < BM_COLUMNS; c++) {
+            int kind = imp_key_kind(key[c]);
+            double v;
+            if ((st = imp_value(b->d, b->file, b->r.line, col[c], &tok[c], kind, &v)))
+                return st;
+            if (mult[c] >= 0)
+                v *= m->mult[mult[c]];
+            if ((st = imp_check(b->d, b->file, b->r.line, col[c], kind, v)))
+                return st;
+            s->v[key[c]] = v;
+        }
+    }
+    for (c = 0; c < BM_COLUMNS; c++)
+        t->mask |= 1u << key[c];
+    t->mask |= (1u << IK_CG_F) | (1u << IK_SC_F) | (1u << IK_TC_F); /* flap parts 0 */
+    return imp_table_order(b->d, b->file, t, "sec_loc");
+}
+
+/* The blade (everything but the stations) and the warnings of the .bmi. */
+static int bm_blade(const bm_main *m, const import_options *o, imp_blade *bl, json_t *warn)
+{
+    int bad = 0;
+
+    bl->length = m->radius - m->hub_rad;
+    bl->hub_radius = m->hub_rad;
+    bl->precone_deg = m->precone;
+    bl->pitch_deg = m->bl_thp;
+    bl->rpm = m->rot_rpm * m->rpm_mult;
+    if (!isnan(o->rpm)) {
+        bad |= imp_warn(warn, "rotor speed %g rpm given: the file's %g rpm (rot_rpm x "
+                        "rpm_mult) is not used", o->rpm, bl->rpm);
+        bl->rpm = o->rpm;
+    }
+    bl->modes = (int)m->modepr;
+    if (o->max_modes > 0 && bl->modes > o->max_modes) {
+        bad |= imp_warn(warn, "modepr %d is above the limit of %d modes: analysis.modes = %d",
+                        bl->modes, o->max_modes, o->max_modes);
+        bl->modes = o->max_modes;
+    }
+    bl->has_tip = m->tip[0] != 0.0 || m->tip[1] != 0.0 || m->tip[3] != 0.0 ||
+                  m->tip[4] != 0.0 || m->tip[5] != 0.0 || m->tip[6] != 0.0 ||
+                  m->tip[7] != 0.0 || m->tip[8] != 0.0;
+    bl->tip_mass = m->tip[0];
+    bl->tip_offset[1] = m->tip[1];     /* cm_loc, along the edgewise axis b2 */
+    bl->tip_inertia[0] = m->tip[5];    /* izz: torsion, about the span axis b1 */
+    bl->tip_inertia[1] = m->tip[4];    /* iyy: flap, about b2 */
+    bl->tip_inertia[2] = m->tip[3];    /* ixx: lag, about b3 */
+    bl->tip_products[0] = m->tip[8];   /* iyz -> I12 */
+    bl->tip_products[1] = m->tip[6];   /* ixy -> I23 */
+    bl->tip_products[2] = m->tip[7];   /* izx -> I31 */
+    if (m->tip[2] != 0.0)
+        bad |= imp_warn(warn, "cm_axial = %g m is ignored: BModes uses it for towers only",
+                        m->tip[2]);
+    return bad ? SM_NOMEM : SM_OK;
+}
+
+/* "source": what the .bmi said that the request does not carry. */
+static json_t *bm_source(const bm_main *m, const char *bmi, json_t *el_loc)
+{
+    json_t *src = json_object(), *mult = json_object();
+    int i, bad = !src || !mult;
+
+    for (i = 0; !bad && i < 10; i++)
+        bad |= json_object_set_new(mult, bm_mult_names[i], json_real(imp_round(m->mult[i])));
+    if (!bad) {
+        bad |= json_object_set_new(src, "format", json_string("bmodes"));
+        bad |= json_object_set_new(src, "file", imp_string(bmi));
+        bad |= json_object_set_new(src, "sec_props_file", json_string(m->sec_file));
+        bad |= json_object_set_new(src, "title", json_string(m->title));
+        bad |= json_object_set_new(src, "rot_rpm", json_real(imp_round(m->rot_rpm)));
+        bad |= json_object_set_new(src, "rpm_mult", json_real(imp_round(m->rpm_mult)));
+        bad |= json_object_set_new(src, "multipliers", mult);
+        mult = NULL;
+        bad |= json_object_set_new(src, "nselt", json_integer(m->nselt));
+        bad |= json_object_set(src, "el_loc", el_loc);
+        bad |= json_object_set_new(src, "note", json_string(
+            "BModes' element boundaries (nselt, el_loc) are not used: the blade is meshed "
+            "with blade.elements equal elements"));
+    }
+    json_decref(mult);
+    if (bad) {
+        json_decref(src);
+        return NULL;
+    }
+    return src;
+}
+
+int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void *ctx,
+                  const import_options *o, import_diag *d)
+{
+    json_t *warn = json_array(), *el_loc = json_array(), *src;
+    import_file sf = {NULL, NULL, 0};
+    imp_table t = {NULL, 0, 0, 0};
+    imp_blade bl;
+    bm_main m;
+    bm_in b;
+    char why[160];
+    int st;
+
+    *out = NULL;
+    memset(&m, 0, sizeof(m));
+    imp_blade_init(&bl);
+    if (!warn || !el_loc) {
+        st = SM_NOMEM;
+        goto done;
+    }
+    bm_init(&b, bmi, d);
+    if ((st = bm_general(&b, &m)) || (st = bm_props(&b, &m)) || (st = bm_mesh(&b, &m, el_loc)))
+        goto done;
+    why[0] = '\0';
+    st = load(ctx, m.sec_raw, &sf, why, sizeof(why));
+    if (st == SM_INVALID_INPUT)
+        st = imp_fail(d, bmi->name, m.sec_line, "sec_props_file", "cannot read \"%s\": %s",
+                      m.sec_file, why);
+    if (st)
+        goto done;
+    if (!sf.name)
+        sf.name = m.sec_file;
+    bm_init(&b, &sf, d);
+    if ((st = bm_sections(&b, &m, &t)) || (st = bm_blade(&m, o, &bl, warn)))
+        goto done;
+    src = bm_source(&m, bmi->name, el_loc);
+    *out = imp_document(&bl, &t, NULL, warn, src);
+    warn = NULL;
+    st = *out ? SM_OK : SM_NOMEM;
+done:
+    json_decref(warn);
+    json_decref(el_loc);
+    imp_table_clear(&t);
+    return st;
+}

@@ -1,0 +1,283 @@
+/*
+ * http_import.c — POST /v1/import/{bmodes|elastodyn|csv}: a blade file in,
+ * the import document {"request", "warnings", "source"} out (200), or a 422
+ * problem document naming the file, line and field that is wrong.
+ *
+ * How it fits: routed by http.c like /v1/validate (a POST whose body is
+ * collected by http_take_body under --max-body, the same guards and
+ * deadlines), but answered here: no request is validated, no model built,
+ * nothing stored or queued.  The importers (server/codec/import.h) only
+ * read the text once, linearly, so the cost is bounded by --max-body.
+ *
+ * Bodies: BModes needs two files, so it takes JSON {"main": ".bmi text",
+ * "sec_props": "section file text", "name": "optional .bmi name"};
+ * elastodyn and csv take the same JSON (without sec_props) or the raw text
+ * (text/plain, text/csv or application/octet-stream).  Query parameters:
+ * tip_radius, hub_radius, rpm (numbers, as the CLI options) and name (the
+ * file name used in messages).  The token is needed only under
+ * --auth-reads (as for /v1/validate: nothing is written).
+ */
+#include "http_internal.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+
+#include "import.h"
+
+/* Which body a file came from, for the pointer of a 422. */
+typedef struct http_import_in {
+    const char *format;    /* from the path */
+    int json;              /* the body is JSON */
+    import_file main;      /* the .bmi / blade file / CSV */
+    import_file sec;       /* BModes section file (JSON "sec_props") */
+    import_options opt;
+} http_import_in;
+
+/* The format of the path /v1/import/{format} (routed only when known). */
+static const char *http_import_format(const http_req *r)
+{
+    return r->path + strlen("/v1/import/");
+}
+
+/* 1 when the media type of ct (parameters ignored) is mt. */
+static int http_import_ctype(const char *ct, const char *mt)
+{
+    size_t n = strlen(mt);
+
+    if (!ct)
+        return 0;
+    while (*ct == ' ' || *ct == '\t')
+        ct++;
+    return strncasecmp(ct, mt, n) == 0 &&
+           (ct[n] == '\0' || ct[n] == ';' || ct[n] == ' ' || ct[n] == '\t');
+}
+
+int http_import_begin(struct MHD_Connection *c, http_req *r, enum MHD_Result *q)
+{
+    const char *ct = MHD_lookup_connection_value(c, MHD_HEADER_KIND,
+                                                 MHD_HTTP_HEADER_CONTENT_TYPE);
+    const char *cl = MHD_lookup_connection_value(c, MHD_HEADER_KIND,
+                                                 MHD_HTTP_HEADER_CONTENT_LENGTH);
+    int json = http_import_ctype(ct, "application/json");
+    int text = http_import_ctype(ct, "text/plain") || http_import_ctype(ct, "text/csv") ||
+               http_import_ctype(ct, "application/octet-stream");
+    long long n = 0;
+
+    if (r->h->auth_reads && !http_authorized(r->h, c)) {
+        *q = http_unauthorized(c, r);
+        return 0;
+    }
+    if (!json && (!text || strcmp(http_import_format(r), "bmodes") == 0)) {
+        *q = http_problem(c, r, MHD_HTTP_UNSUPPORTED_MEDIA_TYPE, NULL, "Unsupported Media Type",
+                          strcmp(http_import_format(r), "bmodes") == 0
+                              ? "A BModes import is JSON {\"main\": \"...\", \"sec_props\": "
+                                "\"...\"} (Content-Type: application/json)."
+                              : "The body is the file (Content-Type: text/plain, text/csv or "
+                                "application/octet-stream) or JSON {\"main\": \"...\"} "
+                                "(application/json).",
+                          NULL, 0);
+        return 0;
+    }
+    if (cl && (http_parse_int(cl, 0, (long long)r->h->max_body, &n) ||
+               (size_t)n > r->h->max_body)) {
+        *q = http_too_large(c, r);
+        return 0;
+    }
+    r->announced = cl ? (size_t)n : 0;
+    return 1;
+}
+
+/* 400 with a detail. */
+static enum MHD_Result http_import_bad(struct MHD_Connection *c, http_req *r,
+                                       const char *pointer, const char *message)
+{
+    codec_errors *errs = codec_errors_new();
+    json_t *p = NULL;
+
+    if (errs && codec_errors_add(errs, pointer, "%s", message) == SM_OK)
+        p = codec_problem_new(MHD_HTTP_BAD_REQUEST, NULL, "Bad Request",
+                              "The import body is not usable.", errs);
+    codec_errors_free(errs);
+    return http_respond_problem(c, r, MHD_HTTP_BAD_REQUEST, p, NULL, 0);
+}
+
+/* The query parameters into in->opt and in->main.name; 0, or -1 after a 400. */
+static int http_import_query(struct MHD_Connection *c, http_req *r, http_import_in *in,
+                             enum MHD_Result *q)
+{
+    static const char *const names[3] = {"tip_radius", "hub_radius", "rpm"};
+    double *dst[3] = {&in->opt.tip_radius, &in->opt.hub_radius, &in->opt.rpm};
+    const char *v;
+    char *end;
+    int k;
+
+    for (k = 0; k < 3; k++) {
+        v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, names[k]);
+        if (!v)
+            continue;
+        *dst[k] = strtod(v, &end);
+        if (end == v || *end != '\0' || !isfinite(*dst[k]) || *dst[k] < 0.0) {
+            *q = http_bad_query(c, r, names[k], "expected a number >= 0");
+            return -1;
+        }
+    }
+    v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "name");
+    if (v && *v)
+        in->main.name = v;
+    return 0;
+}
+
+/* A JSON body: main, sec_props, name; 0, or -1 after a 400/422 (*q). doc keeps the texts. */
+static int http_import_json(struct MHD_Connection *c, http_req *r, http_import_in *in,
+                            json_t **doc, enum MHD_Result *q)
+{
+    int bmodes = strcmp(in->format, "bmodes") == 0;
+    const char *key;
+    json_error_t jerr;
+    json_t *v;
+
+    *doc = json_loadb(r->body ? r->body : "", r->len, JSON_REJECT_DUPLICATES, &jerr);
+    if (!*doc || !json_is_object(*doc)) {
+        *q = http_import_bad(c, r, "", *doc ? "the body must be a JSON object" : jerr.text);
+        return -1;
+    }
+    json_object_foreach(*doc, key, v) {
+        if (strcmp(key, "main") && strcmp(key, "name") && (!bmodes || strcmp(key, "sec_props"))) {
+            char pointer[80];
+            snprintf(pointer, sizeof(pointer), "/%.60s", key);
+            *q = http_import_bad(c, r, pointer, bmodes ? "unknown key; expected main, sec_props "
+                                 "and name" : "unknown key; expected main and name");
+            return -1;
+        }
+        if (!json_is_string(v)) {
+            char pointer[80];
+            snprintf(pointer, sizeof(pointer), "/%s", key);
+            *q = http_import_bad(c, r, pointer, "must be a string (the file's text)");
+            return -1;
+        }
+    }
+    if (!json_object_get(*doc, "main") || (bmodes && !json_object_get(*doc, "sec_props"))) {
+        const char *miss = json_object_get(*doc, "main") ? "/sec_props" : "/main";
+        *q = http_import_bad(c, r, miss, bmodes ? "required: the .bmi text (main) and the "
+                             "section-properties file's text (sec_props)"
+                             : "required: the file's text");
+        return -1;
+    }
+    v = json_object_get(*doc, "main");
+    in->main.text = json_string_value(v);
+    in->main.len = json_string_length(v);
+    if ((v = json_object_get(*doc, "name")) && json_string_length(v) > 0)
+        in->main.name = json_string_value(v);
+    if ((v = json_object_get(*doc, "sec_props"))) {
+        in->sec.text = json_string_value(v);
+        in->sec.len = json_string_length(v);
+    }
+    return 0;
+}
+
+/* import_loader: the JSON's sec_props, under the name the .bmi gives it. */
+static int http_import_load(void *ctx, const char *name, import_file *out, char *why,
+                            size_t cap)
+{
+    const http_import_in *in = ctx;
+
+    (void)name;
+    (void)why;
+    (void)cap;
+    *out = in->sec;
+    out->name = NULL;
+    return SM_OK;
+}
+
+/* 422 for a refused file: errors[0] points at the body member (or query) that held it. */
+static enum MHD_Result http_import_refused(struct MHD_Connection *c, http_req *r,
+                                           const http_import_in *in, const import_diag *d)
+{
+    codec_errors *errs = codec_errors_new();
+    char pointer[80] = "";
+    json_t *p = NULL;
+
+    if (d->line == 0 && (!strcmp(d->field, "tip_radius") || !strcmp(d->field, "hub_radius") ||
+                         !strcmp(d->field, "rpm")))
+        snprintf(pointer, sizeof(pointer), "/query/%s", d->field);
+    else if (in->json)
+        snprintf(pointer, sizeof(pointer), "%s",
+                 in->main.name && !strcmp(d->file, in->main.name) ? "/main" : "/sec_props");
+    if (errs && codec_errors_add(errs, pointer, "%s", d->text) == SM_OK)
+        p = codec_problem_new(MHD_HTTP_UNPROCESSABLE_CONTENT, HTTP_PROBLEMS "import-invalid",
+                              "Unprocessable Content", d->text, errs);
+    codec_errors_free(errs);
+    if (p && (json_object_set_new(p, "file", json_string(d->file)) ||
+              json_object_set_new(p, "line", json_integer(d->line)) ||
+              json_object_set_new(p, "field", json_string(d->field)))) {
+        json_decref(p);
+        p = NULL;
+    }
+    return http_respond_problem(c, r, MHD_HTTP_UNPROCESSABLE_CONTENT, p, NULL, 0);
+}
+
+/* Run the importer and answer. */
+static enum MHD_Result http_import_run(struct MHD_Connection *c, http_req *r, http_import_in *in)
+{
+    import_diag d;
+    json_t *doc = NULL;
+    char *text;
+    int st;
+
+    in->opt.max_modes = r->h->limits.max_modes;
+    if (!strcmp(in->format, "bmodes"))
+        st = import_bmodes(&doc, &in->main, http_import_load, in, &in->opt, &d);
+    else if (!strcmp(in->format, "elastodyn"))
+        st = import_elastodyn(&doc, &in->main, &in->opt, &d);
+    else
+        st = import_csv(&doc, &in->main, &in->opt, &d);
+    if (st == SM_INVALID_INPUT)
+        return http_import_refused(c, r, in, &d);
+    if (st != SM_OK)
+        return http_send_oom(c, r);
+    text = import_dumps(doc, 0);
+    json_decref(doc);
+    if (!text)
+        return http_send_oom(c, r);
+    return http_respond(c, r, MHD_HTTP_OK, "application/json", text, strlen(text), 1, NULL, 0);
+}
+
+enum MHD_Result http_import_end(struct MHD_Connection *c, http_req *r)
+{
+    static const char *const default_names[3][2] = {
+        {"bmodes", "main.bmi"}, {"elastodyn", "blade.dat"}, {"csv", "stations.csv"}};
+    const char *ct = MHD_lookup_connection_value(c, MHD_HEADER_KIND,
+                                                 MHD_HTTP_HEADER_CONTENT_TYPE);
+    http_import_in in;
+    enum MHD_Result q;
+    json_t *doc = NULL;
+    int k;
+
+    if (r->body_state == BODY_TOO_LARGE)
+        return http_too_large(c, r);
+    if (r->body_state == BODY_NOMEM)
+        return http_send_oom(c, r);
+    memset(&in, 0, sizeof(in));
+    in.format = http_import_format(r);
+    import_default_options(&in.opt);
+    for (k = 0; k < 3; k++)
+        if (!strcmp(in.format, default_names[k][0]))
+            in.main.name = default_names[k][1];
+    in.json = http_import_ctype(ct, "application/json");
+    if (http_import_query(c, r, &in, &q))
+        return q;
+    if (in.json && http_import_json(c, r, &in, &doc, &q)) {
+        json_decref(doc);
+        return q;
+    }
+    if (!in.json) {
+        in.main.text = r->body ? r->body : "";
+        in.main.len = r->len;
+    }
+    q = http_import_run(c, r, &in);
+    json_decref(doc);
+    return q;
+}

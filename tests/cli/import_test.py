@@ -1,0 +1,136 @@
+#!/usr/bin/env python3
+"""`spinmodal import {bmodes|elastodyn|csv}`: exit codes, stdout JSON, stderr messages.
+
+Usage: import_test.py SPINMODAL REFERENCE_BLADES_DIR
+
+The importers' numbers and every bad-file message are checked by
+tests/codec/import_test.c; this checks the command: the request on stdout parses
+and is the blade form, warnings go to stderr, a refused file prints one
+"FILE:LINE: FIELD: ..." line and exits 2 with nothing on stdout, a missing
+file exits 1, bad options exit 64, and the section file is found relative to
+the .bmi wherever the command runs.
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+FAILURES = []
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what)
+    if not cond:
+        FAILURES.append(what)
+    return cond
+
+
+def run(exe, args, cwd=None, stdin=None):
+    p = subprocess.run([exe] + args, capture_output=True, timeout=60, cwd=cwd, input=stdin)
+    return p.returncode, p.stdout.decode("utf-8", "replace"), p.stderr.decode("utf-8", "replace")
+
+
+def main(argv):
+    if len(argv) != 3:
+        print("usage: import_test.py SPINMODAL REFERENCE_BLADES_DIR", file=sys.stderr)
+        return 64
+    exe, ref = os.path.abspath(argv[1]), os.path.abspath(argv[2])
+    bm = os.path.join(ref, "bmodes_certtest")
+    test02 = os.path.join(bm, "Test02_blade_with_tip_mass.bmi")
+    ed = os.path.join(ref, "elastodyn", "NRELOffshrBsline5MW_Blade.dat")
+    tmp = tempfile.mkdtemp(prefix="spinmodal-import-")
+    try:
+        # BModes: the request on stdout, from another working directory
+        rc, out, err = run(exe, ["import", "bmodes", test02], cwd=tmp)
+        check(rc == 0, "bmodes Test02: exit 0 (got %d, %s)" % (rc, err.strip()))
+        req = json.loads(out) if rc == 0 else {}
+        blade = req.get("blade", {})
+        check(set(req) == {"blade", "frames", "analysis"}, "bmodes: stdout is the request only")
+        check(blade.get("length") == 33.25 and blade.get("hub_radius") == 1.75,
+              "bmodes: length 33.25, hub_radius 1.75")
+        check(len(blade.get("stations", [])) == 21, "bmodes: 21 stations")
+        check(blade.get("stations", [{}] * 3)[2].get("mass_per_length") == 181.672,
+              "bmodes: station 3 mass_per_length 181.672")
+        check(blade.get("tip_mass") == {"mass": 40.0, "offset": [0.0, 0.05, 0.0],
+                                        "inertia": [2.5, 1.75, 10.0], "products": [0.0, 0.0, 0.0]},
+              "bmodes: tip mass 40 kg, offset [0, 0.05, 0], inertia [2.5, 1.75, 10]")
+        check(req.get("analysis", {}).get("rpm") == [60.0], "bmodes: analysis.rpm [60]")
+        check(err == "", "bmodes: nothing on stderr")
+        check("181.672," in out, "bmodes: numbers printed at 15 digits (181.672)")
+
+        # --full --pretty: the import document; --rpm overrides with a warning
+        rc, out, err = run(exe, ["import", "bmodes", test02, "--full", "--pretty", "--rpm", "30"])
+        doc = json.loads(out) if rc == 0 else {}
+        check(rc == 0 and set(doc) == {"request", "warnings", "source"},
+              "bmodes --full: request, warnings, source")
+        check(doc.get("request", {}).get("analysis", {}).get("rpm") == [30.0], "bmodes --rpm 30")
+        check(doc.get("source", {}).get("el_loc", [None])[-1] == 1.0, "bmodes: source.el_loc")
+        check("\n  " in out, "--pretty indents")
+        check(err.startswith("spinmodal: warning: rotor speed 30 rpm given"),
+              "bmodes --rpm: warning on stderr (%s)" % err.strip())
+
+        # a refused file: one line on stderr, exit 2, nothing on stdout
+        rc, out, err = run(exe, ["import", "bmodes", os.path.join(bm, "Test03_tower.bmi")])
+        check(rc == 2 and out == "", "tower: exit 2, no stdout (got %d)" % rc)
+        check(err.strip().endswith("Test03_tower.bmi:6: beam_type: towers are not supported "
+                                   "yet (beam_type 2); only blades (1)"), "tower: message (%s)" % err.strip())
+        # the section file is relative to the .bmi: copy the .bmi alone -> cannot read it
+        lone = os.path.join(tmp, "lone.bmi")
+        shutil.copy(test02, lone)
+        rc, out, err = run(exe, ["import", "bmodes", lone])
+        check(rc == 2 and err.strip() == lone + ":31: sec_props_file: cannot read "
+              "\"blade_sec_props.dat\": No such file or directory", "sec file missing: %s" % err.strip())
+        # a bad section file next to it
+        with open(os.path.join(bm, "blade_sec_props.dat")) as f:
+            lines = f.read().split("\n")
+        lines[7] = lines[7].replace("2611.3E+06", "abc")
+        with open(os.path.join(tmp, "blade_sec_props.dat"), "w") as f:
+            f.write("\n".join(lines))
+        rc, out, err = run(exe, ["import", "bmodes", "lone.bmi"], cwd=tmp)
+        check(rc == 2 and err.strip() == 'blade_sec_props.dat:8: axial_stff: not a number ("abc")',
+              "bad section file: exit 2 and message (%s)" % err.strip())
+
+        # ElastoDyn: needs --tip-radius
+        rc, out, err = run(exe, ["import", "elastodyn", ed, "--tip-radius", "63", "--hub-radius",
+                                 "1.5", "--rpm", "12.1"])
+        req = json.loads(out) if rc == 0 else {}
+        check(rc == 0 and req.get("blade", {}).get("length") == 61.5 and
+              len(req["blade"]["stations"]) == 49, "elastodyn: exit 0, length 61.5, 49 stations")
+        check(err.count("spinmodal: warning:") == 2, "elastodyn: 2 warnings (EA, GJ assumed)")
+        rc, out, err = run(exe, ["import", "elastodyn", ed])
+        check(rc == 2 and out == "" and ": tip_radius: the file does not give the blade length" in err,
+              "elastodyn without --tip-radius: exit 2 (%s)" % err.strip())
+
+        # CSV from stdin
+        text = b"# stations\nr [m], mass_per_length [kg/m], EI_flap [N m^2], EI_edge [N m^2]\n" \
+               b"1, 50, 1e7, 2e7\n6, 10, 1e6, 2e6\n"
+        rc, out, err = run(exe, ["import", "csv", "-"], stdin=text)
+        req = json.loads(out) if rc == 0 else {}
+        check(rc == 0 and req.get("blade", {}).get("hub_radius") == 1.0 and
+              req["blade"]["length"] == 5.0, "csv from stdin: hub 1, length 5 (%s)" % err.strip())
+        rc, out, err = run(exe, ["import", "csv", "-"], stdin=text.replace(b"[N m^2], EI_edge", b"[MPa], EI_edge"))
+        check(rc == 2 and err.strip() == "<stdin>:2: EI_flap: unknown unit [MPa]; expected [N m^2] (SI)",
+              "csv unknown unit: exit 2 (%s)" % err.strip())
+
+        # I/O and usage
+        rc, out, err = run(exe, ["import", "csv", os.path.join(tmp, "nope.csv")])
+        check(rc == 1 and "cannot read" in err, "missing file: exit 1")
+        for args, what in ((["import"], "no format"), (["import", "xml", "f"], "unknown format"),
+                           (["import", "csv"], "no file"), (["import", "csv", "a", "b"], "two files"),
+                           (["import", "csv", "a", "--tip-radius"], "option without value"),
+                           (["import", "csv", "a", "--tip-radius", "x"], "non-numeric option"),
+                           (["import", "csv", "a", "--bogus"], "unknown option")):
+            rc, out, err = run(exe, args)
+            check(rc == 64 and out == "" and "usage:" in err, "usage: %s -> exit 64 (got %d)" % (what, rc))
+        rc, out, err = run(exe, ["--help"])
+        check(rc == 0 and "import FORMAT FILE" in out, "--help mentions import")
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    print("%d failure(s)" % len(FAILURES))
+    return 1 if FAILURES else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
