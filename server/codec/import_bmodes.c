@@ -266,6 +266,17 @@ static int bm_sections(bm_in *b, const bm_main *m, imp_table *t)
                 return st;
             s->v[key[c]] = v;
         }
+        /* BModes' mass moments are about the reference axis (its torsional inertia is
+         * flp_iner + edge_iner with no mass cg^2 term, Struct.f90:1302); spinmodal's are about
+         * the centre of mass, which the chordwise cg offset moves off the axis: edge - mass cg^2
+         * (DESIGN.md 8). BModes itself needs it positive (its section mass matrix). */
+        double cg = s->v[IK_CG_E], ie = s->v[IK_I_EDGE] - s->v[IK_MU] * cg * cg;
+        if (ie < 0.0)
+            return imp_fail(b->d, b->file, b->r.line, "edge_iner",
+                            "%g kg m is below mass_den x cg_offst^2 = %g kg m: the section's mass "
+                            "moment about its reference axis cannot be smaller than that of its mass "
+                            "at the centre of mass", s->v[IK_I_EDGE], s->v[IK_MU] * cg * cg);
+        s->v[IK_I_EDGE] = imp_round(ie);
     }
     for (c = 0; c < BM_COLUMNS; c++)
         t->mask |= 1u << key[c];

@@ -145,6 +145,8 @@ static void expect_num(const json_t *doc, const char *path, double want, const c
         fail("%s: %s = %.17g, expected %.17g", what, path, got, want);
 }
 
+static void expect_error(const char *what, int st, const import_diag *d, const char *want);
+
 static void test_bmodes_good(void)
 {
     char *bmi1 = slurp("bmodes_certtest/Test01_nonunif_blade.bmi");
@@ -210,7 +212,7 @@ static void test_bmodes_good(void)
         char *a = edit(bmi1, 8, "1.0 ", "1.5 ");                 /* rpm_mult */
         char *b2 = edit(a, 11, "0. ", "2.5 ");                   /* precone */
         char *c = edit(b2, 12, "0. ", "-3 ");                    /* bl_thp */
-        char *e = edit(c, 34, "1.0 ", "2.0 ");                   /* sec_mass_mult */
+        char *e = edit(c, 34, "1.0 ", "1.2 ");                   /* sec_mass_mult */
         char *g = edit(e, 37, "1.0 ", "0.5 ");                   /* flp_stff_mult */
         char *h = edit(g, 41, "1.0 ", "-1 ");                    /* cg_offst_mult */
         if (bmodes(&doc, "m.bmi", h, sec, &d) != SM_OK) {
@@ -219,14 +221,27 @@ static void test_bmodes_good(void)
             expect_num(doc, "request/analysis/rpm/0", 90, "multipliers");
             expect_num(doc, "request/blade/precone_deg", 2.5, "multipliers");
             expect_num(doc, "request/blade/pitch_deg", -3, "multipliers");
-            expect_num(doc, "request/blade/stations/2/mass_per_length", 363.344, "multipliers");
+            expect_num(doc, "request/blade/stations/2/mass_per_length", 218.0064, "multipliers");
+            /* edge_iner about the reference axis -> about the centre of mass: - mass cg^2 */
+            expect_num(doc, "request/blade/stations/2/edge_inertia", 80.113 - 218.0064 * 0.032 * 0.032,
+                       "multipliers");
+            expect_num(doc, "request/blade/stations/2/flap_inertia", 68.241, "multipliers");
             expect_num(doc, "request/blade/stations/2/EI_flap", 510.31e6, "multipliers");
             expect_num(doc, "request/blade/stations/2/EI_edge", 1092.28e6, "multipliers");
             expect_num(doc, "request/blade/stations/2/cg_offset/0", -0.032, "multipliers");
-            expect_num(doc, "source/multipliers/sec_mass_mult", 2, "multipliers");
+            expect_num(doc, "source/multipliers/sec_mass_mult", 1.2, "multipliers");
         }
         json_decref(doc);
-        free(a), free(b2), free(c), free(e), free(g), free(h);
+        /* twice the mass puts mass x cg^2 above edge_iner at the tip: BModes itself fails there
+         * (its section mass matrix is not positive definite); the importer names the line */
+        char *k = edit(bmi1, 34, "1.0 ", "2.0 ");
+        int st = bmodes(&doc, "k.bmi", k, sec, &d);
+        expect_error("mass multiplier 2", st, &d,
+                     "blade_sec_props.dat:26: edge_iner: 0.747 kg m is below mass_den x cg_offst^2 = 1.09897 kg m: "
+                     "the section's mass moment about its reference axis cannot be smaller than that of its mass at "
+                     "the centre of mass");
+        json_decref(doc);
+        free(a), free(b2), free(c), free(e), free(g), free(h), free(k);
     }
     free(bmi1), free(bmi2), free(sec);
 }
