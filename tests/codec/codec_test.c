@@ -588,11 +588,13 @@ static void unit_csv(test_case *tc)
     sm_result res = {2, cases};
     char *csv = NULL;
     size_t len = 0;
+    /* per_rev is empty at rest; rpm = omega 60 / (2 pi) without a request */
     const char *want =
-        "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status\n"
-        "0,1,3.5,0.55704230082163375,0,3.5,,solved\n"
-        "0,2,20,3.183098861837907,0,20,,solved\n"
-        "20,,,,,,,no_equilibrium\n";
+        "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,"
+        "rpm\n"
+        "0,1,3.5,0.55704230082163375,0,3.5,,solved,,0\n"
+        "0,2,20,3.183098861837907,0,20,,solved,,0\n"
+        "20,,,,,,,no_equilibrium,,190.9859317102744\n";
 
     memset(cases, 0, sizeof(cases));
     cases[0].status = SM_CASE_SOLVED;
@@ -604,7 +606,7 @@ static void unit_csv(test_case *tc)
     cases[0].previous_index = prev;
     cases[1].omega = 20;
     cases[1].status = SM_CASE_NO_EQUILIBRIUM;
-    if (codec_result_csv(&csv, &len, &res) != SM_OK || strcmp(csv, want) || len != strlen(want))
+    if (codec_result_csv(&csv, &len, NULL, &res) != SM_OK || strcmp(csv, want) || len != strlen(want))
         fail(tc, "CSV:\n%s", csv ? csv : "(none)");
     free(csv);
 }
