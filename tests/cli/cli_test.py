@@ -197,17 +197,19 @@ def t_csv(tmp):
     rc, out, err = run(["solve", "--csv", write_request(tmp, "sweep.json", req)])
     lines = out.splitlines()
     check(rc == 0, "csv: exit 0 (got %d; %.200s)" % (rc, err))
-    check(lines[:1] == ["omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status"],
+    check(lines[:1] == ["omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,"
+                        "per_rev,rpm"],
           "csv: header")
     check(len(lines) == 1 + 3 * 4, "csv: 12 rows for 3 speeds x 4 modes (got %d)" % (len(lines) - 1))
     rows = [l.split(",") for l in lines[1:]]
-    check(all(len(r) == 8 for r in rows), "csv: 8 fields per row")
+    check(all(len(r) == 10 for r in rows), "csv: 10 fields per row")
     check(rows and rows[0][1] == "1" and rows[0][6] == "" and rows[-1][6] != "",
           "csv: modes numbered from 1, MAC empty at the first speed only")
     rc, out, err = run(["solve", "--csv", write_request(tmp, "angled.json", angled_beam(20, "single"))])
     lines = out.splitlines()
-    check(rc == 3 and len(lines) == 2 and lines[1].split(",")[1:] == ["", "", "", "", "", "", "no_equilibrium"],
-          "csv: a case without equilibrium is one row with its status (%s)" % lines[1:])
+    check(rc == 3 and len(lines) == 2 and lines[1].split(",")[1:8] == ["", "", "", "", "", "", "no_equilibrium"]
+          and lines[1].split(",")[8] == "" and abs(float(lines[1].split(",")[9]) - 20 * 60 / (2 * math.pi)) < 1e-12,
+          "csv: a case without equilibrium is one row with its status, no per_rev and its rpm (%s)" % lines[1:])
 
 
 def t_help_version(tmp):
@@ -297,7 +299,7 @@ def t_spatial(tmp):
               "spatial %s: in-plane frequencies are the planar ones to 1e-7 (%s vs %s)" % (what, got, want))
         rc, csv, err = run(["solve", "--csv", path])
         lines = csv.splitlines()
-        check(rc == 0 and lines[0] == "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status"
+        check(rc == 0 and lines[0] == "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm"
               and len(lines) == 17, "spatial %s: CSV header and one row per mode (%d lines)" % (what, len(lines)))
     # validate: the canonical form writes the spatial defaults out
     rc, out, err = run(["validate", write_request(tmp, "spatial.json", blade(variants[0][1], 4))])

@@ -162,12 +162,16 @@ def scenario_solve(d):
 
     text = c.csv(st["id"])
     lines = text.strip().split("\n")
-    check(lines[0] == "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status",
+    check(lines[0] == "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm",
           "csv(): header")
     check(len(lines) == 4, "csv(): 3 rows (%d)" % (len(lines) - 1))
     row = lines[1].split(",")
-    check(row[1] == "1" and close(float(row[2]), w1_cli, 1e-9) and row[-1] == "solved",
+    check(row[1] == "1" and close(float(row[2]), w1_cli, 1e-9) and row[7] == "solved",
           "csv(): row 1 is mode 1, omega1 as the CLI, solved")
+    # per_rev = omega1 / Omega and rpm = Omega 60 / (2 pi), appended after status (DESIGN.md 8)
+    check(close(float(row[8]), float(row[2]) / float(row[0]), 1e-15)
+          and close(float(row[9]), float(row[0]) * 60 / (2 * math.pi), 1e-15),
+          "csv(): per_rev = omega1 / Omega and rpm = Omega 60 / 2 pi")
     check(text == cli_solve(load_example("angled-beam-90.json"), csv=True) or
           all(close(float(a.split(",")[2]), float(b.split(",")[2]), 1e-9)
               for a, b in zip(lines[1:], cli_solve(load_example("angled-beam-90.json"), csv=True)
@@ -560,7 +564,7 @@ def scenario_curl(d):
     check(p.returncode == 0 and len(p.stdout.strip().split("\n")) == 5, "csv.sh REQUEST: exit 0, header + 4 rows (%d)"
           % p.returncode)
     p = run_sh("csv.sh", [noeq], env)
-    check(p.returncode == 1 and p.stdout.strip().split("\n")[-1].endswith(",no_equilibrium"),
+    check(p.returncode == 1 and p.stdout.strip().split("\n")[-1].split(",")[7] == "no_equilibrium",
           "csv.sh of a failed job: exit 1, CSV still printed (%d)" % p.returncode)
     p = run_sh("csv.sh", ["0" * 64], env)
     check(p.returncode == 3 and "404" in p.stderr, "csv.sh of an unknown id: exit 3, 404 (%d)" % p.returncode)

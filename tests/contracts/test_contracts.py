@@ -555,7 +555,9 @@ def t_negative():
                           "stability": {"stable": True, "negative_eigenvalues": 0},
                           "modes": [{"frequency_rad_s": 1.0, "frequency_hz": 0.16, "eigenvalue": [0.0, 1.0],
                                      "mac_to_previous": None, "previous_index": None,
-                                     "shape": {"re": [[0, 0, 0], [1, 0, 0]], "im": [[0, 0, 0], [0, 0, 0]]}}]}],
+                                     "shape": {"re": [[0, 0, 0], [1, 0, 0]], "im": [[0, 0, 0], [0, 0, 0]]},
+                                     "per_rev": 1.0}],
+                          "rpm": 9.549296585513721}],
                "timing_ms": {"equilibrium": 0.1, "linearize": 0.1, "eigen": 0.1}}
     validates(res_doc, "result", "baseline result document")
     check(not m.is_valid(res_doc, "result"), "mutated result schema (no shape.im) rejects a Coriolis result")
