@@ -276,6 +276,14 @@ json_t *blade_validate(val_ctx *v, const json_t *root, json_t *canon)
     blade_scalars(v, b, cb, g);
     if ((tm = json_object_get(b, "tip_mass")))
         tip_ok = blade_tip_mass(v, tm, cb, t);
+    if (json_object_get(b, "section") && sec_classify_as(json_object_get(b, "section"), 1) ==
+                                             SEC_PLANAR) {
+        field_error(v, "/blade/section", "a blade is spatial, and this section is %s: give it "
+                    "as EA, EI_flap, EI_edge, GJ and mass_per_length (or E, G, A, I_flap, I_edge, "
+                    "J and mass_per_length)", sec_form_name(SEC_PLANAR));
+        field_set(v, canon, "blade", cb);
+        return NULL;
+    }
     st = blade_structure(b, g, tip_ok ? t : NULL);
     if (!st)
         v->nomem = 1;
