@@ -14,8 +14,10 @@
  *       canonical_text and sha256 (exact: pins of the canonical form),
  *       same_sha_as / different_sha_from (other files of the folder),
  *       joint_names, speeds, options, structure (with the spatial arrays:
- *       spatial, joint_z, member_spatial, point_mass_inertia), sections
- *       (sm_section values), model (sizes from sm_model_get_info).
+ *       spatial, joint_z, joint_xy, member_spatial, point_mass_inertia,
+ *       point_mass_products, point_mass_offset, member_stations), sections
+ *       (sm_section values, offsets), model (sizes from sm_model_get_info),
+ *       rpm (codec_request_rpm) and input_warnings (exactly these).
  *
  * Spatial requests (DESIGN.md 7.3): a valid case with "spatial": true in
  * checks.json is read twice: by the codec alone (req_parse_codec_only, no
@@ -25,7 +27,8 @@
  * SHA-256, for the "model" checks.
  * Before the folders a few unit checks run (SHA-256 vector, error list cap,
  * problem document, CSV encoder, diag pointers; spatial_units.c: spatial
- * diag pointers and result rows).  One line per case; exit status 1 when
+ * diag pointers and result rows; blade_units.c: a solved blade's Hz,
+ * per-rev and rpm).  One line per case; exit status 1 when
  * anything failed.
  */
 #include <dirent.h>
@@ -783,7 +786,7 @@ static int cmp_name(const void *a, const void *b)
 int main(int argc, char **argv)
 {
     test_case tc = {"unit: sha256, error list, problem, csv, diag pointers, spatial diag and "
-                    "result rows", 0};
+                    "result rows, blade result (Hz, per-rev, rpm)", 0};
     char **names = NULL;
     size_t n = 0, cap = 0, i;
     struct dirent *de;
@@ -800,6 +803,7 @@ int main(int argc, char **argv)
     unit_diag(&tc);
     unit_spatial_diag(&tc);
     unit_spatial_result(&tc);
+    unit_blade_result(&tc);
     if (tc.failures)
         failed++;
     else
