@@ -320,6 +320,11 @@ static int cli_validate(const cli_args *a, const codec_request *req)
                             codec_request_canonical(req));
     int rc = CLI_OK;
 
+    if (doc && json_array_size(codec_request_input_warnings(req)) &&
+        json_object_set(doc, "input_warnings", (json_t *)codec_request_input_warnings(req))) {
+        json_decref(doc);
+        doc = NULL;
+    }
     if (!doc)
         return cli_fail("validate", SM_NOMEM);
     if (cli_print_json(stdout, doc, a->pretty)) {

@@ -357,6 +357,12 @@ def t_blade(tmp):
     rc, out, err = run(["solve", "--table", write_request(tmp, "slip.json", req)])
     check(rc == 0 and "warning: /blade/section/GJ: GJ = 0.5 N m^2" in out,
           "blade --table: a unit slip is printed as a warning with its pointer (%s)" % out.splitlines()[-1:])
+    rc, out, err = run(["validate", write_request(tmp, "slip.json", req)])
+    doc = json.loads(out) if rc == 0 else {}
+    check([w["pointer"] for w in doc.get("input_warnings", [])] == ["/blade/section/GJ"],
+          "blade validate: input_warnings with the pointer (%s)" % doc.get("input_warnings"))
+    rc, out, err = run(["validate", example])
+    check(rc == 0 and "input_warnings" not in json.loads(out), "blade validate: no warnings for the example")
     rc, out, err = run(["solve", "--csv", "--table", example])
     check(rc == 64, "blade: --csv with --table is a usage error (%d)" % rc)
 
