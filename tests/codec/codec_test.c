@@ -555,6 +555,19 @@ static void check_warnings(test_case *tc, const json_t *got, const json_t *want)
     }
 }
 
+/* checks.speeds / checks.rpm: the n numbers at got equal want exactly. */
+static void check_exact(test_case *tc, const char *what, const double *got, int n,
+                        const json_t *want)
+{
+    int k;
+
+    if (n != (int)json_array_size(want))
+        fail(tc, "%d %s values, expected %zu", n, what, json_array_size(want));
+    for (k = 0; k < n && k < (int)json_array_size(want); k++)
+        if (got[k] != json_number_value(json_array_get(want, (size_t)k)))
+            fail(tc, "%s %d is %.17g", what, k, got[k]);
+}
+
 /* A valid request and its checks. */
 static void run_valid(test_case *tc, const char *dir, const json_t *chk)
 {
@@ -563,7 +576,7 @@ static void run_valid(test_case *tc, const char *dir, const json_t *chk)
     const json_t *x;
     const double *sp;
     size_t i;
-    int n, k;
+    int n;
 
     if (!req)
         return;
@@ -588,19 +601,11 @@ static void run_valid(test_case *tc, const char *dir, const json_t *chk)
     }
     if ((x = json_object_get(chk, "speeds"))) {
         sp = codec_request_speeds(req, &n);
-        if (n != (int)json_array_size(x))
-            fail(tc, "%d speeds, expected %zu", n, json_array_size(x));
-        for (k = 0; k < n && k < (int)json_array_size(x); k++)
-            if (sp[k] != json_number_value(json_array_get(x, (size_t)k)))
-                fail(tc, "speed %d is %g", k, sp[k]);
+        check_exact(tc, "speed", sp, n, x);
     }
     if ((x = json_object_get(chk, "rpm"))) {
         sp = codec_request_rpm(req, &n);
-        if (n != (int)json_array_size(x))
-            fail(tc, "%d rpm, expected %zu", n, json_array_size(x));
-        for (k = 0; k < n && k < (int)json_array_size(x); k++)
-            if (sp[k] != json_number_value(json_array_get(x, (size_t)k)))
-                fail(tc, "rpm %d is %.17g", k, sp[k]);
+        check_exact(tc, "rpm", sp, n, x);
     }
     if ((x = json_object_get(chk, "input_warnings")))
         check_warnings(tc, codec_request_input_warnings(req), x);
