@@ -418,7 +418,8 @@ class Client:
 
 def parse_csv(text):
     """Rows of the daemon's frequency CSV as dicts (omega, mode, frequency_rad_s, frequency_hz,
-    status, mac_to_previous); numbers as float/int, empty fields as None."""
+    status, mac_to_previous, per_rev, rpm); numbers as float/int, empty fields as None (per_rev
+    at omega = 0, or from a daemon before these columns)."""
     rows = []
     for r in _csv.DictReader(io.StringIO(text)):
         rows.append({
@@ -428,8 +429,48 @@ def parse_csv(text):
             "frequency_hz": _num(r.get("frequency_hz")),
             "status": r.get("status"),
             "mac_to_previous": _num(r.get("mac_to_previous")),
+            "per_rev": _num(r.get("per_rev")),
+            "rpm": _num(r.get("rpm")),
         })
     return rows
+
+
+# Columns of format_table: key in a row, header, decimals (None: an integer or text).
+TABLE_COLUMNS = (("omega", "omega_rad_s", 4), ("rpm", "rpm", 2), ("mode", "mode", None),
+                 ("frequency_rad_s", "freq_rad_s", 6), ("frequency_hz", "freq_hz", 6),
+                 ("per_rev", "per_rev", 4), ("status", "status", None))
+
+
+def table_rows(result):
+    """The rows of a result document (DESIGN.md 4): one dict per speed and mode with omega, rpm,
+    mode, frequency_rad_s, frequency_hz, per_rev and status (mode and frequencies None for a
+    speed without modes; per_rev None at rest)."""
+    rows = []
+    for c in result.get("cases", []):
+        base = {"omega": c.get("omega"), "rpm": c.get("rpm"), "status": c.get("status")}
+        for k, m in enumerate(c.get("modes") or [None]):
+            m = m or {}
+            rows.append(dict(base, mode=k + 1 if m else None, frequency_rad_s=m.get("frequency_rad_s"),
+                             frequency_hz=m.get("frequency_hz"), per_rev=m.get("per_rev")))
+    return rows
+
+
+def format_table(rows):
+    """rows (table_rows or parse_csv) as an aligned text table: speed in rad/s and rpm, mode, the
+    frequency in rad/s, Hz and per revolution, status; every number of a column with the same
+    decimals, right-aligned; "-" for a missing value (the spinmodal CLI's --table)."""
+    def cell(v, dec):
+        if v is None:
+            return "-"
+        return "%.*f" % (dec, v) if dec is not None else str(v)
+    cells = [[cell(r.get(k), dec) for k, _, dec in TABLE_COLUMNS] for r in rows]
+    heads = [h for _, h, _ in TABLE_COLUMNS]
+    width = [max([len(h)] + [len(c[j]) for c in cells]) for j, h in enumerate(heads)]
+    lines = []
+    for row in [heads] + cells:
+        lines.append("  ".join(v.rjust(width[j]) if j < len(row) - 1 else v.ljust(width[j])
+                               for j, v in enumerate(row)))
+    return "\n".join(lines) + "\n"
 
 
 def _job_error(st):
@@ -491,6 +532,11 @@ def _cmd_solve(c, a):
     if has_result:
         if a.csv:
             sys.stdout.write(c.csv(st["id"]))
+        elif a.table:
+            res = st["result"] if "result" in st else c.result(st["id"])
+            sys.stdout.write(format_table(table_rows(res)))
+            for w in res.get("input_warnings", []):
+                print("warning: %s: %s" % (w.get("pointer"), w.get("message")))
         else:
             _dump(st["result"] if "result" in st else c.result(st["id"]), a.pretty)
     if st.get("state") != "done":
@@ -587,7 +633,11 @@ def _parser():
 
     s = sub.add_parser("solve", parents=[common], help="submit a request, wait, print the result")
     s.add_argument("request", help="request JSON file ('-' for stdin)")
-    s.add_argument("--csv", action="store_true", help="print the frequency CSV instead of JSON")
+    fmt = s.add_mutually_exclusive_group()
+    fmt.add_argument("--csv", action="store_true", help="print the frequency CSV instead of JSON")
+    fmt.add_argument("--table", action="store_true",
+                     help="print an aligned table: speed (rad/s, rpm), mode, frequency in rad/s, Hz "
+                          "and per revolution, status")
     s.add_argument("--timeout", type=float, default=None,
                    help="give up waiting after S seconds (exit 3; the job keeps running)")
     s.set_defaults(func=_cmd_solve)

@@ -42,11 +42,12 @@ typedef struct cli_args {
     const char *command; /* "solve" or "validate" */
     const char *path;    /* request file, "-" = stdin */
     int csv;             /* --csv: frequency table instead of JSON */
+    int table;           /* --table: aligned frequency table for a terminal */
     int pretty;          /* --pretty: indented JSON */
 } cli_args;
 
 static const char cli_usage_text[] =
-    "usage: spinmodal solve [--csv] [--pretty] FILE|-\n"
+    "usage: spinmodal solve [--csv | --table] [--pretty] FILE|-\n"
     "       spinmodal validate [--pretty] FILE|-\n"
     "       spinmodal import bmodes|elastodyn|csv FILE [--tip-radius R] [--hub-radius H]\n"
     "                        [--rpm N] [--pretty] [--full]\n"
@@ -64,6 +65,8 @@ static void cli_help(void)
            "                   ElastoDyn and CSV with s need --tip-radius; see README\n\n"
            "options:\n"
            "  --csv            print the frequency table as CSV instead of JSON\n"
+           "  --table          print an aligned table: speed (rad/s, rpm), mode,\n"
+           "                   frequency in rad/s, Hz and per revolution, status\n"
            "  --pretty         indent the JSON output\n"
            "  -h, --help       show this help\n"
            "  -V, --version    show the version\n\n"
@@ -167,13 +170,99 @@ static int cli_fail(const char *what, int status)
     return CLI_FAILED;
 }
 
-/* Print the documents of a run (JSON or CSV); returns an exit code. */
+/* Columns of --table: header, decimals (-1: an integer or text). */
+#define CLI_TABLE_COLS 7
+static const struct {
+    const char *head;
+    int decimals;
+} cli_table_cols[CLI_TABLE_COLS] = {
+    {"omega_rad_s", 4}, {"rpm", 2}, {"mode", -1}, {"freq_rad_s", 6}, {"freq_hz", 6},
+    {"per_rev", 4}, {"status", -1},
+};
+
+/* Cell text of a number with d decimals, "-" for null or absent. */
+static void cli_cell_num(char *cell, size_t n, const json_t *x, int d)
+{
+    if (json_is_number(x))
+        snprintf(cell, n, "%.*f", d, json_number_value(x));
+    else
+        snprintf(cell, n, "-");
+}
+
+/* The cells of one table row of case c and mode m (NULL: a case without modes). */
+static void cli_table_row(char cells[CLI_TABLE_COLS][40], const json_t *c, const json_t *m, int k)
+{
+    cli_cell_num(cells[0], 40, json_object_get(c, "omega"), cli_table_cols[0].decimals);
+    cli_cell_num(cells[1], 40, json_object_get(c, "rpm"), cli_table_cols[1].decimals);
+    if (m)
+        snprintf(cells[2], 40, "%d", k + 1);
+    else
+        snprintf(cells[2], 40, "-");
+    cli_cell_num(cells[3], 40, json_object_get(m, "frequency_rad_s"), cli_table_cols[3].decimals);
+    cli_cell_num(cells[4], 40, json_object_get(m, "frequency_hz"), cli_table_cols[4].decimals);
+    cli_cell_num(cells[5], 40, json_object_get(m, "per_rev"), cli_table_cols[5].decimals);
+    snprintf(cells[6], 40, "%.39s", json_string_value(json_object_get(c, "status")));
+}
+
+/* Print or measure (print 0: widen w) every row of the result's cases. */
+static void cli_table_rows(FILE *f, const json_t *cases, int w[CLI_TABLE_COLS], int print)
+{
+    char cells[CLI_TABLE_COLS][40];
+    const json_t *c, *m;
+    size_t i, k;
+    int j;
+
+    json_array_foreach(cases, i, c) {
+        const json_t *modes = json_object_get(c, "modes");
+        for (k = 0; k < (json_array_size(modes) ? json_array_size(modes) : 1); k++) {
+            m = json_array_get(modes, k);
+            cli_table_row(cells, c, m, (int)k);
+            for (j = 0; j < CLI_TABLE_COLS; j++) {
+                int len = (int)strlen(cells[j]);
+                if (!print && len > w[j])
+                    w[j] = len;
+                if (print)
+                    fprintf(f, j < CLI_TABLE_COLS - 1 ? "%*s  " : "%-*s\n", w[j], cells[j]);
+            }
+        }
+    }
+}
+
+/*
+ * --table: one row per speed and mode, every number of a column with the
+ * same decimals, right-aligned (DESIGN.md 8: rad/s, Hz and per revolution
+ * side by side).  0 or -1 on a write error.
+ */
+static int cli_print_table(FILE *f, const json_t *result)
+{
+    const json_t *cases = json_object_get(result, "cases"), *w = json_object_get(result,
+                                                                                 "input_warnings");
+    int width[CLI_TABLE_COLS], j;
+    size_t i;
+
+    for (j = 0; j < CLI_TABLE_COLS; j++)
+        width[j] = (int)strlen(cli_table_cols[j].head);
+    cli_table_rows(f, cases, width, 0);
+    for (j = 0; j < CLI_TABLE_COLS; j++)
+        fprintf(f, j < CLI_TABLE_COLS - 1 ? "%*s  " : "%-*s\n", width[j], cli_table_cols[j].head);
+    cli_table_rows(f, cases, width, 1);
+    for (i = 0; i < json_array_size(w); i++)
+        fprintf(f, "warning: %s: %s\n",
+                json_string_value(json_object_get(json_array_get(w, i), "pointer")),
+                json_string_value(json_object_get(json_array_get(w, i), "message")));
+    return ferror(f) || fflush(f) ? -1 : 0;
+}
+
+/* Print the documents of a run (JSON, CSV or the table); returns an exit code. */
 static int cli_output(const cli_args *a, const codec_run_out *out)
 {
     int rc = CLI_OK;
 
     if (a->csv) {
         if (fwrite(out->csv, 1, out->csv_len, stdout) != out->csv_len || fflush(stdout))
+            rc = CLI_FAILED;
+    } else if (a->table) {
+        if (cli_print_table(stdout, out->result))
             rc = CLI_FAILED;
     } else if (cli_print_json(stdout, out->result, a->pretty)) {
         rc = CLI_FAILED;
@@ -237,6 +326,11 @@ static int cli_validate(const cli_args *a, const codec_request *req)
                             codec_request_canonical(req));
     int rc = CLI_OK;
 
+    if (doc && json_array_size(codec_request_input_warnings(req)) &&
+        json_object_set(doc, "input_warnings", (json_t *)codec_request_input_warnings(req))) {
+        json_decref(doc);
+        doc = NULL;
+    }
     if (!doc)
         return cli_fail("validate", SM_NOMEM);
     if (cli_print_json(stdout, doc, a->pretty)) {
@@ -286,7 +380,7 @@ done:
 
 int main(int argc, char **argv)
 {
-    cli_args a = {NULL, NULL, 0, 0};
+    cli_args a = {NULL, NULL, 0, 0, 0};
     int i, opts_done = 0;
 
     if (argc < 2)
@@ -307,6 +401,8 @@ int main(int argc, char **argv)
             opts_done = 1;
         } else if (!opts_done && !strcmp(s, "--csv")) {
             a.csv = 1;
+        } else if (!opts_done && !strcmp(s, "--table")) {
+            a.table = 1;
         } else if (!opts_done && !strcmp(s, "--pretty")) {
             a.pretty = 1;
         } else if (!opts_done && s[0] == '-' && s[1] != '\0') {
@@ -328,7 +424,9 @@ int main(int argc, char **argv)
         return cli_usage("a command is required");
     if (!a.path)
         return cli_usage("a request file (or - for standard input) is required");
-    if (a.csv && strcmp(a.command, "solve"))
-        return cli_usage("--csv applies to solve only");
+    if ((a.csv || a.table) && strcmp(a.command, "solve"))
+        return cli_usage("--csv and --table apply to solve only");
+    if (a.csv && a.table)
+        return cli_usage("give --csv or --table, not both");
     return cli_run(&a);
 }

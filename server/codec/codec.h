@@ -145,6 +145,15 @@ const sm_options *codec_request_options(const codec_request *r);
 /** The speeds (rad/s) in request order; borrowed from r.  *n receives their count. */
 const double *codec_request_speeds(const codec_request *r, int *n);
 
+/** The speeds in rev/min (request order, as given when the request used rpm); borrowed. */
+const double *codec_request_rpm(const codec_request *r, int *n);
+
+/**
+ * The unit-slip warnings of r (DESIGN.md 8): an array [{"pointer",
+ * "message"}], empty when none; borrowed from r.
+ */
+const json_t *codec_request_input_warnings(const codec_request *r);
+
 /** Name of joint j (the joints are indexed in sorted name order), borrowed; NULL if out of range. */
 const char *codec_request_joint_name(const codec_request *r, int j);
 
@@ -208,12 +217,13 @@ int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
 
 /**
  * Encode the frequency table as CSV (header omega,mode,frequency_rad_s,
- * frequency_hz,eig_re,eig_im,mac_to_previous,status; one row per speed and
- * mode, one row with empty mode fields for a speed without modes).
+ * frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm; one row
+ * per speed and mode, one row with empty mode fields for a speed without
+ * modes).  r (may be NULL: rpm from omega) gives the rpm of each case.
  * *out receives a malloc'd NUL-terminated string (free), *len its length
  * (len may be NULL).  Returns SM_OK or SM_NOMEM.
  */
-int codec_result_csv(char **out, size_t *len, const sm_result *res);
+int codec_result_csv(char **out, size_t *len, const codec_request *r, const sm_result *res);
 
 /* --------------------------------------------------- problem (problem.c) */
 

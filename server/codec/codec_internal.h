@@ -7,6 +7,10 @@
  *   errors.c    the error list and RFC 6901 pointer building         err_
  *   field.c     reading one request field: check, report, canonical  field_
  *   section.c   a section in its planar or spatial forms             sec_
+ *   station.c   section properties along a member (stations)         stn_
+ *   blade.c     the "blade" form expanded to a structure             blade_
+ *   speeds.c    analysis.omega / analysis.rpm: numbers, lists, ranges spd_
+ *   warn.c      unit-slip warnings of a valid request                warn_
  *   validate.c  the request document walked field by field           val_
  *   request.c   canonical text, SHA-256, the core's arrays           req_
  *   diag.c      core diagnostics -> pointers, codec_model_new        diag_
@@ -88,6 +92,13 @@ typedef struct val_ctx {
     int spatial;                /* kind of the sections: 1 spatial, 0 planar, -1 not known
                                    (no usable section); DESIGN.md 7.3 */
     int nomem;                  /* an allocation failed */
+    /* stations (station.c, DESIGN.md 8): */
+    const json_t *cover;        /* section name -> mask (SM_ST_*) of the quantities that the
+                                   stations of every member using it give, or NULL */
+    const json_t *in_sections;  /* the request's sections object (borrowed), or NULL */
+    json_t *canon_sections;     /* their canonical copies (borrowed), or NULL */
+    int blade;                  /* 1 while the structure expanded from "blade" is checked:
+                                   a section without E, A, I is spatial (blade.c) */
 } val_ctx;
 
 /** A user-supplied name shortened for messages (at most 60 bytes + "..."). */
@@ -149,6 +160,17 @@ int field_int(val_ctx *v, const json_t *obj, const char *key, const char *base,
               json_t *canon, int required, long def, long lo, long hi,
               const char *limit_name, long *out);
 
+/**
+ * Vector field obj[key]: an array of n (1..3) numbers of kind, checked at
+ * base/key/k into out[0..n-1]; shape ("[x, y, z]") and unit go into
+ * messages.  Nothing is written to a canonical copy.  Returns 1 when valid.
+ */
+int field_vector(val_ctx *v, const json_t *obj, const char *key, const char *base, int n,
+                 enum field_real_kind kind, const char *shape, const char *unit, double *out);
+
+/** A new JSON array of the n reals x, or NULL when out of memory. */
+json_t *field_reals(const double *x, int n);
+
 /** Boolean field obj[key], default def when absent. */
 void field_bool(val_ctx *v, const json_t *obj, const char *key, const char *base,
                 json_t *canon, int def);
@@ -189,6 +211,13 @@ typedef enum sec_form {
  */
 sec_form sec_classify(const json_t *sec);
 
+/**
+ * sec_classify, except that with spatial set a section without E, A and I
+ * (a partial section whose stiffnesses the stations give, DESIGN.md 8) is
+ * SEC_STIFFNESS.
+ */
+sec_form sec_classify_as(const json_t *sec, int spatial);
+
 /** "planar (E, A, I, mass_per_length)", ... for messages; never NULL. */
 const char *sec_form_name(sec_form f);
 
@@ -196,20 +225,25 @@ const char *sec_form_name(sec_form f);
  * Check the section object sec (borrowed) at ptr in its form f (from
  * sec_classify, not SEC_NONE): unknown keys, fields of another form, the
  * required fields (> 0) and, spatial, the inertias (given > 0, or their
- * defaults written out).  Returns its canonical copy (new reference), or
+ * defaults written out), the offsets (written only when not zero).  A
+ * stiffness-form field whose SM_ST_* bit is in cover may be absent (the
+ * stations of every member using the section give it).  Returns its
+ * canonical copy (new reference), or
  * NULL after reporting a field of another form or running out of memory
  * (v->nomem).  The copy is complete only when no error was added.
  */
-json_t *sec_validate(val_ctx *v, const json_t *sec, const char *ptr, sec_form f);
+json_t *sec_validate(val_ctx *v, const json_t *sec, const char *ptr, sec_form f,
+                     unsigned cover);
 
 /**
  * The core's section from a validated canonical section (borrowed): planar
  * E, A, I, mu; spatial mu and the spatial block (material form: EA = E*A,
  * EI_flap = E*I_flap, EI_edge = E*I_edge, GJ = G*J, I_p/A = (I_flap +
  * I_edge)/A; stiffness form: I_p/A = (flap_inertia + edge_inertia)/mu).
+ * and the offsets; spatial: the request is spatial (sec_classify_as).
  * Every other field of *out is zero.
  */
-void sec_fill(const json_t *canon, sm_section *out);
+void sec_fill(const json_t *canon, int spatial, sm_section *out);
 
 /**
  * The request field of the canonical section canon (borrowed) behind a core
@@ -222,17 +256,97 @@ void sec_fill(const json_t *canon, sm_section *out);
 const char *sec_request_field(const json_t *canon, const char *core_field,
                               const char **relation);
 
+/* ====================================================== station.c: stn_ */
+
+/* Most stations on one member (DESIGN.md 8). */
+#define CODEC_MAX_STATIONS 1000
+
+/** Mask (SM_ST_*) of the quantities any station of the array stations (borrowed) gives. */
+unsigned stn_keys_mask(const json_t *stations);
+
+/** The SM_ST_* bit of a station key ("EA", "mass_per_length" ...), 0 for another name. */
+unsigned stn_section_bit(const char *key);
+
+/**
+ * For the input members array (borrowed, unchecked): a new object mapping
+ * each section name to the mask of the quantities that the stations of
+ * every member using it give (0 when one member has none).  NULL when out
+ * of memory.
+ */
+json_t *stn_cover(const json_t *members);
+
+/**
+ * Check mem's "stations" (present) at p (the member's pointer) and write
+ * their canonical copy, with the per-station default mass moments, into c
+ * (the member's canonical copy).  Reads v->in_sections, v->canon_sections.
+ */
+void stn_validate(val_ctx *v, const json_t *mem, const char *p, json_t *c);
+
+/**
+ * The core's stations from a canonical stations array (borrowed): out gets
+ * json_array_size(stations) entries (angles in rad).  Returns the mask.
+ */
+unsigned stn_fill(const json_t *stations, sm_station *out);
+
 /* ===================================================== validate.c: val_ */
 
 /**
  * Validate root (borrowed) against DESIGN.md section 3, appending every
  * error to errs.  Returns the canonical request (new reference; defaults
- * applied), or NULL when root is not an object or memory ran out.  The
+ * applied), or NULL when root is not an object or memory ran out, and in
+ * *structure the canonical structure to build the model from (new
+ * reference or NULL: the request's, or its blade's expansion).  The
  * request is valid only if no error was added.  *nomem is set to 1 when an
  * allocation failed (the errors may then be incomplete), else 0.
  */
 json_t *val_request(const json_t *root, const codec_limits *lim, codec_errors *errs,
-                    int *nomem);
+                    int *nomem, json_t **structure);
+
+/**
+ * The "structure" of root (borrowed) checked into canon["structure"] (the
+ * walk of validate.c; blade.c checks its expanded structure with it).
+ */
+void val_structure(val_ctx *v, const json_t *root, json_t *canon);
+
+/* ======================================================== blade.c: blade_ */
+
+/**
+ * Check root's "blade" (DESIGN.md 8), write its canonical copy (defaults
+ * written out) into canon["blade"] and return the canonical structure it
+ * stands for (new reference; the pitch added to the stations' twists), or
+ * NULL.  Errors point into /blade.
+ */
+json_t *blade_validate(val_ctx *v, const json_t *root, json_t *canon);
+
+/**
+ * The pointer p of the structure a blade was expanded to, moved into
+ * /blade ("/structure/members/0/stations/2/EA" -> "/blade/stations/2/EA").
+ * malloc'd; NULL when out of memory.
+ */
+char *blade_pointer(const char *p);
+
+/* ====================================================== speeds.c: spd_ */
+
+/** analysis.omega or analysis.rpm (exactly one) of an (borrowed) checked into can. */
+void spd_validate(val_ctx *v, const json_t *an, json_t *can);
+
+/** Number of speeds of a validated canonical analysis object (borrowed). */
+size_t spd_count(const json_t *an);
+
+/**
+ * The speeds of a validated canonical analysis (borrowed) in request order:
+ * omega (rad/s) and rpm (rev/min), spd_count entries each.
+ */
+void spd_fill(const json_t *an, double *omega, double *rpm);
+
+/* ======================================================== warn.c: warn_ */
+
+/**
+ * Unit-slip warnings (DESIGN.md 8) of a valid canonical structure st
+ * (borrowed): a new array [{"pointer", "message"}], empty when none; blade
+ * 1 moves the pointers into /blade.  NULL when out of memory.
+ */
+json_t *warn_collect(const json_t *st, int blade);
 
 /* ====================================================== request.c: req_ */
 
@@ -241,6 +355,19 @@ json_t *val_request(const json_t *root, const codec_limits *lim, codec_errors *e
  * from r; NULL if out of range.
  */
 const char *req_section_name(const codec_request *r, int s);
+
+/**
+ * The canonical structure the model of r is built from (borrowed): the
+ * request's "structure", or the one its "blade" stands for.
+ */
+const json_t *req_structure(const codec_request *r);
+
+/**
+ * Append an error about r at ptr (a pointer into the structure: moved into
+ * /blade for the blade form), message printf-style.  SM_OK or SM_NOMEM.
+ */
+int req_error(const codec_request *r, codec_errors *errs, const char *ptr, const char *fmt,
+              ...) CODEC_PRINTF(4, 5);
 
 /**
  * codec_request_parse without the core's structure check (topology, sizes)

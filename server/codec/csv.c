@@ -6,6 +6,9 @@
  * row per speed and mode (Campbell-diagram data for a spreadsheet), one row
  * with empty mode fields for a speed without modes.  Numbers are written at
  * full precision (%.17g); a value that is not finite is an empty field.
+ * The columns per_rev (frequency / omega, empty at rest) and rpm (the
+ * case's speed in rev/min, DESIGN.md 8) come last, after the columns of
+ * before, so a reader that takes columns by position still works.
  */
 #include "codec_internal.h"
 
@@ -20,23 +23,40 @@ static void csv_num(FILE *f, double x)
         fprintf(f, "%.17g", x);
 }
 
-int codec_result_csv(char **out, size_t *len, const sm_result *res)
+/* The columns after status: per_rev (frequency / omega, empty at rest) and rpm. */
+static void csv_tail(FILE *f, double freq, double omega, double rpm)
+{
+    fputc(',', f);
+    if (omega > 0)
+        csv_num(f, freq / omega);
+    fputc(',', f);
+    csv_num(f, rpm);
+    fputc('\n', f);
+}
+
+int codec_result_csv(char **out, size_t *len, const codec_request *r, const sm_result *res)
 {
     char *buf = NULL;
     size_t n = 0;
     FILE *f = open_memstream(&buf, &n);
-    int i, k;
+    const double *rpm = NULL;
+    int i, k, n_rpm = 0;
 
     *out = NULL;
     if (!f)
         return SM_NOMEM;
-    fputs("omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status\n", f);
+    if (r)
+        rpm = codec_request_rpm(r, &n_rpm);
+    fputs("omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,"
+          "per_rev,rpm\n", f);
     for (i = 0; i < res->n_cases; i++) {
         const sm_case *c = &res->cases[i];
         const char *st = codec_case_status_name(c->status);
+        double case_rpm = i < n_rpm ? rpm[i] : c->omega * 60 / CODEC_TWO_PI;
         if (c->n_modes == 0) {
             csv_num(f, c->omega);
-            fprintf(f, ",,,,,,,%s\n", st);
+            fprintf(f, ",,,,,,,%s", st);
+            csv_tail(f, NAN, 0, case_rpm);
         }
         for (k = 0; k < c->n_modes; k++) {
             double mac = c->mac_to_previous ? c->mac_to_previous[k] : -1;
@@ -52,7 +72,8 @@ int codec_result_csv(char **out, size_t *len, const sm_result *res)
             fputc(',', f);
             if (mac >= 0)
                 csv_num(f, mac);
-            fprintf(f, ",%s\n", st);
+            fprintf(f, ",%s", st);
+            csv_tail(f, c->frequency[k], c->omega, case_rpm);
         }
     }
     if (ferror(f)) {

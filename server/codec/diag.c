@@ -65,7 +65,7 @@ static char *diag_section_pointer(const codec_request *r, int s, const char *f,
                                   const char **relation)
 {
     const json_t *secs =
-        json_object_get(json_object_get(codec_request_canonical(r), "structure"), "sections");
+        json_object_get(req_structure(r), "sections");
     const char *name = req_section_name(r, s), *key;
     char *base = err_ptr_key("/structure/sections", name), *p;
 
@@ -87,11 +87,15 @@ static char *diag_options_pointer(const codec_request *r, const char *f, int ind
 {
     const json_t *canon = codec_request_canonical(r);
     const json_t *fr = json_object_get(canon, "frames");
-    const json_t *om = json_object_get(json_object_get(canon, "analysis"), "omega");
+    const json_t *an = json_object_get(canon, "analysis");
+    const char *unit = json_object_get(an, "rpm") ? "rpm" : "omega";
+    const json_t *om = json_object_get(an, unit);
 
-    if ((!strcmp(f, "omega") || !strcmp(f, "omegas")) && json_is_array(om) && index >= 0 &&
-        (size_t)index < json_array_size(om))
-        return err_fmt("/analysis/omega/%d", index);
+    if (!strcmp(f, "omega") || !strcmp(f, "omegas")) {
+        if (json_is_array(om) && index >= 0 && (size_t)index < json_array_size(om))
+            return err_fmt("/analysis/%s/%d", unit, index);
+        return err_fmt("/analysis/%s", unit);
+    }
 
     if (!strcmp(f, "frames") || !strcmp(f, "frames_param") || !strcmp(f, "per_member") ||
         !strcmp(f, "elements_per_frame")) {
@@ -111,7 +115,7 @@ static char *diag_options_pointer(const codec_request *r, const char *f, int ind
 static char *diag_joint_pointer(const codec_request *r, int j, const char *f)
 {
     const json_t *joints =
-        json_object_get(json_object_get(codec_request_canonical(r), "structure"), "joints");
+        json_object_get(req_structure(r), "joints");
     const char *name = codec_request_joint_name(r, j);
     char *base = err_ptr_key("/structure/joints", name), *p;
     int k = !strcmp(f, "x") ? 0 : !strcmp(f, "y") ? 1 : !strcmp(f, "z") ? 2 : -1;
@@ -136,8 +140,9 @@ static char *diag_pointer(const codec_request *r, const sm_diag *d, const char *
     char *base, *p;
 
     static const char *const member_fields[] = {"id", "from", "to", "section", "elements",
-                                                "twist_deg", "flap_direction", NULL};
-    static const char *const pm_fields[] = {"joint", "mass", "inertia", NULL};
+                                                "twist_deg", "flap_direction", "stations", NULL};
+    static const char *const pm_fields[] = {"joint", "mass", "inertia", "products", "offset",
+                                            NULL};
     const char *const *known;
 
     *relation = NULL;
@@ -192,10 +197,11 @@ int codec_diag_error(const codec_request *r, const sm_diag *d, codec_errors *err
         err_mark_nomem(errs);
         return SM_NOMEM;
     }
+    /* req_error moves a structure pointer into /blade for the blade form */
     if (relation)
-        rc = codec_errors_add(errs, p, "%s (%s)", msg, relation);
+        rc = req_error(r, errs, p, "%s (%s)", msg, relation);
     else
-        rc = codec_errors_add(errs, p, "%s", msg);
+        rc = req_error(r, errs, p, "%s", msg);
     free(p);
     return rc;
 }

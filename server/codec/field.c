@@ -378,3 +378,49 @@ const char *field_ref(val_ctx *v, const json_t *obj, const char *key, const char
     field_set(v, canon, key, json_string(s));
     return names ? s : NULL;
 }
+
+/* Vector field obj[key] of n (<= 3) numbers of kind; see codec_internal.h. */
+int field_vector(val_ctx *v, const json_t *obj, const char *key, const char *base, int n,
+                 enum field_real_kind kind, const char *shape, const char *unit, double *out)
+{
+    const json_t *x = json_object_get(obj, key);
+    char *p = err_ptr_key(base, key);
+    size_t k;
+    int ok = 1;
+
+    if (!p) {
+        v->nomem = 1;
+        return 0;
+    }
+    if (!json_is_array(x) || json_array_size(x) != (size_t)n) {
+        if (json_is_array(x))
+            field_error(v, p, "must be %s (%d numbers), got %zu value%s", shape, n,
+                        json_array_size(x), json_array_size(x) == 1 ? "" : "s");
+        else
+            field_error(v, p, "must be %s (%d numbers), not %s", shape, n, field_type_name(x));
+        free(p);
+        return 0;
+    }
+    for (k = 0; k < (size_t)n; k++) {
+        char *pk = err_ptr_idx(p, k);
+        if (!field_check_real(v, json_array_get(x, k), pk ? pk : p, kind, unit, &out[k]))
+            ok = 0;
+        free(pk);
+    }
+    free(p);
+    return ok;
+}
+
+/* [out[0], ..., out[n-1]] as reals; NULL when out of memory. */
+json_t *field_reals(const double *x, int n)
+{
+    json_t *a = json_array();
+    int k;
+
+    for (k = 0; a && k < n; k++)
+        if (json_array_append_new(a, json_real(x[k]))) {
+            json_decref(a);
+            return NULL;
+        }
+    return a;
+}

@@ -181,6 +181,14 @@ void codec_validate_doc(codec_text *t, const char *id, const codec_request *req)
     codec_text_printf(t, "{\"valid\":true,\"id\":\"%s\",\"request_sha256\":\"%s\",\"canonical\":",
                       id, codec_request_sha256(req));
     codec_text_puts(t, codec_request_canonical_text(req));
+    if (json_array_size(codec_request_input_warnings(req))) { /* DESIGN.md 8: unit slips */
+        char *w = json_dumps(codec_request_input_warnings(req), JSON_COMPACT);
+        if (!w)
+            t->nomem = 1;
+        codec_text_puts(t, ",\"input_warnings\":");
+        codec_text_puts(t, w ? w : "[]");
+        free(w);
+    }
     codec_text_puts(t, "}");
 }
 

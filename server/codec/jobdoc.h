@@ -95,7 +95,8 @@ int codec_job_id(const struct codec_request *req, char id[65]);
 
 /**
  * Append the answer of a valid POST /v1/validate:
- * {"valid":true,"id","request_sha256","canonical"}; id from codec_job_id.
+ * {"valid":true,"id","request_sha256","canonical"[,"input_warnings"]}; id
+ * from codec_job_id; input_warnings only when the request has any.
  */
 void codec_validate_doc(codec_text *t, const char *id, const struct codec_request *req);
 

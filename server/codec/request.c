@@ -13,6 +13,7 @@
  */
 #include "codec_internal.h"
 
+#include <stdarg.h>
 #include <stdlib.h>
 #include <math.h>
 #include <stdio.h>
@@ -25,6 +26,10 @@
 
 struct codec_request {
     json_t *canon;              /* canonical request, defaults applied */
+    json_t *structure;          /* canonical structure of the model: canon's, or the one its
+                                   "blade" stands for (blade.c) */
+    int blade;                  /* 1 for the blade form: pointers move into /blade */
+    json_t *warnings;           /* input_warnings (warn.c), an array, maybe empty */
     char *canon_text;           /* its sorted compact dump */
     char sha[65];               /* SHA-256 of canon_text, hex */
     const char **joint_names;   /* n_joints, sorted, borrowed from canon */
@@ -34,7 +39,9 @@ struct codec_request {
     sm_section *sections;       /* n_sections */
     sm_member *members;         /* n_members */
     sm_point_mass *point_masses;/* n_point_masses (NULL if 0) */
-    double *speeds;             /* n_speeds, request order */
+    sm_station *stations;       /* every member's stations, member after member (or NULL) */
+    double *speeds;             /* n_speeds, request order, rad/s */
+    double *rpm;                /* n_speeds, the same in rev/min */
     int n_speeds;
     sm_structure st;            /* points into the arrays above */
     sm_options opt;             /* from the analysis and frames fields */
@@ -84,11 +91,12 @@ static double req_number(const json_t *x)
 /*
  * Joints and sections arrays, sorted by name.  The request is spatial when
  * its sections are (validate.c made them all of one kind); then every
- * canonical joint is [x, y, z].
+ * canonical joint is [x, y, z], which is how it is told here (a section
+ * that its members' stations complete may have no field of its form).
  */
 static int req_build_tables(codec_request *r)
 {
-    const json_t *st = json_object_get(r->canon, "structure");
+    const json_t *st = r->structure;
     const json_t *joints = json_object_get(st, "joints");
     const json_t *secs = json_object_get(st, "sections");
     int i, nj = 0, ns = 0;
@@ -101,10 +109,10 @@ static int req_build_tables(codec_request *r)
     r->sections = calloc((size_t)(ns ? ns : 1), sizeof(sm_section));
     if (!r->joint_xy || !r->sections)
         return SM_NOMEM;
+    /* a spatial request writes every joint as [x, y, z] (validate.c), a planar one [x, y] */
+    r->st.spatial = nj > 0 && json_array_size(json_object_get(joints, r->joint_names[0])) == 3;
     for (i = 0; i < ns; i++)
-        sec_fill(json_object_get(secs, r->section_names[i]), &r->sections[i]);
-    r->st.spatial = ns > 0 && sec_classify(json_object_get(secs, r->section_names[0])) >=
-                                  SEC_STIFFNESS;
+        sec_fill(json_object_get(secs, r->section_names[i]), r->st.spatial, &r->sections[i]);
     if (r->st.spatial && !(r->joint_z = malloc((size_t)(nj ? nj : 1) * sizeof(double))))
         return SM_NOMEM;
     for (i = 0; i < nj; i++) {
@@ -133,15 +141,72 @@ static void req_member_spatial(const json_t *x, sm_member *b)
         b->e3[k] = req_number(json_array_get(e3, (size_t)k));
 }
 
+/*
+ * The stations of every member (DESIGN.md 8, station.c) into r->stations;
+ * a section field that only the stations give (absent from a partial
+ * section: zero) takes the member's first station's value, so the section
+ * stays valid for the core, which reads that field from the stations.
+ */
+static int req_build_stations(codec_request *r, const json_t *mems)
+{
+    const json_t *x;
+    size_t i, total = 0, at = 0;
+
+    json_array_foreach(mems, i, x)
+        total += json_array_size(json_object_get(x, "stations"));
+    if (!total)
+        return SM_OK;
+    if (!(r->stations = calloc(total, sizeof(sm_station))))
+        return SM_NOMEM;
+    json_array_foreach(mems, i, x) {
+        const json_t *sts = json_object_get(x, "stations");
+        sm_member *b = &r->members[i];
+        sm_section *c = b->section >= 0 ? &r->sections[b->section] : NULL;
+        size_t n = json_array_size(sts);
+        if (!n)
+            continue;
+        b->stations = r->stations + at;
+        b->n_stations = (int)n;
+        b->station_mask = stn_fill(sts, r->stations + at);
+#define REQ_FROM_STATION(bit, f) if (c && (b->station_mask & (bit)) && c->f == 0) c->f = b->stations[0].f;
+        REQ_FROM_STATION(SM_ST_MU, mu) REQ_FROM_STATION(SM_ST_EA, EA)
+        REQ_FROM_STATION(SM_ST_EI_FLAP, EI_flap) REQ_FROM_STATION(SM_ST_EI_EDGE, EI_edge)
+        REQ_FROM_STATION(SM_ST_GJ, GJ) REQ_FROM_STATION(SM_ST_I_FLAP, i_flap)
+        REQ_FROM_STATION(SM_ST_I_EDGE, i_edge)
+#undef REQ_FROM_STATION
+        if (c && c->ip_over_a == 0 && c->mu > 0) /* DESIGN.md 7.3, stiffness form */
+            c->ip_over_a = (c->i_flap + c->i_edge) / c->mu;
+        at += n;
+    }
+    return SM_OK;
+}
+
+/* The point mass x (canonical) into p: joint, mass and the spatial inertia, products, offset. */
+static void req_point_mass(codec_request *r, const json_t *x, sm_point_mass *p)
+{
+    const json_t *in = json_object_get(x, "inertia"), *pr = json_object_get(x, "products");
+    const json_t *off = json_object_get(x, "offset");
+    int k;
+
+    p->joint = req_name_index(r->joint_names, r->st.n_joints,
+                              json_string_value(json_object_get(x, "joint")));
+    p->mass = req_number(json_object_get(x, "mass"));
+    for (k = 0; k < 3; k++) {
+        p->inertia[k] = req_number(json_array_get(in, (size_t)k));
+        p->products[k] = req_number(json_array_get(pr, (size_t)k));
+        p->offset[k] = req_number(json_array_get(off, (size_t)k));
+    }
+}
+
 /* Members, point masses and clamp as indices. */
 static int req_build_structure(codec_request *r)
 {
-    const json_t *st = json_object_get(r->canon, "structure");
+    const json_t *st = r->structure;
     const json_t *mems = json_object_get(st, "members");
     const json_t *pms = json_object_get(st, "point_masses");
     const json_t *x;
     size_t i, nm = json_array_size(mems), np = json_array_size(pms);
-    int nj = r->st.n_joints, ns = r->st.n_sections, k;
+    int nj = r->st.n_joints, ns = r->st.n_sections;
 
     r->members = calloc(nm ? nm : 1, sizeof(sm_member));
     r->point_masses = np ? calloc(np, sizeof(sm_point_mass)) : NULL;
@@ -157,21 +222,15 @@ static int req_build_structure(codec_request *r)
         r->members[i].elements = (int)json_integer_value(json_object_get(x, "elements"));
         req_member_spatial(x, &r->members[i]);
     }
-    json_array_foreach(pms, i, x) {
-        const json_t *in = json_object_get(x, "inertia");
-        r->point_masses[i].joint = req_name_index(r->joint_names, nj,
-                                                  json_string_value(json_object_get(x, "joint")));
-        r->point_masses[i].mass = req_number(json_object_get(x, "mass"));
-        for (k = 0; k < 3; k++)
-            r->point_masses[i].inertia[k] = req_number(json_array_get(in, (size_t)k));
-    }
+    json_array_foreach(pms, i, x)
+        req_point_mass(r, x, &r->point_masses[i]);
     r->st.n_members = (int)nm;
     r->st.members = r->members;
     r->st.n_point_masses = (int)np;
     r->st.point_masses = r->point_masses;
     r->st.clamp = req_name_index(r->joint_names, nj,
                                  json_string_value(json_object_get(st, "clamp")));
-    return SM_OK;
+    return req_build_stations(r, mems);
 }
 
 /* sm_options and speeds from frames and analysis. */
@@ -179,9 +238,8 @@ static int req_build_options(codec_request *r)
 {
     const json_t *an = json_object_get(r->canon, "analysis");
     const json_t *fr = json_object_get(r->canon, "frames");
-    const json_t *om = json_object_get(an, "omega");
     const json_t *mpf = json_object_get(an, "modes_per_frame");
-    size_t i, n = json_is_array(om) ? json_array_size(om) : 1;
+    size_t n = spd_count(an);
 
     sm_default_options(&r->opt);
     if (json_is_string(fr)) {
@@ -206,10 +264,10 @@ static int req_build_options(codec_request *r)
     r->opt.mode_shapes = json_is_true(json_object_get(an, "mode_shapes"));
 
     r->speeds = malloc(n * sizeof(double));
-    if (!r->speeds)
+    r->rpm = malloc(n * sizeof(double));
+    if (!r->speeds || !r->rpm)
         return SM_NOMEM;
-    for (i = 0; i < n; i++)
-        r->speeds[i] = req_number(json_is_array(om) ? json_array_get(om, i) : om);
+    spd_fill(an, r->speeds, r->rpm); /* speeds.c: rpm or omega, numbers, lists, ranges */
     r->n_speeds = (int)n;
     return SM_OK;
 }
@@ -360,6 +418,24 @@ static const char *req_spatial_range(const sm_section *c, double lmin, double lm
     return NULL;
 }
 
+int req_error(const codec_request *r, codec_errors *errs, const char *ptr, const char *fmt,
+              ...)
+{
+    char *moved = r->blade ? blade_pointer(ptr) : NULL;
+    va_list ap;
+    int rc;
+
+    if (r->blade && !moved) {
+        err_mark_nomem(errs);
+        return SM_NOMEM;
+    }
+    va_start(ap, fmt);
+    rc = err_vadd(errs, moved ? moved : ptr, fmt, ap);
+    va_end(ap);
+    free(moved);
+    return rc;
+}
+
 /*
  * One conditioning error for section i: at its field that stands for the
  * core field `field` (section.c: E for EA in the material form, with the
@@ -368,7 +444,7 @@ static const char *req_spatial_range(const sm_section *c, double lmin, double lm
 static int req_section_error(const codec_request *r, int i, const char *field, const char *msg,
                              codec_errors *errs)
 {
-    const json_t *secs = json_object_get(json_object_get(r->canon, "structure"), "sections");
+    const json_t *secs = json_object_get(r->structure, "sections");
     const char *relation, *key;
     char *sec = err_ptr_key("/structure/sections", r->section_names[i]), *p = NULL;
     int rc = SM_NOMEM;
@@ -379,9 +455,9 @@ static int req_section_error(const codec_request *r, int i, const char *field, c
     if (key && !(p = err_ptr_key(sec, key)))
         goto done;
     if (relation)
-        rc = codec_errors_add(errs, p ? p : sec, "%s (%s)", msg, relation);
+        rc = req_error(r, errs, p ? p : sec, "%s (%s)", msg, relation);
     else
-        rc = codec_errors_add(errs, p ? p : sec, "%s", msg);
+        rc = req_error(r, errs, p ? p : sec, "%s", msg);
 done:
     free(p);
     free(sec);
@@ -409,7 +485,7 @@ static int req_check_conditioning(const codec_request *r, codec_errors *errs)
                      "meaningful frequencies; merge this member into its neighbour or give "
                      "the long members more elements",
                      l, ratio, lmax, REQ_MIN_LENGTH_RATIO);
-            if (codec_errors_add(errs, base, "%s", msg) == SM_NOMEM)
+            if (req_error(r, errs, base, "%s", msg) == SM_NOMEM)
                 return SM_NOMEM;
             bad = 1;
         }
@@ -436,7 +512,7 @@ static int req_from_json(codec_request **out, const json_t *root, const codec_li
 {
     codec_limits deflim;
     codec_request *r = NULL;
-    json_t *canon;
+    json_t *canon, *structure = NULL;
     int rc = SM_NOMEM, before = codec_errors_count(errs), nomem;
 
     *out = NULL;
@@ -444,10 +520,10 @@ static int req_from_json(codec_request **out, const json_t *root, const codec_li
         codec_default_limits(&deflim);
         lim = &deflim;
     }
-    canon = val_request(root, lim, errs, &nomem);
+    canon = val_request(root, lim, errs, &nomem, &structure);
     if (nomem)
         goto fail;
-    if (codec_errors_count(errs) > before || !canon) {
+    if (codec_errors_count(errs) > before || !canon || !structure) {
         rc = SM_INVALID_INPUT;
         goto fail;
     }
@@ -455,7 +531,9 @@ static int req_from_json(codec_request **out, const json_t *root, const codec_li
     if (!r)
         goto fail;
     r->canon = canon;
-    canon = NULL;
+    r->structure = structure;
+    r->blade = json_object_get(canon, "blade") != NULL;
+    canon = structure = NULL;
     r->canon_text = json_dumps(r->canon, CODEC_DUMP_CANON);
     if (!r->canon_text)
         goto fail;
@@ -465,10 +543,14 @@ static int req_from_json(codec_request **out, const json_t *root, const codec_li
         (core_check && (rc = req_check_model(r, lim, errs))) ||
         (rc = req_check_conditioning(r, errs)))
         goto fail;
+    rc = SM_NOMEM;
+    if (!(r->warnings = warn_collect(r->structure, r->blade)))
+        goto fail;
     *out = r;
     return SM_OK;
 fail:
     json_decref(canon);
+    json_decref(structure);
     codec_request_free(r);
     return rc;
 }
@@ -535,6 +617,10 @@ void codec_request_free(codec_request *r)
     if (!r)
         return;
     free(r->speeds);
+    free(r->rpm);
+    free(r->stations);
+    json_decref(r->structure);
+    json_decref(r->warnings);
     free(r->point_masses);
     free(r->members);
     free(r->sections);
@@ -566,6 +652,22 @@ const double *codec_request_speeds(const codec_request *r, int *n)
 {
     *n = r->n_speeds;
     return r->speeds;
+}
+
+const double *codec_request_rpm(const codec_request *r, int *n)
+{
+    *n = r->n_speeds;
+    return r->rpm;
+}
+
+const json_t *codec_request_input_warnings(const codec_request *r)
+{
+    return r->warnings;
+}
+
+const json_t *req_structure(const codec_request *r)
+{
+    return r->structure;
 }
 
 const char *codec_request_joint_name(const codec_request *r, int j)

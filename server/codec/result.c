@@ -14,6 +14,12 @@
  * spatial; a spatial model adds "spatial": true and "dof_per_node": 6 to
  * "model".  A planar result has no new key, so its bytes are those of
  * before the spatial model existed.
+ *
+ * Blades (DESIGN.md 8): each mode ends with "per_rev" (frequency / omega,
+ * null at omega = 0), each case with "rpm", and the document with
+ * "input_warnings" when the request has any (warn.c).  These are appended
+ * after the keys of before, so a result of before reads the same with
+ * them removed.
  */
 #include "codec_internal.h"
 
@@ -120,6 +126,12 @@ fail_set:
     return NULL;
 }
 
+/* Frequency f (rad/s) per revolution at omega: f / omega, null at rest. */
+static json_t *res_per_rev(double f, double omega)
+{
+    return omega > 0 ? res_real(f / omega) : json_null();
+}
+
 /* One mode of a case. */
 static json_t *res_mode(const sm_case *c, int k, int shapes)
 {
@@ -149,14 +161,16 @@ static json_t *res_mode(const sm_case *c, int k, int shapes)
             json_object_set_new(shape, "im", res_rows(c->shape_im + k * stride, c->n_nodes, dof)))
             goto fail;
     }
+    if (json_object_set_new(md, "per_rev", res_per_rev(c->frequency[k], c->omega)))
+        goto fail;
     return md;
 fail:
     json_decref(md);
     return NULL;
 }
 
-/* One case (speed). */
-static json_t *res_case(const codec_request *r, const sm_model *m, const sm_case *c)
+/* One case (speed), rpm its speed in rev/min. */
+static json_t *res_case(const codec_request *r, const sm_model *m, const sm_case *c, double rpm)
 {
     json_t *o = json_object(), *modes;
     int k, shapes = codec_request_options(r)->mode_shapes;
@@ -189,6 +203,8 @@ static json_t *res_case(const codec_request *r, const sm_model *m, const sm_case
                                       c->message[0] ? c->message
                                                     : codec_case_status_name(c->status))))
         goto fail;
+    if (json_object_set_new(o, "rpm", res_real(rpm)))
+        goto fail;
     return o;
 fail:
     json_decref(o);
@@ -215,9 +231,11 @@ int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
                         const sm_result *res)
 {
     json_t *doc = NULL, *cases;
+    const json_t *warnings = codec_request_input_warnings(r);
+    const double *rpm;
     sm_model_info info;
     double te = 0, tl = 0, tg = 0;
-    int i;
+    int i, n_rpm;
 
     *out = NULL;
     sm_model_get_info(m, &info);
@@ -232,9 +250,10 @@ int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
     cases = json_array();
     if (json_object_set_new(doc, "cases", cases))
         goto fail;
+    rpm = codec_request_rpm(r, &n_rpm);
     for (i = 0; i < res->n_cases; i++) {
         const sm_case *c = &res->cases[i];
-        if (json_array_append_new(cases, res_case(r, m, c)))
+        if (json_array_append_new(cases, res_case(r, m, c, i < n_rpm ? rpm[i] : NAN)))
             goto fail;
         te += c->t_equilibrium;
         tl += c->t_linearize;
@@ -243,6 +262,9 @@ int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
     if (json_object_set_new(doc, "timing_ms",
                             json_pack("{s:o, s:o, s:o}", "equilibrium", res_real(te),
                                       "linearize", res_real(tl), "eigen", res_real(tg))))
+        goto fail;
+    if (json_array_size(warnings) &&
+        json_object_set_new(doc, "input_warnings", json_deep_copy(warnings)))
         goto fail;
     *out = doc;
     return SM_OK;

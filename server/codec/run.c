@@ -115,7 +115,7 @@ static int run_encode(const codec_request *req, const sm_model *m, const sm_resu
 {
     if ((want & CODEC_RUN_JSON) && codec_result_encode(&out->result, req, m, res) != SM_OK)
         return SM_NOMEM;
-    if ((want & CODEC_RUN_CSV) && codec_result_csv(&out->csv, &out->csv_len, res) != SM_OK)
+    if ((want & CODEC_RUN_CSV) && codec_result_csv(&out->csv, &out->csv_len, req, res) != SM_OK)
         return SM_NOMEM;
     return run_outcome_of(res, out);
 }

@@ -38,7 +38,11 @@ static const char *const sec_inertia_keys[] = {"flap_inertia", "edge_inertia", N
 /* Every key a section may have, for the unknown-key check and its suggestions. */
 static const char *const sec_all_keys[] = {"E", "A", "I", "mass_per_length", "EA", "EI_flap",
                                            "EI_edge", "GJ", "G", "I_flap", "I_edge", "J",
-                                           "flap_inertia", "edge_inertia", NULL};
+                                           "flap_inertia", "edge_inertia", "cg_offset",
+                                           "shear_center_offset", "tension_center_offset", NULL};
+/* Offsets from the member axis (DESIGN.md 8), [edgewise, flapwise] in m, spatial only. */
+static const char *const sec_offset_keys[] = {"cg_offset", "shear_center_offset",
+                                              "tension_center_offset", NULL};
 /* Keys that only the material form has (the stiffness form has none of them). */
 static const char *const sec_mat_only_keys[] = {"G", "I_flap", "I_edge", "J", NULL};
 
@@ -66,6 +70,16 @@ static int sec_has_key(const char *const *keys, const char *name)
         if (!strcmp(keys[i], name))
             return 1;
     return 0;
+}
+
+sec_form sec_classify_as(const json_t *sec, int spatial)
+{
+    static const char *const planar_only[] = {"E", "A", "I", NULL};
+    sec_form f = sec_classify(sec);
+
+    if (f == SEC_PLANAR && spatial && !sec_has_any(sec, planar_only))
+        return SEC_STIFFNESS;
+    return f;
 }
 
 sec_form sec_classify(const json_t *sec)
@@ -100,7 +114,8 @@ const char *sec_form_name(sec_form f)
 static int sec_foreign(val_ctx *v, const json_t *sec, const char *ptr, sec_form f)
 {
     static const char *const not_stiff[] = {"E", "A", "G", "I_flap", "I_edge", "J", NULL};
-    static const char *const inertias[] = {"flap_inertia", "edge_inertia", NULL};
+    static const char *const inertias[] = {"flap_inertia", "edge_inertia", "cg_offset",
+                                           "shear_center_offset", "tension_center_offset", NULL};
     int i, n = 0;
 
     if (f == SEC_STIFFNESS) {
@@ -137,9 +152,13 @@ static int sec_foreign(val_ctx *v, const json_t *sec, const char *ptr, sec_form 
     return n;
 }
 
-/* The required fields of form f: checked, copied to c; 1 when all are valid. */
+/*
+ * The required fields of form f: checked, copied to c; 1 when all are valid.
+ * A stiffness-form field whose bit (SM_ST_*) is in cover may be absent (the
+ * stations of every member using the section give it); its val stays NaN.
+ */
 static int sec_required(val_ctx *v, const json_t *sec, const char *ptr, sec_form f, json_t *c,
-                        double *val)
+                        double *val, unsigned cover)
 {
     const char *const *keys = f == SEC_PLANAR ? sec_planar_keys
                               : f == SEC_STIFFNESS ? sec_stiff_keys : sec_mat_keys;
@@ -148,6 +167,10 @@ static int sec_required(val_ctx *v, const json_t *sec, const char *ptr, sec_form
     int k, ok = 1;
 
     for (k = 0; keys[k]; k++) {
+        val[k] = NAN;
+        if (f == SEC_STIFFNESS && !json_object_get(sec, keys[k]) &&
+            (cover & stn_section_bit(keys[k])))
+            continue;
         if (f != SEC_PLANAR && !json_object_get(sec, keys[k])) {
             field_error_key(v, ptr, keys[k],
                             "required field '%s' is missing: a spatial section in %s form gives "
@@ -228,6 +251,8 @@ static void sec_inertias(val_ctx *v, const json_t *sec, const char *ptr, sec_for
             continue;
         /* DESIGN.md 7.3: flap_inertia = mu*EI_flap/EA (= mu*I_flap/A), edge likewise */
         def = f == SEC_STIFFNESS ? mu * val[1 + k] / val[0] : mu * val[3 + k] / val[2];
+        if (isnan(def)) /* a factor only the stations give: the stations default it */
+            continue;
         if (!sec_usable(def)) {
             field_error_key(v, ptr, key,
                             "the default %s = mass_per_length*%s = %g is not a number the "
@@ -242,8 +267,8 @@ static void sec_inertias(val_ctx *v, const json_t *sec, const char *ptr, sec_for
         field_set(v, c, key, json_real(def));
     }
     /* stiffness form: I_p/A = (flap_inertia + edge_inertia)/mass_per_length */
-    if (f == SEC_STIFFNESS && have[0] && have[1] && base_ok && given[0] + given[1] != 0 &&
-        !sec_usable((given[0] + given[1]) / mu))
+    if (f == SEC_STIFFNESS && have[0] && have[1] && base_ok && !isnan(mu) &&
+        given[0] + given[1] != 0 && !sec_usable((given[0] + given[1]) / mu))
         field_error(v, ptr,
                     "I_p/A = (flap_inertia + edge_inertia)/mass_per_length = %g (the torsional "
                     "geometric stiffness) is not a number the numerics can carry: check the "
@@ -251,7 +276,26 @@ static void sec_inertias(val_ctx *v, const json_t *sec, const char *ptr, sec_for
                     (given[0] + given[1]) / mu);
 }
 
-json_t *sec_validate(val_ctx *v, const json_t *sec, const char *ptr, sec_form f)
+/*
+ * The offsets of a spatial section (DESIGN.md 8): [edgewise, flapwise], m,
+ * finite; written to c only when not [0, 0] (the default), so a request
+ * without them keeps its canonical form.
+ */
+static void sec_offsets(val_ctx *v, const json_t *sec, const char *ptr, json_t *c)
+{
+    double x[2];
+    int k;
+
+    for (k = 0; sec_offset_keys[k]; k++)
+        if (json_object_get(sec, sec_offset_keys[k]) &&
+            field_vector(v, sec, sec_offset_keys[k], ptr, 2, FIELD_FINITE,
+                         "[edgewise, flapwise]", " (m)", x) &&
+            (x[0] != 0 || x[1] != 0))
+            field_set(v, c, sec_offset_keys[k], field_reals(x, 2));
+}
+
+json_t *sec_validate(val_ctx *v, const json_t *sec, const char *ptr, sec_form f,
+                     unsigned cover)
 {
     double val[8] = {0};
     json_t *c;
@@ -265,11 +309,13 @@ json_t *sec_validate(val_ctx *v, const json_t *sec, const char *ptr, sec_form f)
         v->nomem = 1;
         return NULL;
     }
-    ok = sec_required(v, sec, ptr, f, c, val);
+    ok = sec_required(v, sec, ptr, f, c, val, cover);
     if (f == SEC_MATERIAL && ok)
         sec_products(v, ptr, val);
-    if (f != SEC_PLANAR)
+    if (f != SEC_PLANAR) {
         sec_inertias(v, sec, ptr, f, c, val, ok);
+        sec_offsets(v, sec, ptr, c);
+    }
     return c;
 }
 
@@ -282,9 +328,18 @@ static double sec_num(const json_t *canon, const char *key)
     return d;
 }
 
-void sec_fill(const json_t *canon, sm_section *out)
+/* The offset canon[key] into out[2] (zero when absent). */
+static void sec_offset(const json_t *canon, const char *key, double out[2])
 {
-    sec_form f = sec_classify(canon);
+    const json_t *x = json_object_get(canon, key);
+
+    out[0] = json_number_value(json_array_get(x, 0));
+    out[1] = json_number_value(json_array_get(x, 1));
+}
+
+void sec_fill(const json_t *canon, int spatial, sm_section *out)
+{
+    sec_form f = sec_classify_as(canon, spatial);
 
     memset(out, 0, sizeof(*out));
     out->mu = sec_num(canon, "mass_per_length");
@@ -296,13 +351,17 @@ void sec_fill(const json_t *canon, sm_section *out)
     }
     out->i_flap = sec_num(canon, "flap_inertia");
     out->i_edge = sec_num(canon, "edge_inertia");
+    sec_offset(canon, "cg_offset", out->cg);
+    sec_offset(canon, "shear_center_offset", out->sc);
+    sec_offset(canon, "tension_center_offset", out->tc);
     if (f == SEC_STIFFNESS) {
         out->EA = sec_num(canon, "EA");
         out->EI_flap = sec_num(canon, "EI_flap");
         out->EI_edge = sec_num(canon, "EI_edge");
         out->GJ = sec_num(canon, "GJ");
-        /* DESIGN.md 7.3: without A and I, I_p/A from the mass moments */
-        out->ip_over_a = (out->i_flap + out->i_edge) / out->mu;
+        /* DESIGN.md 7.3: without A and I, I_p/A from the mass moments (0 while a partial
+         * section waits for its stations' values, request.c) */
+        out->ip_over_a = out->mu > 0 ? (out->i_flap + out->i_edge) / out->mu : 0;
     } else {
         double E = sec_num(canon, "E"), G = sec_num(canon, "G"), A = sec_num(canon, "A");
         double I_flap = sec_num(canon, "I_flap"), I_edge = sec_num(canon, "I_edge");

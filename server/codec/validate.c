@@ -210,6 +210,7 @@ static const json_t *val_sections(val_ctx *v, const json_t *st, json_t *cst)
     json_object_foreach((json_t *)secs, name, sec) {
         char *p = err_ptr_key(base, name);
         sec_form f = sec_classify(sec);
+        unsigned cover;
         json_t *c;
         if (!p) {
             v->nomem = 1;
@@ -224,8 +225,11 @@ static const json_t *val_sections(val_ctx *v, const json_t *st, json_t *cst)
             free(p);
             continue;
         }
+        cover = (unsigned)json_integer_value(json_object_get(v->cover, name));
+        if (cover || v->blade) /* a section the stations complete is spatial */
+            f = sec_classify_as(sec, 1);
         val_section_kind(v, p, name, f, &first, &first_form);
-        c = sec_validate(v, sec, p, f);
+        c = sec_validate(v, sec, p, f, cover);
         free(p);
         if (cs && c && json_object_set_new(cs, name, c))
             v->nomem = 1;
@@ -233,6 +237,8 @@ static const json_t *val_sections(val_ctx *v, const json_t *st, json_t *cst)
             json_decref(c);
     }
     field_set(v, cst, "sections", cs);
+    v->in_sections = secs;
+    v->canon_sections = cs;
     return secs;
 }
 
@@ -262,46 +268,25 @@ static int val_vector3(val_ctx *v, const json_t *obj, const char *key, const cha
                        json_t *canon, enum field_real_kind kind, int nonzero, const char *shape,
                        const char *unit)
 {
-    const json_t *x = json_object_get(obj, key);
-    char *p = err_ptr_key(base, key);
     double c[3];
-    size_t k;
-    int ok = 1;
 
-    if (!p) {
-        v->nomem = 1;
+    if (!field_vector(v, obj, key, base, 3, kind, shape, unit, c))
+        return 0;
+    if (nonzero && c[0] == 0 && c[1] == 0 && c[2] == 0) {
+        field_error_key(v, base, key, "[0, 0, 0] is no direction: give a non-zero [x, y, z] "
+                        "(hub frame) for the member's e3 (flapwise) axis, or drop '%s' for the "
+                        "default", key);
         return 0;
     }
-    if (!json_is_array(x) || json_array_size(x) != 3) {
-        if (json_is_array(x))
-            field_error(v, p, "must be %s (3 numbers), got %zu value%s", shape,
-                        json_array_size(x), json_array_size(x) == 1 ? "" : "s");
-        else
-            field_error(v, p, "must be %s (3 numbers), not %s", shape, field_type_name(x));
-        free(p);
-        return 0;
-    }
-    for (k = 0; k < 3; k++) {
-        char *pk = err_ptr_idx(p, k);
-        if (!field_check_real(v, json_array_get(x, k), pk ? pk : p, kind, unit, &c[k]))
-            ok = 0;
-        free(pk);
-    }
-    if (ok && nonzero && c[0] == 0 && c[1] == 0 && c[2] == 0) {
-        field_error(v, p, "[0, 0, 0] is no direction: give a non-zero [x, y, z] (hub frame) "
-                    "for the member's e3 (flapwise) axis, or drop '%s' for the default", key);
-        ok = 0;
-    }
-    free(p);
-    if (ok)
-        field_set(v, canon, key, json_pack("[f, f, f]", c[0], c[1], c[2]));
-    return ok;
+    field_set(v, canon, key, field_reals(c, 3));
+    return 1;
 }
 
 /*
  * The spatial fields of member p (DESIGN.md 7.1, 7.3): twist_deg (degrees,
- * default 0 written out) and flap_direction ([x, y, z], hub frame, any
- * length; no default in the canonical form: the core finds e3).
+ * default 0 written out), flap_direction ([x, y, z], hub frame, any
+ * length; no default in the canonical form: the core finds e3) and
+ * stations (DESIGN.md 8, station.c).
  */
 static void val_member_spatial(val_ctx *v, const json_t *mem, const char *p, json_t *c)
 {
@@ -313,6 +298,8 @@ static void val_member_spatial(val_ctx *v, const json_t *mem, const char *p, jso
     }
     if (val_spatial_field(v, mem, "flap_direction", p) && json_object_get(mem, "flap_direction"))
         val_vector3(v, mem, "flap_direction", p, c, FIELD_FINITE, 1, "[x, y, z]", "");
+    if (val_spatial_field(v, mem, "stations", p) && json_object_get(mem, "stations"))
+        stn_validate(v, mem, p, c);
 }
 
 /* Member i: {id, from, to, section, elements [, twist_deg, flap_direction]}; adds its
@@ -322,7 +309,7 @@ static void val_member(val_ctx *v, const json_t *mem, size_t i, const json_t *jo
                        int *ends_ok, long *total)
 {
     static const char *const keys[] = {"id", "from", "to", "section", "elements", "twist_deg",
-                                       "flap_direction", NULL};
+                                       "flap_direction", "stations", NULL};
     char *p = err_ptr_idx("/structure/members", i);
     const json_t *id;
     const char *from, *to;
@@ -427,13 +414,66 @@ static void val_members(val_ctx *v, const json_t *st, const json_t *joints, cons
 }
 
 /*
- * structure.point_masses: optional array of {joint, mass [, inertia]};
- * inertia [Ixx, Iyy, Izz] (kg m^2, hub axes) with spatial sections only,
- * default [0, 0, 0] written out.
+ * The inertia tensor of point mass p (canonical c: inertia, products) must
+ * be positive semi-definite (every principal minor >= 0, with a round-off
+ * margin): a rotary inertia the core can carry.
+ */
+static void val_inertia_psd(val_ctx *v, const json_t *c, const char *p)
+{
+    const json_t *in = json_object_get(c, "inertia"), *pr = json_object_get(c, "products");
+    double a = json_number_value(json_array_get(in, 0)), b = json_number_value(json_array_get(in, 1));
+    double d = json_number_value(json_array_get(in, 2)), xy = json_number_value(json_array_get(pr, 0));
+    double yz = json_number_value(json_array_get(pr, 1)), zx = json_number_value(json_array_get(pr, 2));
+    double tol = 1e-12 * (a + b + d) * (a + b + d);
+    /* det [[a, xy, zx], [xy, b, yz], [zx, yz, d]] */
+    double det = a * (b * d - yz * yz) - xy * (xy * d - yz * zx) + zx * (xy * yz - b * zx);
+
+    if (!pr || !in)
+        return;
+    if (a * b - xy * xy < -tol || b * d - yz * yz < -tol || a * d - zx * zx < -tol ||
+        det < -tol * (a + b + d))
+        field_error_key(v, p, "products",
+                        "the inertia tensor [[%g, %g, %g], [%g, %g, %g], [%g, %g, %g]] (kg m^2) "
+                        "is not positive semi-definite: no body has it (each |product| must stay "
+                        "below the square root of the two moments it couples)",
+                        a, xy, zx, xy, b, yz, zx, yz, d);
+}
+
+/*
+ * The spatial fields of point mass pm at p (canonical c): inertia [Ixx, Iyy,
+ * Izz] (default [0, 0, 0] written out), and (DESIGN.md 8) products [Ixy,
+ * Iyz, Izx] and offset [x, y, z], written only when not zero.
+ */
+static void val_point_mass_spatial(val_ctx *v, const json_t *pm, const char *p, json_t *c)
+{
+    double x[3];
+
+    if (val_spatial_field(v, pm, "inertia", p)) {
+        if (json_object_get(pm, "inertia"))
+            val_vector3(v, pm, "inertia", p, c, FIELD_NONNEG, 0, "[Ixx, Iyy, Izz]", " (kg m^2)");
+        else
+            field_set(v, c, "inertia", json_pack("[f, f, f]", 0.0, 0.0, 0.0));
+    }
+    if (val_spatial_field(v, pm, "products", p) && json_object_get(pm, "products") &&
+        field_vector(v, pm, "products", p, 3, FIELD_FINITE, "[Ixy, Iyz, Izx]", " (kg m^2)", x) &&
+        (x[0] != 0 || x[1] != 0 || x[2] != 0)) {
+        field_set(v, c, "products", field_reals(x, 3));
+        val_inertia_psd(v, c, p);
+    }
+    if (val_spatial_field(v, pm, "offset", p) && json_object_get(pm, "offset") &&
+        field_vector(v, pm, "offset", p, 3, FIELD_FINITE, "[x, y, z]", " (m)", x) &&
+        (x[0] != 0 || x[1] != 0 || x[2] != 0))
+        field_set(v, c, "offset", field_reals(x, 3));
+}
+
+/*
+ * structure.point_masses: optional array of {joint, mass [, inertia,
+ * products, offset]}, the last three with spatial sections only
+ * (val_point_mass_spatial).
  */
 static void val_point_masses(val_ctx *v, const json_t *st, const json_t *joints, json_t *cst)
 {
-    static const char *const keys[] = {"joint", "mass", "inertia", NULL};
+    static const char *const keys[] = {"joint", "mass", "inertia", "products", "offset", NULL};
     static const char *base = "/structure/point_masses";
     const json_t *pms = json_object_get(st, "point_masses");
     json_t *cp, *pm;
@@ -473,13 +513,7 @@ static void val_point_masses(val_ctx *v, const json_t *st, const json_t *joints,
             v->nomem = 1;
         field_ref(v, pm, "joint", p, c, joints, "joint");
         field_real(v, pm, "mass", p, c, FIELD_NONNEG, " (kg)", NULL);
-        if (val_spatial_field(v, pm, "inertia", p)) {
-            if (json_object_get(pm, "inertia"))
-                val_vector3(v, pm, "inertia", p, c, FIELD_NONNEG, 0, "[Ixx, Iyy, Izz]",
-                            " (kg m^2)");
-            else
-                field_set(v, c, "inertia", json_pack("[f, f, f]", 0.0, 0.0, 0.0));
-        }
+        val_point_mass_spatial(v, pm, p, c);
         free(p);
         if (c && json_array_append_new(cp, c))
             v->nomem = 1;
@@ -502,14 +536,14 @@ static void val_unused_joints(val_ctx *v, const json_t *joints, const json_t *en
 }
 
 /* The structure object. */
-static void val_structure(val_ctx *v, const json_t *root, json_t *canon)
+void val_structure(val_ctx *v, const json_t *root, json_t *canon)
 {
     static const char *const keys[] = {"joints", "sections", "members", "point_masses",
                                        "clamp", NULL};
     const json_t *st = field_object(v, root, "structure", "");
     const json_t *joints, *secs, *clamp;
     const char *first_z;
-    json_t *cst, *ends;
+    json_t *cst, *ends, *cover;
     int ends_ok = 0;
 
     if (!st)
@@ -520,6 +554,10 @@ static void val_structure(val_ctx *v, const json_t *root, json_t *canon)
     if (!cst || !ends)
         v->nomem = 1;
     joints = val_joints(v, st, cst, &first_z);
+    cover = stn_cover(json_object_get(st, "members"));
+    if (!cover)
+        v->nomem = 1;
+    v->cover = cover;
     secs = val_sections(v, st, cst);
     val_spatial_joints(v, cst, first_z);
     if (ends)
@@ -535,6 +573,8 @@ static void val_structure(val_ctx *v, const json_t *root, json_t *canon)
                     field_short_name(json_string_value(clamp)).s);
     field_ref(v, st, "clamp", "/structure", cst, joints, "joint");
     json_decref(ends);
+    json_decref(cover);
+    v->cover = NULL;
     field_set(v, canon, "structure", cst);
 }
 
@@ -585,56 +625,10 @@ static void val_frames(val_ctx *v, const json_t *root, json_t *canon)
     field_set(v, canon, "frames", c);
 }
 
-/* analysis.omega: a number or a non-empty array of numbers, finite, >= 0. */
-static void val_omega(val_ctx *v, const json_t *an, json_t *can)
-{
-    static const char *base = "/analysis/omega";
-    const json_t *om = json_object_get(an, "omega");
-    json_t *arr, *x;
-    size_t i;
-    double d;
-
-    if (!om) {
-        field_error(v, base, "required field 'omega' (the speed in rad/s, or an array of speeds) "
-                    "is missing");
-        return;
-    }
-    if (json_is_number(om)) {
-        if (field_check_real(v, om, base, FIELD_NONNEG, " (rad/s)", &d))
-            field_set(v, can, "omega", json_real(d));
-        return;
-    }
-    if (!json_is_array(om)) {
-        field_error(v, base, "must be a number (rad/s) or an array of numbers, not %s",
-                    field_type_name(om));
-        return;
-    }
-    if (!val_count(v, base, json_array_size(om), v->lim->max_speeds, "speeds",
-                   "must list at least one speed"))
-        return;
-    arr = json_array();
-    if (!arr) {
-        v->nomem = 1;
-        return;
-    }
-    json_array_foreach(om, i, x) {
-        char *p = err_ptr_idx(base, i);
-        if (!p) {
-            v->nomem = 1;
-            break;
-        }
-        if (field_check_real(v, x, p, FIELD_NONNEG, " (rad/s)", &d) &&
-            json_array_append_new(arr, json_real(d)))
-            v->nomem = 1;
-        free(p);
-    }
-    field_set(v, can, "omega", arr);
-}
-
-/* The analysis object: omega, modes and the options, with their defaults. */
+/* The analysis object: omega or rpm (speeds.c), modes and the options, with their defaults. */
 static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
 {
-    static const char *const keys[] = {"omega", "modes", "geometric_stiffening", "coriolis",
+    static const char *const keys[] = {"omega", "rpm", "modes", "geometric_stiffening", "coriolis",
                                        "mass", "substructure_modes", "modes_per_frame",
                                        "mode_shapes", NULL};
     static const char *const mass[] = {"lumped", "consistent", NULL};
@@ -651,7 +645,7 @@ static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
     can = json_object();
     if (!can)
         v->nomem = 1;
-    val_omega(v, an, can);
+    spd_validate(v, an, can);
     field_int(v, an, "modes", base, can, 0, 3, 1, v->lim->max_modes, "the number of modes",
               NULL);
     field_bool(v, an, "geometric_stiffening", base, can, 1);
@@ -685,8 +679,7 @@ static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
 static void val_output_size(val_ctx *v, const json_t *canon)
 {
     const json_t *an = json_object_get(canon, "analysis");
-    const json_t *om = json_object_get(an, "omega");
-    double speeds = json_is_array(om) ? (double)json_array_size(om) : 1;
+    double speeds = (double)spd_count(an);
     double modes = (double)json_integer_value(json_object_get(an, "modes"));
     double nodes = (double)v->total_elements + 1; /* a tree of elements */
     double values = speeds * modes * nodes * (v->spatial == 1 ? 6 : 3) *
@@ -700,10 +693,14 @@ static void val_output_size(val_ctx *v, const json_t *canon)
                 "fewer speeds or modes", speeds, modes, nodes, values, v->lim->max_shape_values);
 }
 
-/* Validate root; returns the canonical request (new) or NULL. */
-static json_t *val_document(val_ctx *v, const json_t *root)
+/*
+ * Validate root; returns the canonical request (new) or NULL, and in
+ * *structure the canonical structure the core's arrays come from (new, or
+ * NULL): the request's, or the one its "blade" stands for (blade.c).
+ */
+static json_t *val_document(val_ctx *v, const json_t *root, json_t **structure)
 {
-    static const char *const keys[] = {"structure", "frames", "analysis", NULL};
+    static const char *const keys[] = {"structure", "blade", "frames", "analysis", NULL};
     json_t *canon;
 
     if (!json_is_object(root)) {
@@ -716,26 +713,33 @@ static json_t *val_document(val_ctx *v, const json_t *root)
         v->nomem = 1;
         return NULL;
     }
-    val_structure(v, root, canon);
+    if (json_object_get(root, "blade") && json_object_get(root, "structure")) {
+        field_error(v, "/blade", "give either 'structure' or 'blade', not both");
+    } else if (json_object_get(root, "blade")) {
+        *structure = blade_validate(v, root, canon);
+    } else {
+        val_structure(v, root, canon);
+        *structure = json_incref(json_object_get(canon, "structure"));
+    }
     val_frames(v, root, canon);
     val_analysis(v, root, canon);
-    if (json_object_get(canon, "analysis") && json_object_get(canon, "structure"))
+    if (json_object_get(canon, "analysis") && *structure)
         val_output_size(v, canon);
     return canon;
 }
 
 json_t *val_request(const json_t *root, const codec_limits *lim, codec_errors *errs,
-                    int *nomem)
+                    int *nomem, json_t **structure)
 {
     val_ctx v;
     json_t *canon;
 
+    memset(&v, 0, sizeof(v));
     v.errs = errs;
     v.lim = lim;
-    v.total_elements = 0;
     v.spatial = -1;
-    v.nomem = 0;
-    canon = val_document(&v, root);
+    *structure = NULL;
+    canon = val_document(&v, root, structure);
     *nomem = v.nomem;
     return canon;
 }

@@ -197,17 +197,19 @@ def t_csv(tmp):
     rc, out, err = run(["solve", "--csv", write_request(tmp, "sweep.json", req)])
     lines = out.splitlines()
     check(rc == 0, "csv: exit 0 (got %d; %.200s)" % (rc, err))
-    check(lines[:1] == ["omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status"],
+    check(lines[:1] == ["omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,"
+                        "per_rev,rpm"],
           "csv: header")
     check(len(lines) == 1 + 3 * 4, "csv: 12 rows for 3 speeds x 4 modes (got %d)" % (len(lines) - 1))
     rows = [l.split(",") for l in lines[1:]]
-    check(all(len(r) == 8 for r in rows), "csv: 8 fields per row")
+    check(all(len(r) == 10 for r in rows), "csv: 10 fields per row")
     check(rows and rows[0][1] == "1" and rows[0][6] == "" and rows[-1][6] != "",
           "csv: modes numbered from 1, MAC empty at the first speed only")
     rc, out, err = run(["solve", "--csv", write_request(tmp, "angled.json", angled_beam(20, "single"))])
     lines = out.splitlines()
-    check(rc == 3 and len(lines) == 2 and lines[1].split(",")[1:] == ["", "", "", "", "", "", "no_equilibrium"],
-          "csv: a case without equilibrium is one row with its status (%s)" % lines[1:])
+    check(rc == 3 and len(lines) == 2 and lines[1].split(",")[1:8] == ["", "", "", "", "", "", "no_equilibrium"]
+          and lines[1].split(",")[8] == "" and abs(float(lines[1].split(",")[9]) - 20 * 60 / (2 * math.pi)) < 1e-12,
+          "csv: a case without equilibrium is one row with its status, no per_rev and its rpm (%s)" % lines[1:])
 
 
 def t_help_version(tmp):
@@ -297,7 +299,7 @@ def t_spatial(tmp):
               "spatial %s: in-plane frequencies are the planar ones to 1e-7 (%s vs %s)" % (what, got, want))
         rc, csv, err = run(["solve", "--csv", path])
         lines = csv.splitlines()
-        check(rc == 0 and lines[0] == "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status"
+        check(rc == 0 and lines[0] == "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm"
               and len(lines) == 17, "spatial %s: CSV header and one row per mode (%d lines)" % (what, len(lines)))
     # validate: the canonical form writes the spatial defaults out
     rc, out, err = run(["validate", write_request(tmp, "spatial.json", blade(variants[0][1], 4))])
@@ -320,6 +322,51 @@ def t_spatial(tmp):
           % (prob or {}).get("errors"))
 
 
+def t_blade(tmp):
+    """(g) blades (DESIGN.md 8): examples/tapered-blade.json (blade form, stations, an rpm range)
+    solves; --table shows omega, rpm, mode and the frequency in rad/s, Hz and per revolution,
+    one number of decimals per column, aligned; a request with E in MPa carries a warning."""
+    example = os.path.join(os.path.dirname(__file__), "..", "..", "examples", "tapered-blade.json")
+    rc, out, err = run(["solve", example])
+    check(rc == 0, "blade: tapered-blade.json solves (exit %d; %.200s)" % (rc, err))
+    res = json.loads(out) if rc == 0 else {"cases": []}
+    check([c.get("rpm") for c in res["cases"]] == [0.0, 30.0, 60.0, 90.0, 120.0],
+          "blade: cases report the rpm of the range as given (%s)" % [c.get("rpm") for c in res["cases"]])
+    rc, out, err = run(["solve", "--table", example])
+    lines = out.splitlines()
+    check(rc == 0 and lines and lines[0].split() == ["omega_rad_s", "rpm", "mode", "freq_rad_s", "freq_hz",
+                                                     "per_rev", "status"],
+          "blade --table: header (%s)" % lines[:1])
+    rows = [l.split() for l in lines[1:]]
+    check(len(rows) == 5 * 4 and all(len(r) == 7 for r in rows), "blade --table: 20 rows of 7 cells")
+    check(len(set(len(l) for l in lines)) == 1, "blade --table: every line equally long (aligned)")
+    for col, dec in ((0, 4), (1, 2), (3, 6), (4, 6), (5, 4)):
+        cells = [r[col] for r in rows if r[col] != "-"]
+        check(cells and all(len(c.split(".")[1]) == dec for c in cells),
+              "blade --table: column %d has %d decimals in every row" % (col, dec))
+    modes = [m for c in res["cases"] for m in c["modes"]]
+    for r, m, c in zip(rows, modes, [c for c in res["cases"] for _ in c["modes"]]):
+        ok = (abs(float(r[3]) - m["frequency_rad_s"]) <= 5e-7 and abs(float(r[4]) - m["frequency_hz"]) <= 5e-7
+              and (r[5] == "-" if c["omega"] == 0 else abs(float(r[5]) - m["frequency_rad_s"] / c["omega"]) <= 5e-5))
+        if not ok:
+            check(False, "blade --table: row %s differs from the JSON" % r)
+            break
+    check(all(r[5] == "-" for r in rows[:4]), "blade --table: per_rev '-' at rest")
+    req = json.loads(open(example).read())
+    req["blade"]["section"]["GJ"] = 0.5
+    rc, out, err = run(["solve", "--table", write_request(tmp, "slip.json", req)])
+    check(rc == 0 and "warning: /blade/section/GJ: GJ = 0.5 N m^2" in out,
+          "blade --table: a unit slip is printed as a warning with its pointer (%s)" % out.splitlines()[-1:])
+    rc, out, err = run(["validate", write_request(tmp, "slip.json", req)])
+    doc = json.loads(out) if rc == 0 else {}
+    check([w["pointer"] for w in doc.get("input_warnings", [])] == ["/blade/section/GJ"],
+          "blade validate: input_warnings with the pointer (%s)" % doc.get("input_warnings"))
+    rc, out, err = run(["validate", example])
+    check(rc == 0 and "input_warnings" not in json.loads(out), "blade validate: no warnings for the example")
+    rc, out, err = run(["solve", "--csv", "--table", example])
+    check(rc == 64, "blade: --csv with --table is a usage error (%d)" % rc)
+
+
 SCENARIOS = {
     "cantilever": t_cantilever,
     "invalid": t_invalid,
@@ -328,6 +375,7 @@ SCENARIOS = {
     "help_version": t_help_version,
     "usage": t_usage,
     "spatial": t_spatial,
+    "blade": t_blade,
 }
 
 

@@ -162,12 +162,16 @@ def scenario_solve(d):
 
     text = c.csv(st["id"])
     lines = text.strip().split("\n")
-    check(lines[0] == "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status",
+    check(lines[0] == "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm",
           "csv(): header")
     check(len(lines) == 4, "csv(): 3 rows (%d)" % (len(lines) - 1))
     row = lines[1].split(",")
-    check(row[1] == "1" and close(float(row[2]), w1_cli, 1e-9) and row[-1] == "solved",
+    check(row[1] == "1" and close(float(row[2]), w1_cli, 1e-9) and row[7] == "solved",
           "csv(): row 1 is mode 1, omega1 as the CLI, solved")
+    # per_rev = omega1 / Omega and rpm = Omega 60 / (2 pi), appended after status (DESIGN.md 8)
+    check(close(float(row[8]), float(row[2]) / float(row[0]), 1e-15)
+          and close(float(row[9]), float(row[0]) * 60 / (2 * math.pi), 1e-15),
+          "csv(): per_rev = omega1 / Omega and rpm = Omega 60 / 2 pi")
     check(text == cli_solve(load_example("angled-beam-90.json"), csv=True) or
           all(close(float(a.split(",")[2]), float(b.split(",")[2]), 1e-9)
               for a, b in zip(lines[1:], cli_solve(load_example("angled-beam-90.json"), csv=True)
@@ -425,6 +429,17 @@ def scenario_python_cli(d):
     p = run_py(["solve", "--csv", example("angled-beam-90.json"), "--url", d.url], dict(env, SPINMODAL_URL="http://127.0.0.1:1"))
     check(p.returncode == 0 and p.stdout.startswith("omega,mode,") and len(p.stdout.strip().split("\n")) == 4,
           "PYTHONPATH=clients/python ... solve --csv --url: exit 0, header + 3 rows (%d)" % p.returncode)
+    # solve --table (DESIGN.md 8): the same table as the CLI's --table, from the daemon's result
+    p = run_py(["solve", "--table", example("tapered-blade.json")], env)
+    cli = subprocess.run([SPINMODAL, "solve", "--table", example("tapered-blade.json")], capture_output=True, text=True,
+                         timeout=B(120), env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    lines = p.stdout.splitlines()
+    check(p.returncode == 0 and lines and lines[0].split() == ["omega_rad_s", "rpm", "mode", "freq_rad_s",
+                                                               "freq_hz", "per_rev", "status"]
+          and len(set(len(l) for l in lines)) == 1,
+          "solve --table: header, aligned rows (%d) %s" % (p.returncode, p.stderr[-200:]))
+    check(p.stdout == cli.stdout, "solve --table: the same table as `spinmodal solve --table`:\n%s\n%s"
+          % (p.stdout[:400], cli.stdout[:400]))
     with open(example("angled-beam-90.json")) as f:
         p = subprocess.run([sys.executable, "-m", "spinmodal_client", "solve", "-"], stdin=f, env=dict(env, PYTHONPATH=pkg),
                            capture_output=True, text=True, timeout=B(120))
@@ -471,8 +486,8 @@ def scenario_python_cli(d):
     check(p.returncode == 3 and "409" in p.stderr, "cancel of a done job: exit 3, 409 (%d)" % p.returncode)
     n_jobs = len(list(c.list()))
     p = run_py(["list"], env)
-    check(p.returncode == 0 and n_jobs == 2 and len(p.stdout.strip().split("\n")) == n_jobs and sid in p.stdout,
-          "list: exit 0, 2 jobs (%d): %s" % (p.returncode, p.stdout))
+    check(p.returncode == 0 and n_jobs == 3 and len(p.stdout.strip().split("\n")) == n_jobs and sid in p.stdout,
+          "list: exit 0, 3 jobs (angled beam, tapered blade, the failed one) (%d): %s" % (p.returncode, p.stdout))
     p = run_py(["list", "--state", "failed", "--json", "--limit", "1"], env)
     check(p.returncode == 0 and [json.loads(x)["id"] for x in p.stdout.split("\n") if x] == [nid],
           "list --state failed --json: the failed job")
@@ -560,7 +575,7 @@ def scenario_curl(d):
     check(p.returncode == 0 and len(p.stdout.strip().split("\n")) == 5, "csv.sh REQUEST: exit 0, header + 4 rows (%d)"
           % p.returncode)
     p = run_sh("csv.sh", [noeq], env)
-    check(p.returncode == 1 and p.stdout.strip().split("\n")[-1].endswith(",no_equilibrium"),
+    check(p.returncode == 1 and p.stdout.strip().split("\n")[-1].split(",")[7] == "no_equilibrium",
           "csv.sh of a failed job: exit 1, CSV still printed (%d)" % p.returncode)
     p = run_sh("csv.sh", ["0" * 64], env)
     check(p.returncode == 3 and "404" in p.stderr, "csv.sh of an unknown id: exit 3, 404 (%d)" % p.returncode)

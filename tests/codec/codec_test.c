@@ -14,8 +14,10 @@
  *       canonical_text and sha256 (exact: pins of the canonical form),
  *       same_sha_as / different_sha_from (other files of the folder),
  *       joint_names, speeds, options, structure (with the spatial arrays:
- *       spatial, joint_z, member_spatial, point_mass_inertia), sections
- *       (sm_section values), model (sizes from sm_model_get_info).
+ *       spatial, joint_z, joint_xy, member_spatial, point_mass_inertia,
+ *       point_mass_products, point_mass_offset, member_stations), sections
+ *       (sm_section values, offsets), model (sizes from sm_model_get_info),
+ *       rpm (codec_request_rpm) and input_warnings (exactly these).
  *
  * Spatial requests (DESIGN.md 7.3): a valid case with "spatial": true in
  * checks.json is read twice: by the codec alone (req_parse_codec_only, no
@@ -25,7 +27,8 @@
  * SHA-256, for the "model" checks.
  * Before the folders a few unit checks run (SHA-256 vector, error list cap,
  * problem document, CSV encoder, diag pointers; spatial_units.c: spatial
- * diag pointers and result rows).  One line per case; exit status 1 when
+ * diag pointers and result rows; blade_units.c: a solved blade's Hz,
+ * per-rev and rpm).  One line per case; exit status 1 when
  * anything failed.
  */
 #include <dirent.h>
@@ -283,6 +286,52 @@ static int numbers_match(const double *got, int n, const json_t *want)
 }
 
 /*
+ * checks.structure.member_stations: per member {"mask": SM_ST_* bits, "stations": [[s, mu, EA,
+ * EI_flap, EI_edge, GJ, i_flap, i_edge, twist, inertia_twist, cg0, cg1, sc0, sc1, tc0, tc1],
+ * ...]} (angles in rad), or null for a member without stations.
+ */
+static void check_stations(test_case *tc, const sm_structure *st, const json_t *want)
+{
+    const json_t *row, *srow;
+    size_t i, j;
+
+    json_array_foreach(want, i, row) {
+        const sm_member *m = (int)i < st->n_members ? &st->members[i] : NULL;
+        const json_t *rows = json_object_get(row, "stations");
+        if (!m) {
+            fail(tc, "member %zu missing", i);
+            continue;
+        }
+        if (json_is_null(row)) {
+            if (m->n_stations)
+                fail(tc, "member %zu has %d stations, expected none", i, m->n_stations);
+            continue;
+        }
+        if (m->station_mask != (unsigned)json_integer_value(json_object_get(row, "mask")))
+            fail(tc, "member %zu: station_mask %#x, expected %#x", i, m->station_mask,
+                 (unsigned)json_integer_value(json_object_get(row, "mask")));
+        if ((size_t)m->n_stations != json_array_size(rows)) {
+            fail(tc, "member %zu: %d stations, expected %zu", i, m->n_stations, json_array_size(rows));
+            continue;
+        }
+        json_array_foreach(rows, j, srow) {
+            const sm_station *q = &m->stations[j];
+            double got[16] = {q->s, q->mu, q->EA, q->EI_flap, q->EI_edge, q->GJ, q->i_flap,
+                              q->i_edge, q->twist, q->inertia_twist, q->cg[0], q->cg[1],
+                              q->sc[0], q->sc[1], q->tc[0], q->tc[1]};
+            if (!numbers_match(got, 16, srow)) {
+                char *w = json_dumps(srow, JSON_COMPACT | JSON_REAL_PRECISION(17));
+                fail(tc, "member %zu station %zu: got [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g, "
+                     "%.17g, %.17g, %.17g, %.17g, %g, %g, %g, %g, %g, %g], want %s", i, j,
+                     got[0], got[1], got[2], got[3], got[4], got[5], got[6], got[7], got[8],
+                     got[9], got[10], got[11], got[12], got[13], got[14], got[15], w ? w : "?");
+                free(w);
+            }
+        }
+    }
+}
+
+/*
  * checks.structure, spatial part: spatial (0/1), joint_z (n_joints numbers,
  * or null for NULL), member_spatial [[twist (rad), e3x, e3y, e3z], ...],
  * point_mass_inertia [[Ixx, Iyy, Izz], ...].
@@ -313,8 +362,24 @@ static void check_structure_spatial(test_case *tc, const sm_structure *st, const
     json_array_foreach(json_object_get(want, "point_mass_inertia"), i, row) {
         const sm_point_mass *p = (int)i < st->n_point_masses ? &st->point_masses[i] : NULL;
         if (!p || !numbers_match(p->inertia, 3, row))
-            fail(tc, "point mass %zu: inertia differs", i);
+            fail(tc, "point mass %zu: inertia [%.17g, %.17g, %.17g] differs", i, p ? p->inertia[0] : 0,
+                 p ? p->inertia[1] : 0, p ? p->inertia[2] : 0);
     }
+    json_array_foreach(json_object_get(want, "point_mass_products"), i, row) {
+        const sm_point_mass *p = (int)i < st->n_point_masses ? &st->point_masses[i] : NULL;
+        if (!p || !numbers_match(p->products, 3, row))
+            fail(tc, "point mass %zu: products [%.17g, %.17g, %.17g] differ", i,
+                 p ? p->products[0] : 0, p ? p->products[1] : 0, p ? p->products[2] : 0);
+    }
+    json_array_foreach(json_object_get(want, "point_mass_offset"), i, row) {
+        const sm_point_mass *p = (int)i < st->n_point_masses ? &st->point_masses[i] : NULL;
+        if (!p || !numbers_match(p->offset, 3, row))
+            fail(tc, "point mass %zu: offset [%.17g, %.17g, %.17g] differs", i,
+                 p ? p->offset[0] : 0, p ? p->offset[1] : 0, p ? p->offset[2] : 0);
+    }
+    if ((x = json_object_get(want, "joint_xy")) && !numbers_match(st->joint_xy, 2 * st->n_joints, x))
+        fail(tc, "joint_xy differs");
+    check_stations(tc, st, json_object_get(want, "member_stations"));
 }
 
 /*
@@ -339,6 +404,11 @@ static void check_sections(test_case *tc, const sm_structure *st, const json_t *
         FIELD(E) FIELD(A) FIELD(I) FIELD(mu) FIELD(EA) FIELD(EI_flap) FIELD(EI_edge) FIELD(GJ)
         FIELD(i_flap) FIELD(i_edge) FIELD(ip_over_a)
 #undef FIELD
+        if (json_object_get(row, "offsets")) { /* [cg0, cg1, sc0, sc1, tc0, tc1] */
+            double got[6] = {c->cg[0], c->cg[1], c->sc[0], c->sc[1], c->tc[0], c->tc[1]};
+            if (!numbers_match(got, 6, json_object_get(row, "offsets")))
+                fail(tc, "section %zu: offsets differ", i);
+        }
     }
 }
 
@@ -459,6 +529,45 @@ static void check_with_core(test_case *tc, const char *dir, const codec_request 
     codec_request_free(full);
 }
 
+/*
+ * checks.input_warnings: exactly these warnings ([{"pointer", "contains"}], in order; [] for
+ * none).
+ */
+static void check_warnings(test_case *tc, const json_t *got, const json_t *want)
+{
+    const json_t *w;
+    size_t i;
+
+    if (json_array_size(got) != json_array_size(want)) {
+        char *g = json_dumps(got, JSON_COMPACT);
+        fail(tc, "%zu input warnings, expected %zu: %s", json_array_size(got),
+             json_array_size(want), g ? g : "?");
+        free(g);
+        return;
+    }
+    json_array_foreach(want, i, w) {
+        const json_t *e = json_array_get(got, i);
+        const char *p = json_string_value(json_object_get(e, "pointer"));
+        const char *m = json_string_value(json_object_get(e, "message"));
+        if (!p || !m || strcmp(p, json_string_value(json_object_get(w, "pointer"))) ||
+            !strstr(m, json_string_value(json_object_get(w, "contains"))))
+            fail(tc, "input warning %zu is '%s': %s", i, p ? p : "?", m ? m : "?");
+    }
+}
+
+/* checks.speeds / checks.rpm: the n numbers at got equal want exactly. */
+static void check_exact(test_case *tc, const char *what, const double *got, int n,
+                        const json_t *want)
+{
+    int k;
+
+    if (n != (int)json_array_size(want))
+        fail(tc, "%d %s values, expected %zu", n, what, json_array_size(want));
+    for (k = 0; k < n && k < (int)json_array_size(want); k++)
+        if (got[k] != json_number_value(json_array_get(want, (size_t)k)))
+            fail(tc, "%s %d is %.17g", what, k, got[k]);
+}
+
 /* A valid request and its checks. */
 static void run_valid(test_case *tc, const char *dir, const json_t *chk)
 {
@@ -467,7 +576,7 @@ static void run_valid(test_case *tc, const char *dir, const json_t *chk)
     const json_t *x;
     const double *sp;
     size_t i;
-    int n, k;
+    int n;
 
     if (!req)
         return;
@@ -492,12 +601,14 @@ static void run_valid(test_case *tc, const char *dir, const json_t *chk)
     }
     if ((x = json_object_get(chk, "speeds"))) {
         sp = codec_request_speeds(req, &n);
-        if (n != (int)json_array_size(x))
-            fail(tc, "%d speeds, expected %zu", n, json_array_size(x));
-        for (k = 0; k < n && k < (int)json_array_size(x); k++)
-            if (sp[k] != json_number_value(json_array_get(x, (size_t)k)))
-                fail(tc, "speed %d is %g", k, sp[k]);
+        check_exact(tc, "speed", sp, n, x);
     }
+    if ((x = json_object_get(chk, "rpm"))) {
+        sp = codec_request_rpm(req, &n);
+        check_exact(tc, "rpm", sp, n, x);
+    }
+    if ((x = json_object_get(chk, "input_warnings")))
+        check_warnings(tc, codec_request_input_warnings(req), x);
     if ((x = json_object_get(chk, "options")))
         check_options(tc, codec_request_options(req), x);
     if ((x = json_object_get(chk, "structure")))
@@ -588,11 +699,13 @@ static void unit_csv(test_case *tc)
     sm_result res = {2, cases};
     char *csv = NULL;
     size_t len = 0;
+    /* per_rev is empty at rest; rpm = omega 60 / (2 pi) without a request */
     const char *want =
-        "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status\n"
-        "0,1,3.5,0.55704230082163375,0,3.5,,solved\n"
-        "0,2,20,3.183098861837907,0,20,,solved\n"
-        "20,,,,,,,no_equilibrium\n";
+        "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,"
+        "rpm\n"
+        "0,1,3.5,0.55704230082163375,0,3.5,,solved,,0\n"
+        "0,2,20,3.183098861837907,0,20,,solved,,0\n"
+        "20,,,,,,,no_equilibrium,,190.9859317102744\n";
 
     memset(cases, 0, sizeof(cases));
     cases[0].status = SM_CASE_SOLVED;
@@ -604,7 +717,7 @@ static void unit_csv(test_case *tc)
     cases[0].previous_index = prev;
     cases[1].omega = 20;
     cases[1].status = SM_CASE_NO_EQUILIBRIUM;
-    if (codec_result_csv(&csv, &len, &res) != SM_OK || strcmp(csv, want) || len != strlen(want))
+    if (codec_result_csv(&csv, &len, NULL, &res) != SM_OK || strcmp(csv, want) || len != strlen(want))
         fail(tc, "CSV:\n%s", csv ? csv : "(none)");
     free(csv);
 }
@@ -678,7 +791,7 @@ static int cmp_name(const void *a, const void *b)
 int main(int argc, char **argv)
 {
     test_case tc = {"unit: sha256, error list, problem, csv, diag pointers, spatial diag and "
-                    "result rows", 0};
+                    "result rows, blade result (Hz, per-rev, rpm)", 0};
     char **names = NULL;
     size_t n = 0, cap = 0, i;
     struct dirent *de;
@@ -695,6 +808,7 @@ int main(int argc, char **argv)
     unit_diag(&tc);
     unit_spatial_diag(&tc);
     unit_spatial_result(&tc);
+    unit_blade_result(&tc);
     if (tc.failures)
         failed++;
     else

@@ -26,4 +26,7 @@ void fail(test_case *tc, const char *fmt, ...)
 void unit_spatial_diag(test_case *tc);
 void unit_spatial_result(test_case *tc);
 
+/** A solved blade-form request: frequency_hz, per_rev, rpm in JSON and CSV (blade_units.c). */
+void unit_blade_result(test_case *tc);
+
 #endif /* SPINMODAL_CODEC_TEST_H */

@@ -144,6 +144,17 @@ SCHEMA_REJECTS = [
     "spatial-GJ-negative", "spatial-flap-inertia-negative", "spatial-edge-inertia-negative",
     "spatial-EI-flap-null", "flap-direction-zero", "flap-direction-two-numbers",
     "flap-direction-string", "point-mass-inertia-negative", "point-mass-inertia-number",
+    # blades (DESIGN.md 8)
+    "stations-with-planar", "stations-s-outside", "stations-only-one", "stations-not-array",
+    "stations-entry-not-object", "stations-s-missing", "stations-non-numeric",
+    "stations-negative-stiffness", "stations-zero-mass", "stations-negative-inertia",
+    "stations-unknown-key", "stations-material-key", "stations-offset-one-number",
+    "stations-too-many", "section-offset-with-planar", "section-offset-string",
+    "point-mass-offset-two-numbers", "point-mass-products-with-planar", "rpm-and-omega",
+    "rpm-negative", "range-unknown-key", "speeds-missing", "blade-and-structure",
+    "blade-length-zero", "blade-length-missing", "blade-precone-90", "blade-hub-radius-negative",
+    "blade-elements-zero", "blade-unknown-key", "blade-station-error", "blade-tip-inertia-negative",
+    "blade-tip-mass-missing", "blade-paper-basis", "blade-not-object", "blade-planar-section",
 ]
 
 # Invalid codec cases a JSON Schema cannot express (not forced; printed for information).
@@ -182,6 +193,27 @@ SCHEMA_CANNOT = {
     "spatial-on-axis-no-flap-direction": "geometry: a member on the spin axis at radius zero (core)",
     "spatial-flap-direction-along-member": "geometry: flap_direction parallel to the member (core)",
     "spatial-frame-too-large": "a cost bound from the model's sizes (lowered --max-frame-dofs)",
+    "stations-s-not-increasing": "order of values across array items",
+    "stations-s-repeated": "order of values across array items",
+    "stations-first-not-zero": "a value of the first array item (prefixItems would do; kept simple)",
+    "stations-last-not-one": "a value of the last array item",
+    "stations-missing-key": "the same keys at every array item",
+    "stations-section-not-completed": "a section completed by its members' stations (cross-reference)",
+    "point-mass-products-not-psd": "positive semi-definiteness of a tensor from two fields",
+    "blade-tip-not-psd": "positive semi-definiteness of a tensor from two fields",
+    "range-to-below-from": "to >= from compares two values",
+    "range-steps-zero": "steps >= 1 unless from == to compares values",
+    "range-too-many-speeds": "run with a lowered limit (max_speeds 3)",
+    "blade-station-missing-key": "the same keys at every array item",
+    "blade-section-incomplete": "a section completed by the stations (cross-reference)",
+    "blade-no-section-no-stations": "a section completed by the stations (cross-reference)",
+}
+
+# Valid codec cases a JSON Schema cannot accept (the codec is more permissive than the schema).
+SCHEMA_CANNOT_ACCEPT = {
+    "stations-complete-section": "a section may leave out what the stations of every member "
+                                 "using it give (DESIGN.md 8): a cross-reference between sections "
+                                 "and members; the schema asks for complete sections there",
 }
 
 # --------------------------------------------------------------------- groups
@@ -245,6 +277,9 @@ def t_requests():
     n = 0
     for name, d, valid in codec_cases():
         if not valid:
+            continue
+        if name in SCHEMA_CANNOT_ACCEPT:
+            note("%s: valid, not expressible in the schema (%s)" % (name, SCHEMA_CANNOT_ACCEPT[name]))
             continue
         for path in sorted(glob.glob(os.path.join(d, "*.json"))):
             base = os.path.basename(path)
@@ -555,7 +590,9 @@ def t_negative():
                           "stability": {"stable": True, "negative_eigenvalues": 0},
                           "modes": [{"frequency_rad_s": 1.0, "frequency_hz": 0.16, "eigenvalue": [0.0, 1.0],
                                      "mac_to_previous": None, "previous_index": None,
-                                     "shape": {"re": [[0, 0, 0], [1, 0, 0]], "im": [[0, 0, 0], [0, 0, 0]]}}]}],
+                                     "shape": {"re": [[0, 0, 0], [1, 0, 0]], "im": [[0, 0, 0], [0, 0, 0]]},
+                                     "per_rev": 1.0}],
+                          "rpm": 9.549296585513721}],
                "timing_ms": {"equilibrium": 0.1, "linearize": 0.1, "eigen": 0.1}}
     validates(res_doc, "result", "baseline result document")
     check(not m.is_valid(res_doc, "result"), "mutated result schema (no shape.im) rejects a Coriolis result")

@@ -281,7 +281,7 @@ static void fuzz_check_solve(const codec_request *r, const sm_model *m)
     FUZZ_CHECK(text != NULL);
     free(text);
     json_decref(doc);
-    rc = codec_result_csv(&text, &len, res);
+    rc = codec_result_csv(&text, &len, r, res);
     FUZZ_CHECK(rc == SM_OK && text != NULL && len == strlen(text));
     free(text);
     sm_result_free(res);
