@@ -562,3 +562,15 @@ char *import_dumps(const json_t *doc, int pretty)
     return json_dumps(doc, JSON_REAL_PRECISION(IMP_DUMP_PRECISION) |
                                (pretty ? JSON_INDENT(2) : JSON_COMPACT));
 }
+
+json_t *imp_document_assumed(const imp_blade *b, const imp_table *t, const char *format,
+                             json_t *warnings, json_t *source)
+{
+    json_t *sec = warnings ? imp_assumed_section(t, b->length, warnings, format) : NULL;
+    if (!sec) {
+        json_decref(warnings);
+        json_decref(source);
+        return NULL;
+    }
+    return imp_document(b, t, sec, warnings, source);
+}

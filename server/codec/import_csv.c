@@ -297,7 +297,7 @@ static json_t *csv_source(const char *file, const int *col, int ncol)
 
 int import_csv(json_t **out, const import_file *f, const import_options *o, import_diag *d)
 {
-    json_t *warn = json_array(), *sec;
+    json_t *warn = json_array();
     imp_table t = {NULL, 0, 0, 0};
     int col[CSV_MAX_COLUMNS], ncol = 0, has_r, c, st;
     imp_blade bl;
@@ -317,11 +317,7 @@ int import_csv(json_t **out, const import_file *f, const import_options *o, impo
     if ((st = imp_table_order(d, f->name, &t, has_r ? "r" : "s")) ||
         (st = imp_options_apply(d, f->name, o, has_r, &bl, warn)))
         goto done;
-    if (!(sec = imp_assumed_section(&t, bl.length, warn, "CSV"))) {
-        st = SM_NOMEM;
-        goto done;
-    }
-    *out = imp_document(&bl, &t, sec, warn, csv_source(f->name, col, ncol));
+    *out = imp_document_assumed(&bl, &t, "CSV", warn, csv_source(f->name, col, ncol));
     warn = NULL;
     st = *out ? SM_OK : SM_NOMEM;
 done:

@@ -253,7 +253,7 @@ static json_t *ed_source(const ed_params *p, const char *file)
 int import_elastodyn(json_t **out, const import_file *f, const import_options *o,
                      import_diag *d)
 {
-    json_t *warn = json_array(), *sec = NULL;
+    json_t *warn = json_array();
     imp_table t = {NULL, 0, 0, 0};
     int col[ED_MAX_COLUMNS], ncol = 0, st;
     imp_blade bl;
@@ -270,11 +270,7 @@ int import_elastodyn(json_t **out, const import_file *f, const import_options *o
         (st = ed_rows(&r, d, &p, col, ncol, &t)) ||
         (st = imp_options_apply(d, f->name, o, 0, &bl, warn)))
         goto done;
-    if (!(sec = imp_assumed_section(&t, bl.length, warn, "ElastoDyn blade"))) {
-        st = SM_NOMEM;
-        goto done;
-    }
-    *out = imp_document(&bl, &t, sec, warn, ed_source(&p, f->name));
+    *out = imp_document_assumed(&bl, &t, "ElastoDyn blade", warn, ed_source(&p, f->name));
     warn = NULL;
     st = *out ? SM_OK : SM_NOMEM;
 done:

@@ -196,4 +196,9 @@ int imp_options_apply(import_diag *d, const char *file, const import_options *o,
 json_t *imp_document(const imp_blade *b, const imp_table *t, json_t *section,
                      json_t *warnings, json_t *source);
 
+/** imp_document with the section imp_assumed_section makes for a file without EA/GJ (ElastoDyn,
+ *  CSV; format names it in the warning); takes warnings and source like imp_document. */
+json_t *imp_document_assumed(const imp_blade *b, const imp_table *t, const char *format,
+                             json_t *warnings, json_t *source);
+
 #endif /* SPINMODAL_IMPORT_INTERNAL_H */
