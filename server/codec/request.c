@@ -147,6 +147,14 @@ static void req_member_spatial(const json_t *x, sm_member *b)
  * section: zero) takes the member's first station's value, so the section
  * stays valid for the core, which reads that field from the stations.
  */
+/* 1 when section k of r gives ip_over_a itself (DESIGN.md 8.1). */
+static int req_ip_given(const codec_request *r, int k)
+{
+    const json_t *secs = json_object_get(r->structure, "sections");
+
+    return k >= 0 && json_object_get(json_object_get(secs, r->section_names[k]), "ip_over_a");
+}
+
 static int req_build_stations(codec_request *r, const json_t *mems)
 {
     const json_t *x;
@@ -174,8 +182,14 @@ static int req_build_stations(codec_request *r, const json_t *mems)
         REQ_FROM_STATION(SM_ST_GJ, GJ) REQ_FROM_STATION(SM_ST_I_FLAP, i_flap)
         REQ_FROM_STATION(SM_ST_I_EDGE, i_edge)
 #undef REQ_FROM_STATION
-        if (c && c->ip_over_a == 0 && c->mu > 0) /* DESIGN.md 7.3, stiffness form */
-            c->ip_over_a = (c->i_flap + c->i_edge) / c->mu;
+        if (c && c->ip_over_a == 0 && c->mu > 0 && !req_ip_given(r, b->section))
+            c->ip_over_a = (c->i_flap + c->i_edge) / c->mu; /* DESIGN.md 7.3, stiffness form */
+        if (c && req_ip_given(r, b->section) && !(b->station_mask & SM_ST_IP_OVER_A)) {
+            size_t j; /* the section's I_p/A given: it holds along the stations too (8.1) */
+            for (j = 0; j < n; j++)
+                r->stations[at + j].ip_over_a = c->ip_over_a;
+            b->station_mask |= SM_ST_IP_OVER_A;
+        }
         at += n;
     }
     return SM_OK;

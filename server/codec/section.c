@@ -39,7 +39,8 @@ static const char *const sec_inertia_keys[] = {"flap_inertia", "edge_inertia", N
 static const char *const sec_all_keys[] = {"E", "A", "I", "mass_per_length", "EA", "EI_flap",
                                            "EI_edge", "GJ", "G", "I_flap", "I_edge", "J",
                                            "flap_inertia", "edge_inertia", "cg_offset",
-                                           "shear_center_offset", "tension_center_offset", NULL};
+                                           "shear_center_offset", "tension_center_offset",
+                                           "ip_over_a", NULL};
 /* Offsets from the member axis (DESIGN.md 8), [edgewise, flapwise] in m, spatial only. */
 static const char *const sec_offset_keys[] = {"cg_offset", "shear_center_offset",
                                               "tension_center_offset", NULL};
@@ -115,7 +116,8 @@ static int sec_foreign(val_ctx *v, const json_t *sec, const char *ptr, sec_form 
 {
     static const char *const not_stiff[] = {"E", "A", "G", "I_flap", "I_edge", "J", NULL};
     static const char *const inertias[] = {"flap_inertia", "edge_inertia", "cg_offset",
-                                           "shear_center_offset", "tension_center_offset", NULL};
+                                           "shear_center_offset", "tension_center_offset",
+                                           "ip_over_a", NULL};
     int i, n = 0;
 
     if (f == SEC_STIFFNESS) {
@@ -313,8 +315,13 @@ json_t *sec_validate(val_ctx *v, const json_t *sec, const char *ptr, sec_form f,
     if (f == SEC_MATERIAL && ok)
         sec_products(v, ptr, val);
     if (f != SEC_PLANAR) {
+        double ip;
         sec_inertias(v, sec, ptr, f, c, val, ok);
         sec_offsets(v, sec, ptr, c);
+        /* the Wagner ratio I_p/A given (DESIGN.md 8.1): it replaces the one derived from the
+         * section (0 switches the tension-torsion term off, as BModes has none) */
+        if (json_object_get(sec, "ip_over_a"))
+            field_real(v, sec, "ip_over_a", ptr, c, FIELD_NONNEG, " (m^2)", &ip);
     }
     return c;
 }
@@ -371,6 +378,8 @@ void sec_fill(const json_t *canon, int spatial, sm_section *out)
         out->GJ = G * sec_num(canon, "J");
         out->ip_over_a = (I_flap + I_edge) / A; /* DESIGN.md 7.3: I_p/A = (I_flap + I_edge)/A */
     }
+    if (json_object_get(canon, "ip_over_a")) /* given: it wins (DESIGN.md 8.1) */
+        out->ip_over_a = sec_num(canon, "ip_over_a");
 }
 
 const char *sec_request_field(const json_t *canon, const char *core_field, const char **relation)
@@ -390,6 +399,8 @@ const char *sec_request_field(const json_t *canon, const char *core_field, const
     *relation = NULL;
     if (!strcmp(core_field, "mu"))
         return "mass_per_length";
+    if (!strcmp(core_field, "ip_over_a") && json_object_get(canon, "ip_over_a"))
+        return "ip_over_a";
     if (!strcmp(core_field, "ip_over_a") && f == SEC_STIFFNESS) {
         *relation = "I_p/A = (flap_inertia + edge_inertia)/mass_per_length";
         return NULL;

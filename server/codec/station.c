@@ -52,6 +52,7 @@ static const stn_key stn_keys[] = {
     {"cg_offset", SM_ST_CG, FIELD_FINITE, 2, STN_AT(cg), " (m)"},
     {"shear_center_offset", SM_ST_SC, FIELD_FINITE, 2, STN_AT(sc), " (m)"},
     {"tension_center_offset", SM_ST_TC, FIELD_FINITE, 2, STN_AT(tc), " (m)"},
+    {"ip_over_a", SM_ST_IP_OVER_A, FIELD_NONNEG, 1, STN_AT(ip_over_a), " (m^2)"},
 };
 #define STN_NKEYS (sizeof(stn_keys) / sizeof(stn_keys[0]))
 
@@ -59,7 +60,7 @@ static const stn_key stn_keys[] = {
 static const char *const stn_allowed[] = {
     "s", "mass_per_length", "EA", "EI_flap", "EI_edge", "GJ", "flap_inertia", "edge_inertia",
     "twist_deg", "inertia_twist_deg", "cg_offset", "shear_center_offset",
-    "tension_center_offset", NULL};
+    "tension_center_offset", "ip_over_a", NULL};
 
 /* Material-form keys: stations take the stiffness form only. */
 static const char *const stn_material[] = {"E", "G", "A", "I", "I_flap", "I_edge", "J", NULL};

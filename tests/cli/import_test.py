@@ -57,7 +57,10 @@ def main(argv):
                                         "inertia": [2.5, 1.75, 10.0], "products": [0.0, 0.0, 0.0]},
               "bmodes: tip mass 40 kg, offset [0, 0.05, 0], inertia [2.5, 1.75, 10]")
         check(req.get("analysis", {}).get("rpm") == [60.0], "bmodes: analysis.rpm [60]")
-        check(err == "", "bmodes: nothing on stderr")
+        check(blade.get("section") == {"ip_over_a": 0.0},
+              "bmodes: section.ip_over_a 0 (BModes has no Wagner term)")
+        check(err.count("warning:") == 1 and "Wagner" in err,
+              "bmodes: one warning on stderr, the Wagner term left out")
         check("181.672," in out, "bmodes: numbers printed at 15 digits (181.672)")
 
         # --full --pretty: the import document; --rpm overrides with a warning

@@ -287,8 +287,8 @@ static int numbers_match(const double *got, int n, const json_t *want)
 
 /*
  * checks.structure.member_stations: per member {"mask": SM_ST_* bits, "stations": [[s, mu, EA,
- * EI_flap, EI_edge, GJ, i_flap, i_edge, twist, inertia_twist, cg0, cg1, sc0, sc1, tc0, tc1],
- * ...]} (angles in rad), or null for a member without stations.
+ * EI_flap, EI_edge, GJ, i_flap, i_edge, twist, inertia_twist, cg0, cg1, sc0, sc1, tc0, tc1
+ * [, ip_over_a]], ...]} (angles in rad), or null for a member without stations.
  */
 static void check_stations(test_case *tc, const sm_structure *st, const json_t *want)
 {
@@ -316,10 +316,11 @@ static void check_stations(test_case *tc, const sm_structure *st, const json_t *
         }
         json_array_foreach(rows, j, srow) {
             const sm_station *q = &m->stations[j];
-            double got[16] = {q->s, q->mu, q->EA, q->EI_flap, q->EI_edge, q->GJ, q->i_flap,
+            double got[17] = {q->s, q->mu, q->EA, q->EI_flap, q->EI_edge, q->GJ, q->i_flap,
                               q->i_edge, q->twist, q->inertia_twist, q->cg[0], q->cg[1],
-                              q->sc[0], q->sc[1], q->tc[0], q->tc[1]};
-            if (!numbers_match(got, 16, srow)) {
+                              q->sc[0], q->sc[1], q->tc[0], q->tc[1], q->ip_over_a};
+            /* a 17th number, when given, is ip_over_a */
+            if (!numbers_match(got, json_array_size(srow) == 17 ? 17 : 16, srow)) {
                 char *w = json_dumps(srow, JSON_COMPACT | JSON_REAL_PRECISION(17));
                 fail(tc, "member %zu station %zu: got [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g, "
                      "%.17g, %.17g, %.17g, %.17g, %g, %g, %g, %g, %g, %g], want %s", i, j,
