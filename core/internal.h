@@ -61,6 +61,10 @@ typedef struct sm_elem {
     double sc[2], tc[2];         /* shear and tension centre offsets along (p2, p3), m (p2 as in
                                     ax: it turns with the element's direction) */
     double cg[3];                /* centre-of-mass offset from the axis, hub axes at rest, m */
+    double end_s[2];             /* span fractions of n1, n2 on the member */
+    double end_tw[2];            /* the member's twist at n1, n2 (rad) */
+    double base_ax[9];           /* the member's axes without twist (from -> to; p3 from
+                                    flap_direction): sm_model_member_axes */
 } sm_elem;
 
 /* A point that carries mass (lumped node, or quadrature point for consistent mass). */

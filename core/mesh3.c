@@ -445,15 +445,19 @@ int mesh3_elements(sm_model *m, const sm_structure *st, sm_diag *d)
         }
         /* the axes a node reports: those of the first member that reaches it, twist at the node */
         double sp[2] = {sa, sz};
-        for (int h = 0; h < 2; h++)
+        memcpy(el->base_ax, base, sizeof el->base_ax);
+        for (int h = 0; h < 2; h++) {
+            double t = (b->station_mask & SM_ST_TWIST)
+                           ? mesh3_mean(b, offsetof(sm_station, twist), 0, sp[h], sp[h])
+                           : b->twist;
+            el->end_tw[h] = t;
+            el->end_s[h] = sp[h];
             if (ends[h]->member < 0) {
-                double t = (b->station_mask & SM_ST_TWIST)
-                               ? mesh3_mean(b, offsetof(sm_station, twist), 0, sp[h], sp[h])
-                               : b->twist;
                 mesh3_twist(base, t, ends[h]->ax);
                 ends[h]->member = el->member;
                 ends[h]->span = sp[h];
             }
+        }
     }
     for (int i = 0; i < st->n_point_masses; i++) {
         const sm_point_mass *pm = &st->point_masses[i];

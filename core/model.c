@@ -196,6 +196,56 @@ int sm_model_node_position(const sm_model *m, int node, double xy[2])
     return SM_OK;
 }
 
+int sm_model_member_nodes(const sm_model *m, int member, int cap, int *nodes, double *s,
+                          double *twist)
+{
+    int ne = 0, n = 0;
+
+    if (!m->spatial || member < 0)
+        return SM_INVALID_INPUT;
+    for (int e = 0; e < m->n_elems; e++)
+        ne += m->elems[e].member == member;
+    if (ne == 0)
+        return SM_INVALID_INPUT;
+    if (cap < ne + 1)
+        return ne + 1;
+    for (int e = 0; e < m->n_elems; e++) {
+        const sm_elem *el = &m->elems[e];
+        if (el->member != member)
+            continue;
+        for (int h = 0; h < 2; h++) {
+            int node = h ? el->n2 : el->n1, k, seen = 0;
+            double sh = el->end_s[h];
+            for (k = 0; k < n; k++)
+                seen |= nodes[k] == node;
+            if (seen || n > ne)
+                continue;
+            for (k = n; k > 0 && s[k - 1] > sh; k--) { /* insertion by span fraction */
+                nodes[k] = nodes[k - 1];
+                s[k] = s[k - 1];
+                twist[k] = twist[k - 1];
+            }
+            nodes[k] = node;
+            s[k] = sh;
+            twist[k] = el->end_tw[h];
+            n++;
+        }
+    }
+    return n;
+}
+
+int sm_model_member_axes(const sm_model *m, int member, double axes[9])
+{
+    if (!m->spatial || member < 0)
+        return SM_INVALID_INPUT;
+    for (int e = 0; e < m->n_elems; e++)
+        if (m->elems[e].member == member) {
+            memcpy(axes, m->elems[e].base_ax, 9 * sizeof(double));
+            return SM_OK;
+        }
+    return SM_INVALID_INPUT;
+}
+
 int sm_model_node_axes(const sm_model *m, int node, double axes[9], int *member, double *s)
 {
     if (!m->spatial || node < 0 || node >= m->n_nodes || m->nodes[node].member < 0)

@@ -302,6 +302,20 @@ int sm_model_node_position3(const sm_model *m, int node, double xyz[3]);
  *  only.  Returns SM_OK or SM_INVALID_INPUT (planar model, k out of range). */
 int sm_model_node_axes(const sm_model *m, int node, double axes[9], int *member, double *s);
 
+/** The FE nodes of member i from its `from` joint (s = 0) to its `to` joint (s = 1): up to cap
+ *  node indices into nodes, their span fractions into s and the member's structural twist at
+ *  each (rad, about e1 from the axes of sm_model_member_axes; the stations' twist interpolated)
+ *  into twist.  Returns the number of nodes, elements + 1 (filled only when cap is at least
+ *  that: call with cap 0 to size the arrays), or SM_INVALID_INPUT (planar model, no such
+ *  member). */
+int sm_model_member_nodes(const sm_model *m, int member, int cap, int *nodes, double *s,
+                          double *twist);
+
+/** The axes of member i without twist (hub frame, column-major 3x3): e1 from `from` to `to`,
+ *  e3 its flap_direction made normal to e1 (DESIGN.md 7.1), e2 = e3 x e1 (edgewise; for a
+ *  blade, in the rotor plane).  SM_OK or SM_INVALID_INPUT (planar model, no such member). */
+int sm_model_member_axes(const sm_model *m, int member, double axes[9]);
+
 /* ---------------------------------------------------------------- solve */
 
 /**

@@ -4,8 +4,10 @@
 #   csv.sh JOB_ID            the CSV of a finished job (GET /v1/analyses/ID/result?format=csv)
 #   csv.sh REQUEST.json|-    submit the request, wait for it (via submit.sh), then print its CSV
 #
-# Columns: omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status — one
-# row per speed and mode (a speed without equilibrium has one row with empty mode fields).
+# Columns: omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,
+# rpm — one row per speed and mode (a speed without equilibrium has one row with empty mode
+# fields; per_rev is empty at omega = 0).  Span-wise mode shapes of a spatial job:
+# curl "$SPINMODAL_URL/v1/analyses/ID/result?format=spanwise" (or format=bmodes), DAEMON.md.
 #
 # Environment: SPINMODAL_URL (default http://127.0.0.1:8080), SPINMODAL_TOKEN (bearer token).
 # Needs curl and python3, and submit.sh next to this script for a request file.

@@ -361,6 +361,28 @@ class Client:
         return self._call("GET", "/v1/analyses/%s/result" % self._check_id(id),
                           query={"format": "csv"}, expect_json=False)[2]
 
+    def spanwise(self, id, bmodes=False):
+        """GET /v1/analyses/{id}/result?format=spanwise (CSV) or format=bmodes (BModes-style
+        text): the span-wise mode shapes of a spatial result with mode shapes (409 otherwise)."""
+        return self._call("GET", "/v1/analyses/%s/result" % self._check_id(id),
+                          query={"format": "bmodes" if bmodes else "spanwise"},
+                          expect_json=False)[2]
+
+    def import_file(self, format, main, sec_props=None, name=None, tip_radius=None,
+                    hub_radius=None, rpm=None):
+        """POST /v1/import/{format}: a blade file's text (``main``; BModes also the text of its
+        section-properties file, ``sec_props``) -> the import document {request, warnings,
+        source}.  SpinmodalError 422 names the file, line and field of a refused file."""
+        body = {"main": main}
+        if sec_props is not None:
+            body["sec_props"] = sec_props
+        if name:
+            body["name"] = name
+        return self._call("POST", "/v1/import/" + urllib.parse.quote(format, safe=""),
+                          body=json.dumps(body).encode("utf-8"),
+                          query={"tip_radius": tip_radius, "hub_radius": hub_radius,
+                                 "rpm": rpm})[2]
+
     def cancel(self, id):
         """DELETE /v1/analyses/{id}: the status document (``canceled`` for a queued job,
         ``cancel_requested`` for a running one); SpinmodalError 409 when already finished."""
@@ -532,6 +554,8 @@ def _cmd_solve(c, a):
     if has_result:
         if a.csv:
             sys.stdout.write(c.csv(st["id"]))
+        elif a.spanwise or a.bmodes:
+            sys.stdout.write(c.spanwise(st["id"], bmodes=a.bmodes))
         elif a.table:
             res = st["result"] if "result" in st else c.result(st["id"])
             sys.stdout.write(format_table(table_rows(res)))
@@ -542,6 +566,39 @@ def _cmd_solve(c, a):
     if st.get("state") != "done":
         _print_job_error(st)
         return EXIT_FAILED
+    return EXIT_OK
+
+
+def bmodes_sec_props_name(bmi_text):
+    """The section-properties file a BModes .bmi names (the quoted value on its
+    sec_props_file line), or None."""
+    for line in bmi_text.splitlines():
+        if "sec_props_file" in line:
+            v = line.strip().split()[0] if line.strip() else ""
+            return v.strip("'\"") or None
+    return None
+
+
+def _cmd_import(c, a):
+    try:
+        with open(a.file, encoding="utf-8", errors="replace", newline="") as f:
+            main = f.read()
+        sec = None
+        if a.format == "bmodes":
+            sec_path = a.sec_props or bmodes_sec_props_name(main)
+            if not sec_path:
+                raise _RequestFileError("%s: no sec_props_file line; give --sec-props" % a.file)
+            if not os.path.isabs(sec_path) and not a.sec_props:
+                sec_path = os.path.join(os.path.dirname(os.path.abspath(a.file)), sec_path)
+            with open(sec_path, encoding="utf-8", errors="replace", newline="") as f:
+                sec = f.read()
+    except OSError as e:
+        raise _RequestFileError("%s: %s" % (e.filename, e.strerror)) from None
+    doc = c.import_file(a.format, main, sec_props=sec, name=os.path.basename(a.file),
+                        tip_radius=a.tip_radius, hub_radius=a.hub_radius, rpm=a.rpm)
+    for w in doc.get("warnings", []):
+        print("warning: %s" % w, file=sys.stderr)
+    _dump(doc if a.full else doc.get("request"), a.pretty)
     return EXIT_OK
 
 
@@ -638,9 +695,27 @@ def _parser():
     fmt.add_argument("--table", action="store_true",
                      help="print an aligned table: speed (rad/s, rpm), mode, frequency in rad/s, Hz "
                           "and per revolution, status")
+    fmt.add_argument("--spanwise", action="store_true",
+                     help="print the span-wise mode shapes (flap, edge, twist and slopes) as CSV "
+                          "(spatial requests with mode_shapes)")
+    fmt.add_argument("--bmodes", action="store_true",
+                     help="print the span-wise mode shapes as a BModes-style table")
     s.add_argument("--timeout", type=float, default=None,
                    help="give up waiting after S seconds (exit 3; the job keeps running)")
     s.set_defaults(func=_cmd_solve)
+
+    s = sub.add_parser("import", parents=[common],
+                       help="turn a blade file into a request (POST /v1/import/FORMAT); print it")
+    s.add_argument("format", choices=["bmodes", "elastodyn", "csv"])
+    s.add_argument("file", help="the .bmi, ElastoDyn blade file or CSV")
+    s.add_argument("--sec-props", help="BModes section-properties file (default: the one the "
+                                       ".bmi names, next to it)")
+    s.add_argument("--tip-radius", type=float, help="m from the spin axis (ElastoDyn, CSV)")
+    s.add_argument("--hub-radius", type=float, help="m")
+    s.add_argument("--rpm", type=float, help="rotor speed, rev/min (overrides the file's)")
+    s.add_argument("--full", action="store_true",
+                   help="print the whole import document {request, warnings, source}")
+    s.set_defaults(func=_cmd_import)
 
     s = sub.add_parser("validate", parents=[common],
                        help="validate a request (nothing is stored); print the canonical form and id")

@@ -51,6 +51,7 @@ static const char cli_usage_text[] =
     "       spinmodal validate [--pretty] FILE|-\n"
     "       spinmodal import bmodes|elastodyn|csv FILE [--tip-radius R] [--hub-radius H]\n"
     "                        [--rpm N] [--pretty] [--full]\n"
+    "       spinmodal export spanwise|bmodes RESULT|-\n"
     "       spinmodal --help | --version\n";
 
 static void cli_help(void)
@@ -378,6 +379,47 @@ done:
     return rc;
 }
 
+/* spinmodal export spanwise|bmodes RESULT|-: codec_result_spanwise of a result document. */
+static int cli_export_main(int argc, char **argv)
+{
+    json_error_t jerr;
+    json_t *doc;
+    char *text = NULL, *out = NULL, why[256];
+    size_t len = 0, n = 0;
+    int bmodes, st, e;
+
+    if (argc != 4)
+        return cli_usage("export takes a format (spanwise or bmodes) and a result file (or -)");
+    if (strcmp(argv[2], "spanwise") && strcmp(argv[2], "bmodes"))
+        return cli_usage("export formats: spanwise (CSV) or bmodes (text table)");
+    bmodes = !strcmp(argv[2], "bmodes");
+    e = cli_read(argv[3], (size_t)1 << 31, &text, &len);
+    if (e) {
+        fprintf(stderr, "spinmodal: %s: %s\n", argv[3], strerror(e));
+        return CLI_FAILED;
+    }
+    doc = json_loadb(text, len, 0, &jerr);
+    free(text);
+    if (!doc) {
+        fprintf(stderr, "spinmodal: %s:%d: not a result document: %s\n", argv[3], jerr.line,
+                jerr.text);
+        return CLI_FAILED;
+    }
+    st = codec_result_spanwise(&out, &n, doc, bmodes, why, sizeof why);
+    json_decref(doc);
+    if (st == SM_INVALID_INPUT) {
+        fprintf(stderr, "spinmodal: %s: %s\n", argv[3], why);
+        return CLI_FAILED;
+    }
+    if (st) {
+        fprintf(stderr, "spinmodal: out of memory\n");
+        return CLI_FAILED;
+    }
+    e = fwrite(out, 1, n, stdout) != n || fflush(stdout);
+    free(out);
+    return e ? CLI_FAILED : CLI_OK;
+}
+
 int main(int argc, char **argv)
 {
     cli_args a = {NULL, NULL, 0, 0, 0};
@@ -387,6 +429,8 @@ int main(int argc, char **argv)
         return cli_usage("a command is required");
     if (!strcmp(argv[1], "import"))
         return cli_import_main(argc, argv);
+    if (!strcmp(argv[1], "export"))
+        return cli_export_main(argc, argv);
     for (i = 1; i < argc; i++) {
         const char *s = argv[i];
         if (!opts_done && (!strcmp(s, "-h") || !strcmp(s, "--help") || !strcmp(s, "help"))) {

@@ -24,6 +24,7 @@
 #include "codec_internal.h"
 
 #include <math.h>
+#include <stdlib.h>
 
 const char *codec_case_status_name(sm_case_status s)
 {
@@ -211,20 +212,90 @@ fail:
     return NULL;
 }
 
-/* The "model" object: sizes, and for a spatial model "spatial" and "dof_per_node". */
-static json_t *res_model(const codec_request *r, const sm_model_info *info)
+/* The id of member i in the canonical request: "blade" for the blade form, else its "id" or
+ * null. */
+static json_t *res_member_id(const codec_request *r, int i)
 {
+    const json_t *canon = codec_request_canonical(r);
+    const json_t *mems = json_object_get(json_object_get(canon, "structure"), "members");
+    const json_t *id = json_object_get(json_array_get(mems, (size_t)i), "id");
+
+    if (json_object_get(canon, "blade"))
+        return json_string("blade");
+    return id ? json_deep_copy(id) : json_null();
+}
+
+/*
+ * One member's layout for span-wise shapes (spatial, mode shapes on; DESIGN.md 8.3):
+ * {"member", "id", "length", "axes", "nodes", "s", "twist_deg"}: the member's axes without
+ * twist ([e1, e2, e3], 9 numbers, hub frame), its FE nodes from `from` (s = 0) to `to` (s = 1),
+ * their span fractions and the structural twist there (degrees, about e1 from e2, e3).
+ */
+static json_t *res_member_layout(const codec_request *r, const sm_model *m, int i)
+{
+    int n = sm_model_member_nodes(m, i, 0, NULL, NULL, NULL), k;
+    int *nodes = NULL;
+    double *s = NULL, *tw = NULL, ax[9], a[3], b[3];
+    json_t *o = NULL, *jn, *js, *jt;
+
+    if (n < 2)
+        return json_null();
+    nodes = malloc((size_t)n * sizeof *nodes);
+    s = malloc((size_t)n * sizeof *s);
+    tw = malloc((size_t)n * sizeof *tw);
+    if (!nodes || !s || !tw || sm_model_member_nodes(m, i, n, nodes, s, tw) != n ||
+        sm_model_member_axes(m, i, ax) != SM_OK)
+        goto done;
+    sm_model_node_position3(m, nodes[0], a);
+    sm_model_node_position3(m, nodes[n - 1], b);
+    o = json_pack("{s:i, s:o, s:f, s:o, s:[], s:[], s:[]}", "member", i, "id",
+                  res_member_id(r, i), "length",
+                  sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
+                       (b[2] - a[2]) * (b[2] - a[2])),
+                  "axes", res_reals(ax, 9), "nodes", "s", "twist_deg");
+    jn = json_object_get(o, "nodes");
+    js = json_object_get(o, "s");
+    jt = json_object_get(o, "twist_deg");
+    for (k = 0; o && k < n; k++)
+        if (json_array_append_new(jn, json_integer(nodes[k])) ||
+            json_array_append_new(js, res_real(s[k])) ||
+            json_array_append_new(jt, res_real(tw[k] / CODEC_RAD_PER_DEG))) {
+            json_decref(o);
+            o = NULL;
+        }
+done:
+    free(nodes);
+    free(s);
+    free(tw);
+    return o;
+}
+
+/* The "model" object: sizes, and for a spatial model "spatial" and "dof_per_node", and with
+ * mode shapes "members" (res_member_layout). */
+static json_t *res_model(const codec_request *r, const sm_model *m, const sm_model_info *info)
+{
+    const sm_structure *st = codec_request_structure(r);
     json_t *o = json_pack("{s:i, s:i, s:i, s:i}", "nodes", info->nodes, "elements",
                           info->elements, "frames", info->frames, "coordinates",
-                          info->coordinates);
+                          info->coordinates), *mems;
+    int i;
 
-    if (o && codec_request_structure(r)->spatial &&
+    if (o && st->spatial &&
         (json_object_set_new(o, "spatial", json_true()) ||
-         json_object_set_new(o, "dof_per_node", json_integer(6)))) {
-        json_decref(o);
-        return NULL;
+         json_object_set_new(o, "dof_per_node", json_integer(6))))
+        goto fail;
+    if (o && st->spatial && codec_request_options(r)->mode_shapes) {
+        mems = json_array();
+        if (json_object_set_new(o, "members", mems))
+            goto fail;
+        for (i = 0; i < st->n_members; i++)
+            if (json_array_append_new(mems, res_member_layout(r, m, i)))
+                goto fail;
     }
     return o;
+fail:
+    json_decref(o);
+    return NULL;
 }
 
 int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
@@ -245,7 +316,7 @@ int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
     if (json_object_set_new(doc, "solver",
                             json_pack("{s:s, s:s, s:s}", "name", "spinmodal", "version",
                                       SM_VERSION, "request_sha256", codec_request_sha256(r))) ||
-        json_object_set_new(doc, "model", res_model(r, &info)))
+        json_object_set_new(doc, "model", res_model(r, m, &info)))
         goto fail;
     cases = json_array();
     if (json_object_set_new(doc, "cases", cases))

@@ -166,7 +166,33 @@ enum MHD_Result http_get_analysis(struct MHD_Connection *c, http_req *r)
     return q;
 }
 
-/* GET /v1/analyses/{id}/result[?format=json|csv] */
+/*
+ * The stored result document text[len] as span-wise shapes (codec_result_spanwise: bmodes 0
+ * CSV, 1 the BModes-style table); takes text.  409 for a result without them (planar, or
+ * without mode shapes).
+ */
+static enum MHD_Result http_spanwise(struct MHD_Connection *c, http_req *r, char *text,
+                                     size_t len, int bmodes)
+{
+    json_t *doc = json_loadb(text, len, 0, NULL);
+    char *out = NULL, why[256];
+    size_t n = 0;
+    int st = doc ? codec_result_spanwise(&out, &n, doc, bmodes, why, sizeof why) : SM_NOMEM;
+
+    json_decref(doc);
+    free(text);
+    if (st == SM_INVALID_INPUT)
+        return http_problem(c, r, MHD_HTTP_CONFLICT, "no-spanwise-shapes",
+                            "No Span-wise Shapes", why, NULL, 0);
+    if (st)
+        return http_problem(c, r, MHD_HTTP_SERVICE_UNAVAILABLE, "out-of-memory",
+                            "Out Of Memory", "The shapes could not be written.", NULL, 0);
+    return http_respond(c, r, MHD_HTTP_OK,
+                        bmodes ? "text/plain; charset=utf-8" : "text/csv; charset=utf-8", out,
+                        n, 1, NULL, 0);
+}
+
+/* GET /v1/analyses/{id}/result[?format=json|csv|spanwise|bmodes] */
 enum MHD_Result http_get_result(struct MHD_Connection *c, http_req *r)
 {
     const char *format = NULL;
@@ -174,15 +200,19 @@ enum MHD_Result http_get_result(struct MHD_Connection *c, http_req *r)
     store_job jb;
     char *text;
     size_t len;
-    int csv = 0, rc;
+    int csv = 0, rc, shapes = -1; /* shapes: -1 no, 0 span-wise CSV, 1 BModes table */
 
     if (!r->id_ok)
         return http_not_found(c, r, 1);
     if (MHD_lookup_connection_value_n(c, MHD_GET_ARGUMENT_KIND, "format", 6, &format, NULL) ==
         MHD_YES) {
         csv = format && strcmp(format, "csv") == 0;
-        if (!format || (!csv && strcmp(format, "json") != 0))
-            return http_bad_query(c, r, "format", "must be json or csv");
+        if (format && !strcmp(format, "spanwise"))
+            shapes = 0;
+        else if (format && !strcmp(format, "bmodes"))
+            shapes = 1;
+        else if (!format || (!csv && strcmp(format, "json") != 0))
+            return http_bad_query(c, r, "format", "must be json, csv, spanwise or bmodes");
     }
     rc = http_job_read(r->h, r->id, csv ? STORE_WITH_CSV : STORE_WITH_RESULT, &jb);
     if (rc != JOBS_OK) {
@@ -203,6 +233,10 @@ enum MHD_Result http_get_result(struct MHD_Connection *c, http_req *r)
         jb.result_csv = NULL; /* handed to libmicrohttpd */
     else
         jb.result = NULL;
+    if (shapes >= 0) {
+        store_job_clear(&jb);
+        return http_spanwise(c, r, text, len, shapes);
+    }
     q = http_respond(c, r, MHD_HTTP_OK, csv ? "text/csv; charset=utf-8" : "application/json",
                      text, len, 1, NULL, 0);
     store_job_clear(&jb);

@@ -196,8 +196,14 @@ static void unit_encode(test_case *tc, const codec_request *req, const sm_model 
     model = json_object_get(doc, "model");
     if (dof == 6 && (!json_is_true(json_object_get(model, "spatial")) ||
                      json_integer_value(json_object_get(model, "dof_per_node")) != 6 ||
-                     json_object_size(model) != 6))
+                     json_object_size(model) != 6 + (json_object_get(model, "members") != NULL)))
         fail(tc, "%s: model lacks \"spatial\": true, \"dof_per_node\": 6", what);
+    if (dof == 6 && json_object_get(model, "members") &&
+        (json_array_size(json_object_get(model, "members")) !=
+             (size_t)codec_request_structure(req)->n_members ||
+         json_array_size(json_object_get(json_array_get(json_object_get(model, "members"), 0),
+                                         "nodes")) < 2))
+        fail(tc, "%s: model.members is not one layout per member with its nodes", what);
     if (dof == 3 && json_object_size(model) != 4)
         fail(tc, "%s: model has %zu keys, expected nodes, elements, frames, coordinates", what,
              json_object_size(model));
@@ -229,7 +235,7 @@ void unit_spatial_result(test_case *tc)
     codec_request *sreq = unit_parse(tc, spatial, "spatial result request");
     codec_request *preq = unit_parse(tc, planar, "planar result request");
     codec_errors *errs = codec_errors_new();
-    sm_model *m = NULL;
+    sm_model *m = NULL, *ms = NULL;
 
     if (!sreq || !preq || !errs)
         goto done;
@@ -238,10 +244,16 @@ void unit_spatial_result(test_case *tc)
              codec_errors_message(errs, 0));
         goto done;
     }
-    unit_encode(tc, sreq, m, 6);
+    if (codec_model_new(&ms, sreq, errs, NULL) != SM_OK) {
+        fail(tc, "spatial model for the result rows: '%s' %s", codec_errors_pointer(errs, 0),
+             codec_errors_message(errs, 0));
+        goto done;
+    }
+    unit_encode(tc, sreq, ms, 6);
     unit_encode(tc, preq, m, 3);
 done:
     sm_model_free(m);
+    sm_model_free(ms);
     codec_errors_free(errs);
     codec_request_free(sreq);
     codec_request_free(preq);

@@ -174,7 +174,7 @@ static void fuzz_check_arrays(const codec_request *r, const codec_limits *lim)
         FUZZ_CHECK(s->EA > 0 && s->EI_flap > 0 && s->EI_edge > 0 && s->GJ > 0);
         FUZZ_CHECK(isfinite(s->EA) && isfinite(s->EI_flap) && isfinite(s->EI_edge) &&
                    isfinite(s->GJ));
-        FUZZ_CHECK(s->i_flap > 0 && s->i_edge > 0 && s->ip_over_a > 0);
+        FUZZ_CHECK(s->i_flap > 0 && s->i_edge > 0 && s->ip_over_a >= 0); /* 0: given, Wagner off */
         FUZZ_CHECK(isfinite(s->i_flap) && isfinite(s->i_edge) && isfinite(s->ip_over_a));
         FUZZ_CHECK(s->E == 0 && s->A == 0 && s->I == 0);
     }
