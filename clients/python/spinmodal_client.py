@@ -369,7 +369,7 @@ class Client:
                           expect_json=False)[2]
 
     def import_file(self, format, main, sec_props=None, name=None, tip_radius=None,
-                    hub_radius=None, rpm=None):
+                    hub_radius=None, rpm=None, bmodes_mesh=None):
         """POST /v1/import/{format}: a blade file's text (``main``; BModes also the text of its
         section-properties file, ``sec_props``) -> the import document {request, warnings,
         source}.  SpinmodalError 422 names the file, line and field of a refused file."""
@@ -381,7 +381,7 @@ class Client:
         return self._call("POST", "/v1/import/" + urllib.parse.quote(format, safe=""),
                           body=json.dumps(body).encode("utf-8"),
                           query={"tip_radius": tip_radius, "hub_radius": hub_radius,
-                                 "rpm": rpm})[2]
+                                 "rpm": rpm, "bmodes_mesh": bmodes_mesh})[2]
 
     def cancel(self, id):
         """DELETE /v1/analyses/{id}: the status document (``canceled`` for a queued job,
@@ -595,7 +595,8 @@ def _cmd_import(c, a):
     except OSError as e:
         raise _RequestFileError("%s: %s" % (e.filename, e.strerror)) from None
     doc = c.import_file(a.format, main, sec_props=sec, name=os.path.basename(a.file),
-                        tip_radius=a.tip_radius, hub_radius=a.hub_radius, rpm=a.rpm)
+                        tip_radius=a.tip_radius, hub_radius=a.hub_radius, rpm=a.rpm,
+                        bmodes_mesh=a.bmodes_mesh)
     for w in doc.get("warnings", []):
         print("warning: %s" % w, file=sys.stderr)
     _dump(doc if a.full else doc.get("request"), a.pretty)
@@ -713,6 +714,9 @@ def _parser():
     s.add_argument("--tip-radius", type=float, help="m from the spin axis (ElastoDyn, CSV)")
     s.add_argument("--hub-radius", type=float, help="m")
     s.add_argument("--rpm", type=float, help="rotor speed, rev/min (overrides the file's)")
+    s.add_argument("--bmodes-mesh", type=int, metavar="K",
+                   help="BModes: BModes' own model (its elements as uniform members with "
+                        "midpoint properties), K FE elements each")
     s.add_argument("--full", action="store_true",
                    help="print the whole import document {request, warnings, source}")
     s.set_defaults(func=_cmd_import)

@@ -28,7 +28,7 @@
 enum { CLI_IMPORT_OK = 0, CLI_IMPORT_FAILED = 1, CLI_IMPORT_INVALID = 2, CLI_IMPORT_USAGE = 64 };
 
 static const char cli_import_usage_text[] =
-    "usage: spinmodal import bmodes FILE.bmi [--rpm N] [--pretty] [--full]\n"
+    "usage: spinmodal import bmodes FILE.bmi [--rpm N] [--bmodes-mesh K] [--pretty] [--full]\n"
     "       spinmodal import elastodyn FILE --tip-radius R [--hub-radius H] [--rpm N] "
     "[--pretty] [--full]\n"
     "       spinmodal import csv FILE [--tip-radius R] [--hub-radius H] [--rpm N] [--pretty] "
@@ -167,6 +167,18 @@ static int cli_import_args_parse(int argc, char **argv, cli_import_args *a)
             a->full = 1;
             continue;
         }
+        if (!opts_done && !strcmp(s, "--bmodes-mesh")) {
+            double per;
+            if (i + 1 >= argc || cli_import_number(argv[i + 1], &per) || per < 1 ||
+                per > 1000 || per != (int)per) {
+                fprintf(stderr, "spinmodal: --bmodes-mesh needs a whole number of FE elements "
+                                "per BModes element (1 to 1000)\n%s", cli_import_usage_text);
+                return CLI_IMPORT_USAGE;
+            }
+            a->opt.bmodes_mesh = (int)per;
+            i++;
+            continue;
+        }
         for (k = 0; !opts_done && k < 3; k++)
             if (!strcmp(s, num_opts[k]))
                 break;
@@ -199,6 +211,8 @@ static int cli_import_args_parse(int argc, char **argv, cli_import_args *a)
         return cli_import_usage("a format is required: bmodes, elastodyn or csv");
     if (!a->path)
         return cli_import_usage("a file (or - for standard input) is required");
+    if (a->opt.bmodes_mesh && strcmp(a->format, "bmodes"))
+        return cli_import_usage("--bmodes-mesh applies to bmodes only");
     return 0;
 }
 

@@ -160,6 +160,10 @@ const char *codec_request_joint_name(const codec_request *r, int j);
 /** The canonical request (defaults applied), borrowed from r. */
 const json_t *codec_request_canonical(const codec_request *r);
 
+/** The canonical structure the model is built from (borrowed): the canonical request's
+ *  "structure", or the structure a "blade" stands for (DESIGN.md 8.1). */
+const json_t *codec_request_structure_json(const codec_request *r);
+
 /**
  * The canonical JSON text: keys sorted, compact, reals with 17 significant
  * digits.  Borrowed from r, NUL-terminated.

@@ -39,6 +39,7 @@ void import_default_options(import_options *o)
     o->hub_radius = NAN;
     o->rpm = NAN;
     o->max_modes = lim.max_modes;
+    o->bmodes_mesh = 0;
 }
 
 int import_format_known(const char *name)

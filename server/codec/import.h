@@ -51,6 +51,9 @@ typedef struct import_options {
     double hub_radius; /* m, >= 0; NAN = not given */
     double rpm;        /* rev/min, >= 0; NAN = not given (overrides the file's) */
     int max_modes;     /* cap of analysis.modes (the codec's limit) */
+    int bmodes_mesh;   /* BModes only: > 0 = BModes' own model (its nselt elements as uniform
+                          members with its midpoint properties, BModes.f90:1110), this many FE
+                          elements each, in the structure form; 0 = the blade form */
 } import_options;
 
 /** Every option "not given", max_modes the codec's default limit. */

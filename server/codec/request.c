@@ -703,6 +703,11 @@ const json_t *codec_request_canonical(const codec_request *r)
     return r->canon;
 }
 
+const json_t *codec_request_structure_json(const codec_request *r)
+{
+    return r->structure;
+}
+
 const char *codec_request_canonical_text(const codec_request *r)
 {
     return r->canon_text;

@@ -124,6 +124,15 @@ static int http_import_query(struct MHD_Connection *c, http_req *r, http_import_
             return -1;
         }
     }
+    v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "bmodes_mesh");
+    if (v) { /* BModes' own model, this many FE elements per BModes element (import.h) */
+        long per = strtol(v, &end, 10);
+        if (end == v || *end != '\0' || per < 1 || per > 1000) {
+            *q = http_bad_query(c, r, "bmodes_mesh", "expected a whole number 1 to 1000");
+            return -1;
+        }
+        in->opt.bmodes_mesh = (int)per;
+    }
     v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "name");
     if (v && *v)
         in->main.name = v;
@@ -269,6 +278,8 @@ enum MHD_Result http_import_end(struct MHD_Connection *c, http_req *r)
     in.json = http_import_ctype(ct, "application/json");
     if (http_import_query(c, r, &in, &q))
         return q;
+    if (in.opt.bmodes_mesh && strcmp(in.format, "bmodes"))
+        return http_bad_query(c, r, "bmodes_mesh", "applies to bmodes only");
     if (in.json && http_import_json(c, r, &in, &doc, &q)) {
         json_decref(doc);
         return q;

@@ -190,6 +190,20 @@ def scenario(exe, cli, ref, client_dir, tmp):
         rc, out, err = client("import", "bmodes", bmi)
         check(rc == 0 and json.loads(out or "null") == req and "Wagner" in err,
               "client import: the CLI's request, the Wagner warning on stderr (%d)" % rc)
+        # BModes' own model through the daemon and the client: the CLI's request again
+        rc, own_cli, err = run([cli, "import", "bmodes", "--bmodes-mesh", "8", bmi])
+        r = d.post("/v1/import/bmodes?bmodes_mesh=8", {"main": main_text, "sec_props": sec_text,
+                                                       "name": "Test01_nonunif_blade.bmi"})
+        check(rc == 0 and r.status == 200 and (r.json() or {}).get("request") ==
+              json.loads(own_cli or "null"), "?bmodes_mesh=8: the CLI's --bmodes-mesh 8 request")
+        rc, out, err = client("import", "bmodes", "--bmodes-mesh", "8", bmi)
+        check(rc == 0 and json.loads(out or "null") == json.loads(own_cli or "null"),
+              "client import --bmodes-mesh 8: the CLI's request (%d)" % rc)
+        r = d.post("/v1/import/bmodes?bmodes_mesh=0", {"main": main_text, "sec_props": sec_text})
+        check(r.status == 400, "?bmodes_mesh=0: 400 (%s)" % r.status)
+        r = d.post("/v1/import/csv?bmodes_mesh=8&tip_radius=10", {"main": "s,mass_per_length\n"})
+        check(r.status == 400 and "bmodes only" in r.text(), "csv ?bmodes_mesh=8: 400 (%s)"
+              % r.status)
         rc, out, err = client("solve", req_path)
         check(rc == 0 and freqs(json.loads(out or "{}")) == freqs(res_cli),
               "client solve: the CLI's frequencies, bit for bit (%d)" % rc)
