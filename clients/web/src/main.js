@@ -1312,6 +1312,13 @@ $('keep-ref').addEventListener('click', () => {
   if (!R) return;
   S.ref = {id: R.id, result: R.result, label: `${R.id.slice(0, 8)} (${(R.result.cases || []).length} speeds)`};
   $('keep-ref').textContent = `Reference: ${R.id.slice(0, 8)} — keep this one instead`;
+  $('clear-ref').hidden = false;
+  updateChart();
+});
+$('clear-ref').addEventListener('click', () => {
+  S.ref = null;
+  $('keep-ref').textContent = 'Compare: keep as reference';
+  $('clear-ref').hidden = true;
   updateChart();
 });
 
