@@ -500,11 +500,14 @@ async function exportsAndCompare(page, result) {
   const png = await downloadText(page, '#campbell-png', null);
   ok(/\.png$/.test(png.name) && png.buf.subarray(1, 4).toString() === 'PNG' && png.buf.length > 5000,
     'Campbell as PNG', `${png.name} ${png.buf.length} bytes`);
+  fs.mkdirSync(SHOTS, {recursive: true});
+  fs.writeFileSync(path.join(SHOTS, '18-campbell-export.png'), png.buf); // the exported file, to look at
   const msvg = await downloadText(page, '#mode-svg-dl');
   ok(/<path[^>]*id="mode-path"/.test(msvg.text) && /<style>[^<]*svg \.mode/.test(msvg.text),
     'mode shape as SVG (the drawing with its styles)', msvg.text.slice(0, 200));
   const mpng = await downloadText(page, '#mode-png-dl', null);
   ok(mpng.buf.subarray(1, 4).toString() === 'PNG' && mpng.buf.length > 2000, 'mode shape as PNG', String(mpng.buf.length));
+  fs.writeFileSync(path.join(SHOTS, '19-mode-export.png'), mpng.buf);
   const withReq = await downloadText(page, '#dl-json-req');
   const wr = JSON.parse(withReq.text);
   ok(wr.request && wr.request.structure && wr.result && wr.result.cases.length === result.cases.length &&

@@ -251,7 +251,11 @@ export function campbellChart(container) {
     const fu = FREQ_UNITS[units.freq], su = SPEED_UNITS[units.speed];
     const yl = `frequency ${fu.sym} (${fu.label})`;
     let ymax = 0;
-    for (let i = 1; i <= nModes; i++) for (const v of data[i]) if (typeof v === 'number') ymax = Math.max(ymax, v);
+    const refFrom = 1 + nModes + orders.length + 1; // the reference's modes follow the crossings
+    for (let i = 1; i < data.length; i++) {
+      if (i > nModes && i < refFrom) continue;
+      for (const v of data[i]) if (typeof v === 'number') ymax = Math.max(ymax, v);
+    }
     for (const p of flagged) ymax = Math.max(ymax, p.y);
     if (units.freq === 'rev' && orders.length) ymax = Math.max(ymax, orders[orders.length - 1]);
     plot = new uPlot({

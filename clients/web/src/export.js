@@ -25,7 +25,9 @@ function svgRules() {
     }
     for (const r of Array.from(rules || [])) if (r.selectorText && /^svg[ .[]/.test(r.selectorText)) out.push(r.cssText);
   }
-  return out.join('\n');
+  // the page's custom properties (var(--mode) …) mean nothing outside it: put their values in
+  const root = getComputedStyle(document.documentElement);
+  return out.join('\n').replace(/var\((--[\w-]+)\)/g, (m, name) => root.getPropertyValue(name).trim() || '#333');
 }
 
 /** A standalone SVG text of an <svg> of the page (styles inlined, white background, a title). */
@@ -143,6 +145,14 @@ export function campbellSvg(u, last, title) {
       pen = true;
     }
     out.push(`<path d="${d}" fill="none" stroke="${stroke}" stroke-width="${s.width || 1}"${dash} stroke-linejoin="round"/>`);
+    if (/^\d+P$/.test(s.label)) { // the engine order's label where its line leaves the plot
+      let k = -1;
+      for (let j = 0; j < xv.length; j++) if (typeof yv[j] === 'number' && yv[j] <= ys.max && xv[j] <= xs.max) k = j;
+      if (k >= 0) {
+        const lx = Math.min(X(xv[k]) + 3, L + pw - 22), ly = Math.max(T + 10, Y(yv[k]) - 5);
+        out.push(`<text x="${r2(lx)}" y="${r2(ly)}" fill="#374151" font-size="11">${esc(s.label)}</text>`);
+      }
+    }
     if (/^mode /.test(s.label)) {
       for (let j = 0; j < xv.length; j++) {
         if (typeof yv[j] === 'number') out.push(`<circle cx="${r2(X(xv[j]))}" cy="${r2(Y(yv[j]))}" r="2.2" fill="${stroke}"/>`);
