@@ -257,7 +257,15 @@ export function campbellChart(container) {
       for (const v of data[i]) if (typeof v === 'number') ymax = Math.max(ymax, v);
     }
     for (const p of flagged) ymax = Math.max(ymax, p.y);
-    if (units.freq === 'rev' && orders.length) ymax = Math.max(ymax, orders[orders.length - 1]);
+    if (units.freq === 'rev') {
+      // per rev explodes towards Ω = 0: show the band of the engine orders and the modes at the top
+      // speed (the lower speeds' values stay in the table; zoom works inside this range)
+      const top = data[1 + 0] ? data.slice(1, 1 + nModes).map((col) => {
+        for (let j = col.length - 1; j >= 0; j--) if (typeof col[j] === 'number') return col[j];
+        return 0;
+      }) : [];
+      ymax = Math.min(ymax, Math.max(1.5 * (orders.length ? orders[orders.length - 1] : 1), ...top));
+    }
     plot = new uPlot({
       width: width(),
       height: 340,
