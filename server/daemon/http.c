@@ -156,10 +156,18 @@ static void http_route_of(http_req *r, const char *url)
     } else if (strncmp(url, "/v1/analyses/", 13) == 0) {
         rest = url + 13;
         slash = strchr(rest, '/');
-        if (slash && strcmp(slash, "/result") != 0)
+        if (slash && strcmp(slash, "/result") != 0 && strcmp(slash, "/request") != 0)
             return;
-        r->route = slash ? R_RESULT : R_ANALYSIS;
-        r->tmpl = slash ? "/v1/analyses/{id}/result" : "/v1/analyses/{id}";
+        if (!slash) {
+            r->route = R_ANALYSIS;
+            r->tmpl = "/v1/analyses/{id}";
+        } else if (strcmp(slash, "/result") == 0) {
+            r->route = R_RESULT;
+            r->tmpl = "/v1/analyses/{id}/result";
+        } else {
+            r->route = R_REQUEST;
+            r->tmpl = "/v1/analyses/{id}/request";
+        }
         r->id_ok = http_is_id(rest, slash ? (size_t)(slash - rest) : strlen(rest));
         if (r->id_ok) {
             memcpy(r->id, rest, 64);
@@ -227,6 +235,8 @@ static enum MHD_Result http_get(struct MHD_Connection *c, http_req *r)
         return http_get_analysis(c, r);
     case R_RESULT:
         return http_get_result(c, r);
+    case R_REQUEST:
+        return http_get_request(c, r);
     case R_LIVEZ:
         return http_respond(c, r, MHD_HTTP_OK, "application/json", (char *)livez,
                             sizeof(livez) - 1, 0, NULL, 0);
@@ -246,7 +256,7 @@ static enum MHD_Result http_get(struct MHD_Connection *c, http_req *r)
 static int http_read_needs_token(http_route route)
 {
     return route == R_ANALYSES || route == R_ANALYSIS || route == R_RESULT ||
-           route == R_METRICS;
+           route == R_REQUEST || route == R_METRICS;
 }
 
 /* Answer a request other than a POST with a body (all of it is in). */

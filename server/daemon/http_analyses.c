@@ -1,6 +1,7 @@
 /*
  * http_analyses.c — the /v1/analyses routes of spinmodald and the end of a
- * POST (DAEMON.md): status, result, listing, cancel, validate and submit,
+ * POST (DAEMON.md): status, result, request, listing, cancel, validate and
+ * submit,
  * with ?wait=S.
  *
  * How it fits: reads go through the job pool while it runs (live progress)
@@ -239,6 +240,40 @@ enum MHD_Result http_get_result(struct MHD_Connection *c, http_req *r)
     }
     q = http_respond(c, r, MHD_HTTP_OK, csv ? "text/csv; charset=utf-8" : "application/json",
                      text, len, 1, NULL, 0);
+    store_job_clear(&jb);
+    return q;
+}
+
+/*
+ * GET /v1/analyses/{id}/request: the canonical request the job was
+ * submitted as (defaults applied, keys sorted: the text its id is the
+ * SHA-256 of), verbatim from the store, in any state.  POSTing it back
+ * gives the same job.  404 for an unknown id (also once retention removed
+ * it); the token rules are those of GET /v1/analyses/{id}.
+ */
+enum MHD_Result http_get_request(struct MHD_Connection *c, http_req *r)
+{
+    enum MHD_Result q;
+    store_job jb;
+    char *text;
+    size_t len;
+    int rc;
+
+    if (!r->id_ok)
+        return http_not_found(c, r, 1);
+    rc = http_job_read(r->h, r->id, STORE_WITH_REQUEST, &jb);
+    if (rc != JOBS_OK) {
+        store_job_clear(&jb);
+        return http_jobs_failed(c, r, rc);
+    }
+    if (!jb.request) { /* a store always keeps it: treat a missing text as a store fault */
+        store_job_clear(&jb);
+        return http_unavailable(c, r, "unavailable");
+    }
+    text = jb.request;
+    len = jb.request_len;
+    jb.request = NULL; /* handed to libmicrohttpd */
+    q = http_respond(c, r, MHD_HTTP_OK, "application/json", text, len, 1, NULL, 0);
     store_job_clear(&jb);
     return q;
 }

@@ -61,6 +61,7 @@ typedef enum http_route {
     R_VALIDATE,      /* /v1/validate */
     R_ANALYSIS,      /* /v1/analyses/{id} */
     R_RESULT,        /* /v1/analyses/{id}/result */
+    R_REQUEST,       /* /v1/analyses/{id}/request */
     R_LIVEZ,
     R_READYZ,
     R_METRICS,
@@ -217,6 +218,8 @@ enum MHD_Result http_get_analysis(struct MHD_Connection *c, http_req *r);
 
 /** GET /v1/analyses/{id}/result[?format=json|csv] */
 enum MHD_Result http_get_result(struct MHD_Connection *c, http_req *r);
+/** GET /v1/analyses/{id}/request: the job's canonical request (http_analyses.c). */
+enum MHD_Result http_get_request(struct MHD_Connection *c, http_req *r);
 
 /** GET /v1/analyses[?limit=N&before=SEQ&state=S] */
 enum MHD_Result http_list(struct MHD_Connection *c, http_req *r);

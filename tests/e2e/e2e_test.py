@@ -1397,7 +1397,9 @@ def t_list(sc):
 
 
 def t_misc(sc):
-    """/, /openapi.json, schemas byte for byte, /livez, /readyz, HEAD, flags, durability."""
+    """/, /openapi.json, schemas byte for byte, /livez, /readyz, HEAD, flags, durability,
+    GET /v1/analyses/{id}/request (t_job_request)."""
+    t_job_request(sc)
     d = sc.daemon(["--workers", "2"])
     r = d.get("/")
     check(r.status == 200 and r.media_type() == "text/html", "misc: GET / is HTML (%s %r)" % (r.status, r.ctype()))
@@ -1627,6 +1629,53 @@ def t_spatial(sc):
     stop_clean(d, "spatial")
 
 
+def t_job_request(sc):
+    """GET /v1/analyses/{id}/request: the job's canonical request (the web page reopens past jobs
+    with it); 404 for an unknown id; the token rules of GET /v1/analyses/{id}."""
+    d = sc.daemon(["--workers", "1"], name="request")
+    req = small(7, modes=2)
+    v = d.post("/v1/validate", req).json() or {}
+    jid, r = submit_id(d, req, "request: job", wait=ts.wait_param(30), expect=(200,))
+    if jid:
+        r = d.get(job_path(jid) + "/request")
+        check(r.status == 200 and r.media_type() == "application/json",
+              "request: GET /request -> 200 application/json (%s %r)" % (r.status, r.ctype()))
+        got = r.json()
+        check(got == v.get("canonical"), "request: it is the canonical request (= /v1/validate's canonical): %s"
+              % r.text(200))
+        check(got.get("analysis", {}).get("coriolis") is True and got.get("frames") == "per_element",
+              "request: defaults written out (%s)" % r.text(300))
+        r2 = submit(d, got)
+        check(r2.status == 200 and (r2.json() or {}).get("id") == jid,
+              "request: POSTing it back is the same job (a cache hit, %s)" % r2.status)
+        r = d.request("HEAD", job_path(jid) + "/request")
+        check(r.status == 200 and r.body == b"", "request: HEAD -> 200 without a body (%s)" % r.status)
+        problem_ok(d.post(job_path(jid) + "/request", req), 405, "request: POST /request -> 405")
+    problem_ok(d.get(job_path("0" * 64) + "/request"), 404, "request: unknown id -> 404")
+    problem_ok(d.get("/v1/analyses/not-an-id/request"), 404, "request: malformed id -> 404")
+    problem_ok(d.get(job_path("0" * 64) + "/requests"), 404, "request: /requests is no route -> 404")
+    stop_clean(d, "request")
+    # --auth-reads: the token is needed as for GET /v1/analyses/{id}, checked before the id
+    token = "req-Token-7"
+    tf = os.path.join(sc.tmp, "req-token")
+    with open(tf, "w") as f:
+        f.write(token + "\n")
+    os.chmod(tf, 0o600)
+    d = sc.daemon(["--workers", "1", "--token-file", tf, "--auth-reads", "yes"], name="request-auth")
+    auth = {"Authorization": "Bearer " + token}
+    jid, r = submit_id(d, req, "request: job (auth)", wait=ts.wait_param(30), expect=(200,), headers=auth)
+    if jid:
+        problem_ok(d.get(job_path(jid) + "/request"), 401, "request: --auth-reads: without a token -> 401")
+        problem_ok(d.get(job_path(jid)), 401, "request: --auth-reads: GET of the job without a token -> 401 too")
+        r = d.get(job_path(jid) + "/request", headers=auth)
+        check(r.status == 200 and r.json() == v.get("canonical"), "request: --auth-reads: with the token -> 200 (%s)"
+              % r.status)
+    problem_ok(d.get(job_path("0" * 64) + "/request"), 401, "request: --auth-reads: unknown id without a token -> 401")
+    problem_ok(d.get(job_path("0" * 64) + "/request", headers=auth), 404,
+               "request: --auth-reads: unknown id with the token -> 404")
+    stop_clean(d, "request auth")
+
+
 # ------------------------------------------------------------------ main
 
 SCENARIOS = {
@@ -1648,6 +1697,7 @@ SCENARIOS = {
     "misc": t_misc,
     "validate": t_validate,
     "spatial": t_spatial,
+    "request": t_job_request,
 }
 
 

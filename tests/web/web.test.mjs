@@ -394,6 +394,302 @@ async function flapMode(page, result) {
   await shot(page, '08-flapping-blade-mode1.png');
 }
 
+const TWO_PI = 2 * Math.PI;
+const BLADES = new URL('../reference/blades/bmodes_certtest/', import.meta.url).pathname;
+
+/** The text of a page-made download (a blob link or a saved blob) after clicking sel. */
+async function downloadText(page, sel, encoding = 'utf8') {
+  const [d] = await Promise.all([page.waitForEvent('download'), page.click(sel)]);
+  const buf = fs.readFileSync(await d.path());
+  return {name: d.suggestedFilename(), text: encoding ? buf.toString(encoding) : null, buf};
+}
+
+/**
+ * Units (issue 13 item 5): rpm / rad/s for speeds and rad/s / Hz / per rev for
+ * frequencies on the Campbell axes, the table and the "CSV (units shown)"
+ * download, checked against the result of the 0…20 rad/s sweep; engine orders
+ * as the user picks them; zoom in y.
+ */
+async function unitsAndCampbell(page, result) {
+  const c20 = result.cases.find((c) => c.omega === 20);
+  const rpm20 = 20 * 60 / TWO_PI;
+  await page.selectOption('#speed-unit', 'rpm');
+  let p = await page.evaluate(() => window.__spinmodal.campbell());
+  ok(Math.abs(p.x[p.x.length - 1] - rpm20) <= 1e-9 * rpm20 && /rpm/.test(p.axisLabels[0]),
+    'rpm: the Campbell x axis is in rpm (last speed = 20·60/2π)', `${p.x[p.x.length - 1]} vs ${rpm20}; ${p.axisLabels[0]}`);
+  const xi = p.x.length - 1;
+  const m1 = p.series.find((s) => /^mode 1/.test(s.label));
+  ok(Math.abs(m1.values[xi] - c20.modes[0].frequency_rad_s) <= 1e-12 * c20.modes[0].frequency_rad_s,
+    'rpm: mode 1 is still plotted in rad/s at that speed', String(m1.values[xi]));
+  const eo1 = p.series.find((s) => s.label === '1P');
+  ok(Math.abs(eo1.values[xi] - 20) < 1e-9, 'rpm axis with rad/s frequencies: the 1P line is ω = Ω = 20 rad/s at 190.99 rpm',
+    String(eo1.values[xi]));
+  let head = await page.textContent('#freq-table thead');
+  let last = await page.locator('#freq-table tbody tr').last().locator('th').textContent();
+  ok(/Ω \(rpm\)/.test(head) && Number(last) === Number(rpm20.toPrecision(6)), 'rpm: the table gives the speed in rpm',
+    `${head.slice(0, 40)} | ${last}`);
+  await page.selectOption('#freq-unit', 'hz');
+  p = await page.evaluate(() => window.__spinmodal.campbell());
+  const hz = p.series.find((s) => /^mode 1/.test(s.label)).values[xi];
+  ok(Math.abs(hz - c20.modes[0].frequency_hz) <= 1e-12 * hz && /Hz/.test(p.axisLabels[1]),
+    'Hz: the Campbell y axis is the result\'s frequency_hz', `${hz} vs ${c20.modes[0].frequency_hz}`);
+  ok(Math.abs(p.series.find((s) => s.label === '2P').values[xi] - 2 * 20 / TWO_PI) < 1e-9,
+    'Hz against rpm: the 2P line is 2·Ω/2π Hz (not 2·Ω)');
+  const cell = await page.locator('#freq-table tbody tr').last().locator('td').nth(1).textContent();
+  ok(Number(cell) === Number(c20.modes[0].frequency_hz.toPrecision(6)), 'Hz: the table gives f₁ in Hz', cell);
+  const cross = await page.locator('#crossings tbody tr').first().locator('td').allTextContents();
+  const pc = p.crossings[0];
+  ok(Math.abs(Number(cross[2]) - Number((pc.omega * 60 / TWO_PI).toPrecision(5))) < 1e-9 &&
+    Math.abs(Number(cross[3]) - Number((pc.freq / TWO_PI).toPrecision(5))) < 1e-9,
+  'the crossings table follows the units (rpm, Hz)', JSON.stringify([cross, pc]));
+  const csv = await downloadText(page, '#dl-csv-units');
+  const lines = csv.text.trim().split('\n');
+  const row20 = lines[lines.length - 1].split(',').map(Number);
+  ok(lines[0].startsWith('speed (rpm),status,mode 1 (Hz)') && Math.abs(row20[0] - rpm20) <= 1e-12 * rpm20 &&
+    row20[2] === c20.modes[0].frequency_hz, 'CSV (units shown): rpm and Hz columns, the values of the result',
+  `${lines[0]} | ${lines[lines.length - 1]}`);
+  await page.selectOption('#freq-unit', 'rev');
+  p = await page.evaluate(() => window.__spinmodal.campbell());
+  const pr = p.series.find((s) => /^mode 1/.test(s.label)).values[xi];
+  ok(Math.abs(pr - c20.modes[0].per_rev) <= 1e-12 && p.series.find((s) => s.label === '3P').values.every((v) => v === 3),
+    'per rev: mode 1 is the result\'s per_rev and the 3P line is the constant 3', `${pr} vs ${c20.modes[0].per_rev}`);
+  await shot(page, '10-units-rpm-per-rev.png');
+  await page.selectOption('#speed-unit', 'rad');
+  await page.selectOption('#freq-unit', 'rad');
+
+  // engine orders as picked; each line labelled on the plot
+  await page.fill('#eo-list', '1, 3, 5');
+  p = await page.evaluate(() => window.__spinmodal.campbell());
+  const eo = p.series.filter((s) => /^\d+P$/.test(s.label)).map((s) => s.label);
+  ok(JSON.stringify(eo) === '["1P","3P","5P"]' && p.crossings.every((c) => [1, 3, 5].includes(c.order)),
+    'engine orders as picked (1, 3, 5): only those lines and crossings', JSON.stringify(eo));
+  await page.fill('#eo-list', '1-4');
+  // zoom: a drag mostly up-down zooms y only (a low mode need not be squashed against the axis)
+  const before = (await page.evaluate(() => window.__spinmodal.campbell())).scales;
+  const over = page.locator('#campbell .u-over');
+  const b = await over.boundingBox();
+  await page.mouse.move(b.x + b.width * 0.5, b.y + b.height * 0.70);
+  await page.mouse.down();
+  await page.mouse.move(b.x + b.width * 0.51, b.y + b.height * 0.98, {steps: 6});
+  await page.mouse.up();
+  const after = (await page.evaluate(() => window.__spinmodal.campbell())).scales;
+  ok(after.y[1] < 0.5 * before.y[1] && after.y[1] > 0 && Math.abs(after.x[1] - before.x[1]) < 1e-9,
+    'zoom in y: a vertical drag narrows the frequency axis, the speed axis stays', JSON.stringify([before, after]));
+  await shot(page, '11-campbell-zoom-y.png');
+  await page.click('#zoom-reset');
+  const reset = (await page.evaluate(() => window.__spinmodal.campbell())).scales;
+  ok(Math.abs(reset.y[1] - before.y[1]) < 1e-9, 'Reset zoom shows everything again', JSON.stringify(reset));
+  // mode colours told apart from each other and from the crossing markers
+  const colours = await page.evaluate(() => {
+    const items = Array.from(document.querySelectorAll('#campbell .u-legend .u-series'));
+    return items.map((e) => [e.querySelector('.u-label') ? e.querySelector('.u-label').textContent : '',
+      getComputedStyle(e.querySelector('.u-marker')).borderColor]);
+  });
+  const modeCols = colours.filter(([l]) => /^mode /.test(l)).map(([, c]) => c);
+  const crossCol = (colours.find(([l]) => l === 'crossings') || [])[1];
+  ok(modeCols.length === 3 && new Set(modeCols).size === 3 && !modeCols.includes(crossCol),
+    'mode colours differ from each other and from the crossings', JSON.stringify(colours));
+}
+
+/** SVG and PNG of the Campbell diagram and the mode shape; a second design overlaid on the first. */
+async function exportsAndCompare(page, result) {
+  const svg = await downloadText(page, '#campbell-svg');
+  ok(/\.svg$/.test(svg.name) && /^<\?xml/.test(svg.text) && /<svg[^>]+xmlns="http:\/\/www.w3.org\/2000\/svg"/.test(svg.text) &&
+    svg.text.includes('mode 1') && svg.text.includes('1P') && (svg.text.match(/<path /g) || []).length >= 3 + 4,
+  'Campbell as SVG: vector paths of the modes and engine orders, with the legend', `${svg.name} ${svg.text.length} bytes`);
+  const png = await downloadText(page, '#campbell-png', null);
+  ok(/\.png$/.test(png.name) && png.buf.subarray(1, 4).toString() === 'PNG' && png.buf.length > 5000,
+    'Campbell as PNG', `${png.name} ${png.buf.length} bytes`);
+  fs.mkdirSync(SHOTS, {recursive: true});
+  fs.writeFileSync(path.join(SHOTS, '18-campbell-export.png'), png.buf); // the exported file, to look at
+  const msvg = await downloadText(page, '#mode-svg-dl');
+  ok(/<path[^>]*id="mode-path"/.test(msvg.text) && /<style>[^<]*svg \.mode/.test(msvg.text),
+    'mode shape as SVG (the drawing with its styles)', msvg.text.slice(0, 200));
+  const mpng = await downloadText(page, '#mode-png-dl', null);
+  ok(mpng.buf.subarray(1, 4).toString() === 'PNG' && mpng.buf.length > 2000, 'mode shape as PNG', String(mpng.buf.length));
+  fs.writeFileSync(path.join(SHOTS, '19-mode-export.png'), mpng.buf);
+  const withReq = await downloadText(page, '#dl-json-req');
+  const wr = JSON.parse(withReq.text);
+  ok(wr.request && wr.request.structure && wr.result && wr.result.cases.length === result.cases.length &&
+    JSON.stringify(wr.request.analysis.omega) === JSON.stringify(result.cases.map((c) => c.omega)),
+  'JSON + request: the result with the request that produced it');
+
+  // compare: keep this result, change the design (a heavier tip), solve, both on the Campbell diagram
+  await page.click('#keep-ref');
+  const text = (await page.inputValue('#json')).replace('"mass_per_length": 1.2', '"mass_per_length": 2.4');
+  await page.fill('#json', text);
+  await page.click('#submit');
+  await waitFor(page, () => document.body.dataset.jobState === 'done', null, 'the second design', 180000);
+  ok(await waitFor(page, () => (window.__spinmodal.campbell().series || []).some((s) => s.label === 'ref mode 1'), null,
+    'the overlay'), 'compare: the reference result is overlaid');
+  const p = await page.evaluate(() => window.__spinmodal.campbell());
+  const xi = p.x.indexOf(20);
+  const ref1 = p.series.find((s) => s.label === 'ref mode 1').values[xi];
+  const cur1 = p.series.find((s) => /^mode 1/.test(s.label)).values[xi];
+  const want = result.cases.find((c) => c.omega === 20).modes[0].frequency_rad_s;
+  ok(ref1 === want && cur1 < want, 'compare: ref mode 1 at 20 rad/s is the first design\'s, the heavier beam\'s is lower',
+    `${ref1} vs ${want}; now ${cur1}`);
+  await shot(page, '12-compare-designs.png');
+  await page.click('#clear-ref');
+  ok(!(await page.evaluate(() => window.__spinmodal.campbell())).series.some((s) => /^ref /.test(s.label)),
+    'Stop comparing removes the overlay');
+  await page.fill('#json', text.replace('"mass_per_length": 2.4', '"mass_per_length": 1.2'));
+}
+
+/** Speeds with warnings or without equilibrium: hollow grey, not in the lines, never used for crossings. */
+async function flaggedSpeeds(page) {
+  const p = await page.evaluate(() => window.__spinmodal.campbell());
+  const res = await page.evaluate(() => window.__spinmodal.result);
+  const bad = new Set(res.cases.filter((c) => c.status !== 'solved' || (c.warnings || []).length).map((c) => c.omega));
+  const m1 = p.series.find((s) => /^mode 1/.test(s.label));
+  ok(bad.size > 0 && p.flagged.length > 0 && p.flagged.every((f) => bad.has(f.x)) &&
+    p.x.every((x, i) => !bad.has(x) || m1.values[i] === null || m1.values[i] === undefined),
+  'flagged speeds are drawn apart (hollow), not on the mode lines', `${p.flagged.length} flagged points at ${[...bad]}`);
+  const sorted = res.cases.map((c) => c.omega).sort((a, b) => a - b);
+  const okX = p.crossings.every((c) => {
+    const i = sorted.findIndex((o, k) => k + 1 < sorted.length && o <= c.omega && c.omega <= sorted[k + 1]);
+    return i >= 0 && !bad.has(sorted[i]) && !bad.has(sorted[i + 1]);
+  });
+  ok(okX, 'no crossing uses a flagged speed', JSON.stringify(p.crossings.map((c) => c.omega)));
+}
+
+/**
+ * Blades (issue 12): the BModes certification blade Test01 opened with "Open
+ * blade file…" (the .bmi and its section file) loads as a blade-form request,
+ * is drawn, solves at its 60 rpm; a broken file names file, line and field;
+ * a unit slip is a warning next to its field; speeds in rpm and as a range.
+ */
+async function blades(page) {
+  // a broken section file: the error names the file, line and field
+  await page.click('#open-blade');
+  await page.selectOption('#import-format', 'bmodes');
+  const bmi = fs.readFileSync(path.join(BLADES, 'Test01_nonunif_blade.bmi'));
+  const sec = fs.readFileSync(path.join(BLADES, 'blade_sec_props.dat'), 'utf8');
+  const broken = sec.split('\n').map((l, i) => (i === 7 ? l.replace(/^(\s*\S+\s+\S+\s+\S+\s+)\S+/, '$1abc') : l)).join('\n');
+  await page.setInputFiles('#import-main', {name: 'Test01_nonunif_blade.bmi', mimeType: 'text/plain', buffer: bmi});
+  await page.setInputFiles('#import-sec', {name: 'blade_sec_props.dat', mimeType: 'text/plain', buffer: Buffer.from(broken)});
+  await page.click('#import-go');
+  ok(await waitFor(page, () => document.getElementById('import-error').textContent !== '', null, 'the import error'),
+    'a broken section file is refused');
+  const ie = await page.evaluate(() => ({text: document.getElementById('import-error').textContent,
+    ...document.getElementById('import-error').dataset}));
+  ok(ie.file === 'blade_sec_props.dat' && ie.line === '8' && ie.field === 'mass_den' &&
+    /blade_sec_props\.dat, line 8, field mass_den/.test(ie.text) && /not a number/.test(ie.text),
+  'the import error names the file, line and field', JSON.stringify(ie));
+  await shot(page, '13-import-error.png');
+
+  // the real files
+  await page.setInputFiles('#import-sec', {name: 'blade_sec_props.dat', mimeType: 'text/plain', buffer: Buffer.from(sec)});
+  await page.click('#import-go');
+  ok(await waitFor(page, () => !document.getElementById('import-dialog').open && window.__spinmodal.doc.blade, null,
+    'the imported blade'), 'BModes Test01 imports into the editor');
+  const doc = await page.evaluate(() => window.__spinmodal.doc);
+  ok(doc.blade.length === 33.25 && doc.blade.hub_radius === 1.75 && doc.blade.stations.length === 21 &&
+    JSON.stringify(doc.analysis.rpm) === '[60]' && !('structure' in doc),
+  'the blade form: length 33.25 m, hub 1.75 m, 21 stations, 60 rpm', JSON.stringify({...doc.blade, stations: undefined}));
+  ok(await page.isVisible('#blade-panel') && !await page.isVisible('#joints') &&
+    await page.inputValue('#blade-length') === '33.25' && await page.locator('#stations tbody tr').count() === 21,
+  'the blade panel shows its fields and the 21 stations (the structure tables are hidden)');
+  ok(await page.inputValue('#speed-in-unit') === 'rpm' && await page.inputValue('#omega-list') === '60' &&
+    await page.isVisible('#omega-list'),
+    'speeds given in rpm are shown in rpm');
+  const v = await page.evaluate(() => window.__spinmodal.view());
+  const lines = await memberLines(page);
+  ok(v.structure === '3d' && lines.length === 1 && Math.hypot(lines[0][2] - lines[0][0], lines[0][3] - lines[0][1]) > 100,
+    'the blade is drawn expanded: one member root → tip, in 3D', JSON.stringify(lines));
+  const frames = await page.locator('#structure-svg .frame-x').count();
+  ok(frames === 48, 'the blade\'s 48 elements carry 48 frames', String(frames));
+  await shot(page, '14-bmodes-imported.png');
+  // solve: 60 rpm
+  await page.click('#submit');
+  const done = await waitFor(page, () => ['done', 'failed', 'rejected'].includes(document.body.dataset.jobState) &&
+    window.__spinmodal.result && window.__spinmodal.result.model.nodes === 49, null, 'the blade job', 180000);
+  const r = await page.evaluate(() => window.__spinmodal.result);
+  ok(done && r && r.cases.length === 1 && r.cases[0].rpm === 60 && r.cases[0].modes.length === 20,
+    'the imported blade solves at 60 rpm (20 modes)', JSON.stringify(r && r.cases[0] && {rpm: r.cases[0].rpm}));
+  if (r) {
+    const bm = fs.readFileSync(path.join(BLADES, 'certtest_frequencies.csv'), 'utf8');
+    console.log(`# Test01 at 60 rpm: f1..f3 = ${r.cases[0].modes.slice(0, 3).map((m) => m.frequency_hz.toFixed(4)).join(', ')} Hz` +
+      ` (BModes: ${bm.split('\n').slice(0, 3).join(' | ').slice(0, 160)})`);
+    ok(await page.inputValue('#speed-unit') === 'rpm' &&
+      await page.locator('#freq-table tbody tr').first().locator('th').textContent() === '60',
+    'a result of a request in rpm is shown in rpm');
+    ok(await waitFor(page, () => window.__spinmodal.anim().drawn && window.__spinmodal.anim().drawn.world.length === 49, null,
+      'the blade mode'), 'the blade\'s mode shape is animated on the expanded mesh (49 nodes)');
+  }
+  await shot(page, '15-bmodes-solved.png');
+
+  // a unit slip: a warning next to the field (not an error), from /v1/validate
+  await page.fill('#blade-length', '33.25');
+  const json0 = await page.inputValue('#json');
+  const gj0 = /"GJ": ([^,}\s]+)/.exec(json0)[1];
+  const text = json0.replace(`"GJ": ${gj0}`, '"GJ": 0.5'); // the first station's
+  await page.fill('#json', text);
+  ok(await waitFor(page, () => window.__spinmodal.warnings().some((w) => w.pointer === '/blade/stations/0/GJ'), null,
+    'the unit-slip warning'), 'a unit slip (GJ = 0.5 N·m²) gives an input_warning with its pointer',
+  JSON.stringify(await page.evaluate(() => window.__spinmodal.warnings())));
+  const slot = await page.evaluate(() => {
+    const td = document.querySelector('#stations td[data-pointer="/blade/stations/0/GJ"]');
+    return td ? td.querySelector('.msg').textContent : null;
+  });
+  ok(slot && /⚠/.test(slot) && /GJ/.test(slot) && /valid, \d+ warning/.test(await page.textContent('#validity')),
+    'the warning is shown next to the station\'s GJ; the request stays valid', `${slot} | ${await page.textContent('#validity')}`);
+  await shot(page, '16-unit-slip-warning.png');
+
+  // speeds: rad/s <-> rpm, and a range {from, to, steps}
+  await page.fill('#json', text.replace('"GJ": 0.5', `"GJ": ${gj0}`).replace(/"rpm": \[60\]/, '"rpm": {"from": 0, "to": 600, "steps": 4}'));
+  ok(await page.isChecked('input[name="speed-mode"][value="sweep"]') && await page.inputValue('#sweep-to') === '600' &&
+    await page.inputValue('#sweep-count') === '5', 'a range in rpm reads as a sweep 0…600 rpm, 5 speeds');
+  await page.fill('#sweep-to', '300');
+  let an = await page.evaluate(() => window.__spinmodal.doc.analysis);
+  ok(JSON.stringify(an.rpm) === '{"from":0,"to":300,"steps":4}', 'editing it keeps the range form', JSON.stringify(an.rpm));
+  await page.selectOption('#speed-in-unit', 'rad');
+  an = await page.evaluate(() => window.__spinmodal.doc.analysis);
+  ok(!('rpm' in an) && an.omega && Math.abs(an.omega.to - 300 * TWO_PI / 60) < 1e-9 && an.omega.steps === 4 &&
+    await page.inputValue('#sweep-to') === String(an.omega.to), 'switching the speeds to rad/s converts them (300 rpm = 10π rad/s)',
+  JSON.stringify(an.omega));
+  await page.selectOption('#speed-in-unit', 'rpm');
+  an = await page.evaluate(() => window.__spinmodal.doc.analysis);
+  ok(!('omega' in an) && Math.abs(an.rpm.to - 300) < 1e-9, 'and back to rpm', JSON.stringify(an.rpm));
+}
+
+/** A design is never lost: a reload keeps the request, a file saves and opens it, a past job reopens. */
+async function keepTheDesign(page, base) {
+  await page.selectOption('#example', 'branched');
+  await page.click('#load-example');
+  await page.getByLabel('x of joint A (m)').fill('3.25');
+  const before = await page.inputValue('#json');
+  await page.reload({waitUntil: 'load'});
+  await waitFor(page, () => window.__spinmodal && document.querySelectorAll('#joints tbody tr').length > 0, null, 'the reload');
+  ok(await page.inputValue('#json') === before && await page.getByLabel('x of joint A (m)').inputValue() === '3.25',
+    'a reload keeps the request being edited');
+  const saved = await downloadText(page, '#save-request');
+  ok(saved.text.trim() === before.trim() && /\.json$/.test(saved.name), 'Save request downloads the request', saved.name);
+  await page.selectOption('#example', 'angled-45');
+  await page.click('#load-example');
+  await page.setInputFiles('#open-request', {name: 'mine.json', mimeType: 'application/json', buffer: Buffer.from(saved.text)});
+  ok(await waitFor(page, (t) => document.getElementById('json').value.trim() === t.trim(), before, 'the opened file'),
+    'Open request… loads a saved request');
+  // reopen a past job: its canonical request (GET /v1/analyses/{id}/request) and its result
+  const list = await (await fetch(`${base}/v1/analyses?limit=100&state=done`)).json();
+  const job = list.items.find((j) => j.progress.total === 11);
+  await page.locator('#past-jobs').focus();
+  await waitFor(page, (id) => Array.from(document.querySelectorAll('#past-jobs option')).some((o) => o.value === id), job.id,
+    'the past jobs list');
+  await page.selectOption('#past-jobs', job.id);
+  await page.click('#open-job');
+  const want = await (await fetch(`${base}/v1/analyses/${job.id}/request`)).json();
+  ok(await waitFor(page, (id) => window.__spinmodal.job && window.__spinmodal.job.id === id && window.__spinmodal.result, job.id,
+    'the reopened job'), 'Reopen: the past job and its result are shown');
+  const doc = await page.evaluate(() => window.__spinmodal.doc);
+  ok(JSON.stringify(doc) === JSON.stringify(want) && (await page.locator('#freq-table tbody tr').count()) === 11,
+    'Reopen: the editor holds the job\'s canonical request, the table its 11 speeds', JSON.stringify(doc).slice(0, 120));
+  ok(!await page.isVisible('#result-stale'), 'Reopen: the result matches the request in the editor');
+  await shot(page, '17-reopened-job.png');
+  await page.selectOption('#example', 'angled-90');
+  await page.click('#load-example');
+}
+
 async function run() {
   fs.rmSync(SHOTS, {recursive: true, force: true}); // this run's screenshots only
   const base = await startDaemon('web');
@@ -434,7 +730,7 @@ async function run() {
   const badResponses = [];
   page.on('response', (r) => {
     // 422 from /v1/validate and /v1/analyses is the API answering an invalid request
-    const expected = r.status() === 422 && /\/v1\/(validate|analyses)$/.test(new URL(r.url()).pathname);
+    const expected = r.status() === 422 && /\/v1\/(validate|analyses|import\/\w+)$/.test(new URL(r.url()).pathname);
     if (r.status() >= 400 && !expected) badResponses.push(`${r.status()} ${r.request().method()} ${r.url()}`);
   });
   page.on('request', (r) => {
@@ -543,8 +839,8 @@ async function run() {
     ok(Math.abs(f20 - api20) <= 1e-12 * Math.abs(api20), 'Campbell first frequency at 20 rad/s equals the API value',
       `${f20} vs ${api20}`);
     ok(api20 > 6.9 && api20 < 7.1, 'first frequency at 20 rad/s is about 7.0 rad/s (README)', String(api20));
-    const eo = plotted.series.filter((s) => /^\d+×$/.test(s.label));
-    ok(eo.length >= 3 && eo[0].values[xi] === 20 && eo[1].values[xi] === 40, 'engine-order lines 1×, 2×, 3×…',
+    const eo = plotted.series.filter((s) => /^\d+P$/.test(s.label));
+    ok(eo.length >= 3 && eo[0].values[xi] === 20 && eo[1].values[xi] === 40, 'engine-order lines 1P, 2P, 3P…',
       eo.map((s) => s.label).join(' '));
     ok(plotted.crossings.length > 0 && plotted.crossings.every((c) => c.omega >= 0 && c.omega <= 20),
       'engine-order crossings marked', JSON.stringify(plotted.crossings.slice(0, 3)));
@@ -588,6 +884,8 @@ async function run() {
     const [dj] = await Promise.all([page.waitForEvent('download'), page.click('#dl-json')]);
     const jdoc = JSON.parse(fs.readFileSync(await dj.path(), 'utf8'));
     ok(jdoc.cases && jdoc.cases.length === 11, 'JSON download is the result document');
+    await unitsAndCampbell(page, result);
+    await exportsAndCompare(page, result);
 
     // cancel a long job
     await page.fill('#sweep-count', '1001');
@@ -615,12 +913,14 @@ async function run() {
     const st3 = await page.evaluate(() => [document.body.dataset.jobState, window.__spinmodal.job.error && window.__spinmodal.job.error.type]);
     ok(st3[0] === 'failed' && st3[1] === 'no_equilibrium', 'single frame: job failed with no_equilibrium', JSON.stringify(st3));
     const notes = await page.textContent('#case-notes');
-    ok(/20 rad\/s: no_equilibrium/.test(notes), 'speeds without equilibrium are reported', notes.slice(0, 200));
+    ok(/20 rad\/s\)?: no_equilibrium/.test(notes), 'speeds without equilibrium are reported', notes.slice(0, 200));
+    ok((notes.match(/no_equilibrium/g) || []).length === 1, 'one message for the one failure, not one per speed', notes);
     ok(/Warning at \d+ speeds \(Ω = 8…18 rad\/s\): FE node \d+ turns [\d.]+ rad relative to its frame/.test(notes),
       'speeds outside the small-rotation range of a frame carry the warning', notes.slice(0, 400));
     const solvedRows = await page.locator('#freq-table tbody td:text-is("solved")').count();
     ok(solvedRows >= 5 && solvedRows < 11, 'the other speeds are still shown', String(solvedRows));
     await shot(page, '04-no-equilibrium.png');
+    await flaggedSpeeds(page);
     await page.selectOption('#frames', 'per_element');
     ok(await page.isVisible('#result-stale'), 'results marked as stale after an edit');
 
@@ -654,6 +954,8 @@ async function run() {
     'and back: the planar section as it was, the hub-plane view', JSON.stringify(trunk));
 
     await spatial(page, base);
+    await blades(page);
+    await keepTheDesign(page, base);
 
     // without POST /v1/validate (an older daemon: 404), errors come from the submission
     const page2 = await context.newPage();

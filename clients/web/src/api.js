@@ -26,11 +26,11 @@ export function url(path) {
 }
 
 /** An answer: {status, ok, body (parsed JSON or null), text, headers}. */
-async function call(method, path, {body, signal, write = false} = {}) {
+async function call(method, path, {body, signal} = {}) {
   const headers = {Accept: 'application/json, application/problem+json'};
   if (body !== undefined) headers['Content-Type'] = 'application/json';
   const tok = getToken();
-  if (write && tok) headers.Authorization = 'Bearer ' + tok;
+  if (tok) headers.Authorization = 'Bearer ' + tok; // also reads: --auth-reads
   const res = await fetch(url(path), {method, headers, body, signal, cache: 'no-store'});
   const text = await res.text();
   let parsed = null;
@@ -79,7 +79,7 @@ export async function validate(text, signal) {
   if (ans.status === 200) {
     const b = ans.body || {};
     return {supported: true, valid: b.valid !== false, errors: [], status: 200, id: b.id,
-      canonical: b.canonical};
+      canonical: b.canonical, warnings: warningsOf(b)};
   }
   return {supported: true, valid: false, errors: problemErrors(ans), status: ans.status};
 }
@@ -88,7 +88,7 @@ export async function validate(text, signal) {
 
 /** POST /v1/analyses: {status, doc (status document) | errors, retryAfter}. */
 export async function submit(text) {
-  const ans = await call('POST', 'v1/analyses', {body: text, write: true});
+  const ans = await call('POST', 'v1/analyses', {body: text});
   if (ans.status === 200 || ans.status === 202) return {status: ans.status, doc: ans.body};
   return {status: ans.status, errors: problemErrors(ans), retryAfter: ans.headers.get('Retry-After')};
 }
@@ -103,7 +103,7 @@ export async function getStatus(id, wait, signal) {
 
 /** DELETE /v1/analyses/{id}: {status, doc | errors}. */
 export async function cancel(id) {
-  const ans = await call('DELETE', `v1/analyses/${encodeURIComponent(id)}`, {write: true});
+  const ans = await call('DELETE', `v1/analyses/${encodeURIComponent(id)}`);
   if (ans.ok) return {status: ans.status, doc: ans.body};
   return {status: ans.status, errors: problemErrors(ans)};
 }
@@ -117,4 +117,48 @@ export async function getResult(id) {
 
 export function resultUrl(id, format) {
   return url(`v1/analyses/${encodeURIComponent(id)}/result` + (format ? `?format=${format}` : ''));
+}
+
+/** The input_warnings of a validate answer or a result: [{pointer, message}]. */
+export function warningsOf(doc) {
+  const w = doc && Array.isArray(doc.input_warnings) ? doc.input_warnings : [];
+  return w.map((e) => ({pointer: String(e.pointer ?? ''), message: String(e.message ?? '')}));
+}
+
+// ---------------------------------------------------------------- import
+
+/**
+ * POST /v1/import/{format} (DAEMON.md, Importers): body {main, sec_props?, name}
+ * (JSON, the files' texts), query tip_radius, hub_radius, rpm.  Returns
+ * {ok: true, request, warnings, source} or {ok: false, status, message, file,
+ * line, field, errors}.
+ */
+export async function importBlade(format, body, query = {}) {
+  const q = new URLSearchParams();
+  for (const [k, v] of Object.entries(query)) if (v !== '' && v !== undefined && v !== null) q.set(k, String(v));
+  const qs = q.toString();
+  const ans = await call('POST', `v1/import/${encodeURIComponent(format)}${qs ? '?' + qs : ''}`,
+    {body: JSON.stringify(body)});
+  const b = ans.body || {};
+  if (ans.status === 200 && b.request) {
+    return {ok: true, request: b.request, warnings: Array.isArray(b.warnings) ? b.warnings : [], source: b.source || {}};
+  }
+  return {ok: false, status: ans.status, message: b.detail || b.title || `HTTP ${ans.status}`, file: b.file,
+    line: b.line, field: b.field, errors: problemErrors(ans)};
+}
+
+// ------------------------------------------------------------ past jobs
+
+/** GET /v1/analyses?limit=N: the newest jobs (status documents without results). */
+export async function listJobs(limit = 30) {
+  const ans = await call('GET', `v1/analyses?limit=${limit}`);
+  if (!ans.ok || !ans.body || !Array.isArray(ans.body.items)) throw new Error(problemErrors(ans)[0].message);
+  return ans.body.items;
+}
+
+/** GET /v1/analyses/{id}/request: the job's canonical request, or throws. */
+export async function getRequest(id) {
+  const ans = await call('GET', `v1/analyses/${encodeURIComponent(id)}/request`);
+  if (!ans.ok || !ans.body) throw new Error(problemErrors(ans)[0].message);
+  return ans.body;
 }

@@ -8,11 +8,13 @@
 
 import './style.css';
 import {DEFAULTS, prettyJSON, structureToRows, rowsToStructure, speedsForm, speedsValue, cellValue,
-  fmtNum, parentPtr, sig, isSpatial} from './request.js';
+  fmtNum, parentPtr, sig, isSpatial, structureOf, speedList, convertSpeed, rangeOf, SPEED_UNITS, FREQ_UNITS,
+  ptr} from './request.js';
 import {buildMesh} from './mesh.js';
 import {drawStructure, modeView} from './drawing.js';
 import {drawStructure3d, modeView3d, attachOrbit, homeCamera, PRESETS} from './view3d.js';
-import {campbellChart} from './campbell.js';
+import {campbellChart, parseOrders, freqIn, flaggedCase} from './campbell.js';
+import {exportSvg, svgToPng, campbellSvg, saveBlob} from './export.js';
 import {StructureEditor} from './editor.js';
 import {EXAMPLES} from './examples.js';
 import * as api from './api.js';
@@ -28,6 +30,11 @@ const S = {
   localErrors: [],     // errors found in the page: [{pointer | el, message}]
   serverErrors: [],    // errors from the daemon: [{pointer, message}]
   serverErrorsFrom: '', // 'validate' | 'submit'
+  warnings: [],        // input_warnings of the last validation or result: [{pointer, message}]
+  blade: false,        // the request is in the blade form (DESIGN.md 8.1)
+  speedKey: 'omega',   // the request gives analysis.omega or analysis.rpm
+  speedRange: false,   // the speeds are a range {from, to, steps}
+  ref: null,           // a result kept for comparison: {id, result, label}
   job: null,           // {id, state, progress, ...} status document of the current job
   pollGen: 0,
   result: null,        // {id, request (doc), result, mesh}
@@ -41,8 +48,10 @@ const S = {
 function setDoc(doc, from) {
   S.doc = doc && typeof doc === 'object' && !Array.isArray(doc) ? doc : {};
   if (from !== 'options') S.sweepError = null;
+  S.blade = 'blade' in S.doc && !('structure' in S.doc);
   S.rows = structureToRows(S.doc.structure);
   if (from !== 'table') editor.render();
+  if (from !== 'blade') renderBlade();
   if (from !== 'options') renderOptions();
   if (from !== 'json') setText(prettyJSON(S.doc));
   afterChange();
@@ -57,13 +66,14 @@ function setText(t) {
 
 /** Rows or options changed: rebuild the doc and the JSON text. */
 function docChanged(from) {
-  S.doc.structure = rowsToStructure(S.rows);
+  if (!S.blade) S.doc.structure = rowsToStructure(S.rows);
   setText(prettyJSON(S.doc));
   if (from === 'rows') editor.render();
   afterChange();
 }
 
 function afterChange() {
+  persist();
   computeLocalErrors();
   draw();
   scheduleValidate();
@@ -90,11 +100,95 @@ $('json').addEventListener('input', () => {
     setDoc(doc, 'json');
   } catch (e) {
     S.parseError = e.message;
+    persist(); // even half-typed: a reload brings back what was typed
     computeLocalErrors();
     scheduleValidate();
     showErrors();
   }
 });
+
+// ------------------------------------------------------------- blade form
+
+const STATION_COLS = [
+  ['s', 's'], ['mass_per_length', 'μ (kg/m)'], ['EA', 'EA (N)'], ['EI_flap', 'EI<sub>flap</sub> (N·m²)'],
+  ['EI_edge', 'EI<sub>edge</sub> (N·m²)'], ['GJ', 'GJ (N·m²)'], ['flap_inertia', 'i<sub>flap</sub> (kg·m)'],
+  ['edge_inertia', 'i<sub>edge</sub> (kg·m)'], ['twist_deg', 'twist (°)'], ['inertia_twist_deg', 'inertia twist (°)'],
+  ['cg_offset', 'cg offset (m)'], ['shear_center_offset', 'shear centre offset (m)'],
+  ['tension_center_offset', 'tension centre offset (m)'],
+];
+
+/** Show the blade panel (fields, stations) instead of the structure tables for a request in the blade form. */
+function renderBlade() {
+  $('blade-panel').hidden = !S.blade;
+  $('structure-tables').hidden = S.blade;
+  document.querySelector('.spatial-switch').hidden = S.blade;
+  if (!S.blade) return;
+  const b = S.doc.blade && typeof S.doc.blade === 'object' ? S.doc.blade : {};
+  for (const e of document.querySelectorAll('#blade-panel .blade-fields input[data-key]')) {
+    e.value = fmtNum(b[e.dataset.key]);
+  }
+  $('blade-tip-mass').value = b.tip_mass && typeof b.tip_mass === 'object' ? fmtNum(b.tip_mass.mass) : '';
+  const st = Array.isArray(b.stations) ? b.stations : [];
+  const keys = STATION_COLS.filter(([k]) => st.some((r) => r && typeof r === 'object' && k in r));
+  const thead = $('stations').tHead, tbody = $('stations').tBodies[0];
+  thead.innerHTML = '<tr>' + keys.map(([, l]) => `<th scope="col">${l}</th>`).join('') + '</tr>';
+  tbody.textContent = '';
+  st.forEach((r, j) => {
+    const tr = tbody.insertRow();
+    tr.dataset.pointer = ptr('blade', 'stations', j);
+    for (const [k] of keys) {
+      const td = tr.insertCell();
+      td.dataset.pointer = ptr('blade', 'stations', j, k);
+      const v = r && typeof r === 'object' ? r[k] : undefined;
+      const t = document.createElement('span');
+      t.textContent = Array.isArray(v) ? v.map((x) => sig(x, 5)).join(', ') : typeof v === 'number' ? sig(v, 6) : v === undefined ? '' : String(v);
+      const m = document.createElement('div');
+      m.className = 'msg';
+      td.append(t, m);
+    }
+  });
+  $('stations-count').textContent = st.length ? `(${st.length}, from the root s = 0 to the tip s = 1)`
+    : '(none: the section holds along the span)';
+}
+
+for (const e of document.querySelectorAll('#blade-panel .blade-fields input[data-key]')) {
+  e.addEventListener('input', () => {
+    const b = S.doc.blade && typeof S.doc.blade === 'object' ? S.doc.blade : (S.doc.blade = {});
+    if (e.value.trim() === '' && e.dataset.key !== 'length') delete b[e.dataset.key];
+    else b[e.dataset.key] = cellValue(e.value);
+    setText(prettyJSON(S.doc));
+    afterChange();
+  });
+}
+$('blade-tip-mass').addEventListener('input', () => {
+  const b = S.doc.blade && typeof S.doc.blade === 'object' ? S.doc.blade : (S.doc.blade = {});
+  const t = $('blade-tip-mass').value.trim();
+  if (t === '') delete b.tip_mass;
+  else b.tip_mass = Object.assign(b.tip_mass && typeof b.tip_mass === 'object' ? b.tip_mass : {}, {mass: cellValue(t)});
+  setText(prettyJSON(S.doc));
+  afterChange();
+});
+
+// ------------------------------------------------------------- keep the design
+
+const STORE_KEY = 'spinmodal.request';
+
+/** Keep the editor's text across reloads (localStorage; nothing leaves the browser). */
+function persist() {
+  try {
+    localStorage.setItem(STORE_KEY, S.text);
+  } catch {
+    /* storage full or disabled: the design lives in the page only */
+  }
+}
+
+function stored() {
+  try {
+    return localStorage.getItem(STORE_KEY);
+  } catch {
+    return null;
+  }
+}
 
 // ------------------------------------------------------------- options
 
@@ -112,7 +206,16 @@ let speedMode = 'single';
 
 function renderOptions() {
   const a = S.doc.analysis && typeof S.doc.analysis === 'object' ? S.doc.analysis : {};
-  const f = speedsForm(a.omega);
+  S.speedKey = 'rpm' in a && !('omega' in a) ? 'rpm' : 'omega';
+  const f = speedsForm(a[S.speedKey]);
+  S.speedRange = !!f.range;
+  const unit = S.speedKey === 'rpm' ? 'rpm' : 'rad/s';
+  $('speed-in-unit').value = S.speedKey === 'rpm' ? 'rpm' : 'rad';
+  $('speed-legend-unit').textContent = unit;
+  document.querySelector('fieldset.speeds').dataset.pointer = `/analysis/${S.speedKey}`;
+  for (const [id, t] of [['omega', 'Ω'], ['sweep-from', 'from'], ['sweep-to', 'to']]) {
+    document.querySelector(`label[for="${id}"]`).textContent = `${t} (${unit})`;
+  }
   speedMode = f.mode;
   for (const r of document.querySelectorAll('input[name="speed-mode"]')) r.checked = r.value === f.mode;
   if (f.mode === 'single') $('omega').value = f.value;
@@ -160,13 +263,17 @@ function showFramesN() {
 
 function speedFields() {
   return {mode: speedMode, value: $('omega').value, from: $('sweep-from').value, to: $('sweep-to').value,
-    count: $('sweep-count').value, list: $('omega-list').value};
+    count: $('sweep-count').value, list: $('omega-list').value, range: S.speedRange,
+    unit: S.speedKey === 'rpm' ? 'rpm' : 'rad/s'};
 }
 
 function speedsChanged() {
   const v = speedsValue(speedFields());
   S.sweepError = v.error ? {message: v.error, el: $({from: 'sweep-from', to: 'sweep-to', count: 'sweep-count'}[v.field])} : null;
-  if (!v.error) an().omega = v.value;
+  if (!v.error) {
+    an()[S.speedKey] = v.value;
+    delete an()[S.speedKey === 'rpm' ? 'omega' : 'rpm'];
+  }
   docChanged('options');
 }
 
@@ -176,8 +283,8 @@ for (const r of document.querySelectorAll('input[name="speed-mode"]')) {
     const prev = speedsValue(speedFields());
     speedMode = r.value;
     // carry the speeds over into the new form
-    const om = prev.value;
-    const nums = Array.isArray(om) ? om.filter((x) => typeof x === 'number') : typeof om === 'number' ? [om] : [];
+    const nums = speedList(prev.value);
+    S.speedRange = S.speedRange && speedMode === 'sweep';
     if (speedMode === 'single' && nums.length) $('omega').value = fmtNum(nums[nums.length - 1]);
     if (speedMode === 'sweep') {
       const hi = nums.length ? Math.max(...nums) : 20;
@@ -193,6 +300,27 @@ for (const r of document.querySelectorAll('input[name="speed-mode"]')) {
 for (const id of ['omega', 'sweep-from', 'sweep-to', 'sweep-count', 'omega-list']) {
   $(id).addEventListener('input', speedsChanged);
 }
+
+/**
+ * The speeds' unit in the request: analysis.omega (rad/s) or analysis.rpm.
+ * Switching converts the speeds (12 significant digits; a range stays a range)
+ * and the results are then shown in that speed unit too.
+ */
+$('speed-in-unit').addEventListener('change', () => {
+  const toRpm = $('speed-in-unit').value === 'rpm';
+  const from = S.speedKey, to = toRpm ? 'rpm' : 'omega';
+  if (from === to) return;
+  const a = an();
+  const v = a[from];
+  const conv = (x) => (typeof x === 'number' ? convertSpeed(x, toRpm) : x);
+  const r = rangeOf(v);
+  delete a[from];
+  a[to] = r ? {...v, from: conv(r.from), to: conv(r.to)} : Array.isArray(v) ? v.map(conv) : conv(v);
+  renderOptions();
+  docChanged('options');
+  $('speed-unit').value = toRpm ? 'rpm' : 'rad';
+  if (S.result) showUnits();
+});
 
 function framesChanged() {
   showFramesN();
@@ -302,13 +430,33 @@ function showErrors() {
     list.append(li);
   }
   $('errors-box').hidden = all.length === 0;
+  // input_warnings (unit slips): next to their field as the errors, and listed
+  const wl = $('warnings');
+  wl.textContent = '';
+  for (const w of S.warnings) {
+    const target = targetOf(w.pointer);
+    const slot = w.pointer === '' ? $('json-msg') : msgSlot(target);
+    const line = document.createElement('div');
+    line.className = 'warn';
+    line.textContent = '⚠ ' + w.message;
+    slot.append(line);
+    const li = document.createElement('li');
+    const b = document.createElement('button');
+    b.type = 'button';
+    b.className = 'linkish';
+    b.textContent = w.pointer || '(document)';
+    b.addEventListener('click', () => (controlOf(target) || $('json')).focus());
+    li.append(b, ' ', w.message);
+    wl.append(li);
+  }
+  $('warnings-box').hidden = S.warnings.length === 0;
   const v = $('validity');
   if (all.length) {
     v.textContent = `${all.length} error${all.length === 1 ? '' : 's'}` +
       (S.serverErrorsFrom === 'submit' && server.length ? ' (from the last submission)' : '');
     v.className = 'validity bad';
   } else if (api.validateAvailable() === true && S.validated === S.text) {
-    v.textContent = 'valid';
+    v.textContent = 'valid' + (S.warnings.length ? `, ${S.warnings.length} warning${S.warnings.length === 1 ? '' : 's'}` : '');
     v.className = 'validity good';
   } else {
     v.textContent = api.validateAvailable() === false ? 'checked when solved' : '';
@@ -346,6 +494,7 @@ async function runValidate() {
   S.serverErrors = r.errors;
   S.serverErrorsFrom = 'validate';
   S.validated = r.valid ? text : null;
+  S.warnings = r.valid ? r.warnings || [] : [];
   showErrors();
 }
 
@@ -354,21 +503,23 @@ async function runValidate() {
 let meshCache = {key: '', mesh: null};
 
 function meshOf(doc) {
-  const key = JSON.stringify([doc.structure, doc.frames]);
-  if (meshCache.key !== key) meshCache = {key, mesh: buildMesh(doc.structure, 'frames' in doc ? doc.frames : DEFAULTS.frames)};
+  const st = structureOf(doc);
+  const key = JSON.stringify([st, doc.frames]);
+  if (meshCache.key !== key) meshCache = {key, mesh: buildMesh(st, 'frames' in doc ? doc.frames : DEFAULTS.frames)};
   return meshCache.mesh;
 }
 
 function draw() {
-  const st = S.doc.structure && typeof S.doc.structure === 'object' ? S.doc.structure : {};
+  const st0 = structureOf(S.doc);
+  const st = st0 && typeof st0 === 'object' ? st0 : {};
   const mesh = meshOf(S.doc);
   let equilibrium = null, eqLabel = '';
   const R = S.result;
-  if (R && $('show-equilibrium').checked && JSON.stringify(R.request.structure) === JSON.stringify(S.doc.structure)) {
+  if (R && $('show-equilibrium').checked && JSON.stringify(structureOf(R.request)) === JSON.stringify(st0)) {
     const c = selectedCase();
     if (c && c.status !== 'no_equilibrium' && c.equilibrium && Array.isArray(c.equilibrium.nodes)) {
       equilibrium = c.equilibrium.nodes;
-      eqLabel = `steady shape at Ω = ${sig(c.omega)} rad/s (${c.status})`;
+      eqLabel = `steady shape at Ω = ${speedText(c)} (${c.status})`;
     }
   }
   const in3d = structureIn3d();
@@ -391,14 +542,14 @@ for (const id of ['show-frames', 'show-nodes', 'show-equilibrium']) $(id).addEve
 
 /** Is the structure drawn in 3D?  The switch, else whether the structure is spatial. */
 function structureIn3d() {
-  return S.view3d ?? !!(S.rows && S.rows.spatial);
+  return S.view3d ?? (S.blade || !!(S.rows && S.rows.spatial));
 }
 
 /** Is the mode shape drawn in 3D?  The switch, else whether the solved request or its result is spatial. */
 function modeIn3d() {
   const R = S.result;
   if (!R) return false;
-  return S.view3d ?? (isSpatial(R.request && R.request.structure) || (R.result.model || {}).spatial === true);
+  return S.view3d ?? (isSpatial(structureOf(R.request)) || (R.result.model || {}).spatial === true);
 }
 
 /** The 3D switch, the view presets and the reset buttons follow the views shown. */
@@ -476,8 +627,20 @@ function loadExample(key) {
   S.view3d = null;
   Object.assign(S.cam, homeCamera());
   S.serverErrors = [];
+  S.warnings = [];
   S.sweepError = null;
   setDoc(ex.doc(), 'example');
+}
+
+/** Load a request document into the editor (a file, an import, a past job). */
+function loadDoc(doc) {
+  S.view3d = null;
+  Object.assign(S.cam, homeCamera());
+  S.serverErrors = [];
+  S.warnings = [];
+  S.sweepError = null;
+  S.parseError = null;
+  setDoc(doc, 'file');
 }
 
 // ------------------------------------------------------------------ token
@@ -621,68 +784,152 @@ function selectedCase() {
   return R.result.cases[Number.isInteger(i) ? i : 0] || null;
 }
 
+/** The display units of the results: {speed: 'rad' | 'rpm', freq: 'rad' | 'hz' | 'rev'}. */
+function units() {
+  return {speed: $('speed-unit').value, freq: $('freq-unit').value};
+}
+
+/** A case's speed as text in the speed unit shown: "20 rad/s", "190.986 rpm". */
+function speedText(c, n = 6) {
+  const su = units().speed;
+  const v = su === 'rpm' ? (typeof c.rpm === 'number' ? c.rpm : c.omega * 60 / (2 * Math.PI)) : c.omega;
+  return `${sig(v, n)} ${SPEED_UNITS[su].label}`;
+}
+
+/** A mode's frequency as text in the frequency unit shown. */
+function freqText(m, c, n = 6) {
+  const fu = units().freq;
+  const v = freqIn(fu, m, c.omega);
+  return v === null ? '–' : `${sig(v, n)} ${FREQ_UNITS[fu].label}`;
+}
+
+/** "Ω = 8, 10 rad/s" or "Ω = 8…18 rad/s (6 speeds)" for the cases cs. */
+function speedsText(cs) {
+  const su = units().speed, u = SPEED_UNITS[su].label;
+  const v = cs.map((c) => (su === 'rpm' ? (typeof c.rpm === 'number' ? c.rpm : c.omega * 60 / (2 * Math.PI)) : c.omega));
+  if (v.length <= 4) return `Ω = ${v.map((x) => sig(x)).join(', ')} ${u}`;
+  return `${v.length} speeds (Ω = ${sig(Math.min(...v))}…${sig(Math.max(...v))} ${u})`;
+}
+
+/** Cases grouped by what went wrong: one entry per distinct status + message (numbers ignored). */
+function groupBy(cases, text) {
+  const groups = new Map();
+  for (const c of cases) {
+    const t = text(c);
+    const key = t.replace(/-?\d+(\.\d+)?(e[-+]?\d+)?/gi, '#');
+    if (!groups.has(key)) groups.set(key, {text: t, cases: []});
+    groups.get(key).cases.push(c);
+  }
+  return Array.from(groups.values());
+}
+
 function showResult(id, request, result) {
-  const mesh = buildMesh(request && request.structure, request && 'frames' in request ? request.frames : DEFAULTS.frames);
+  const mesh = buildMesh(structureOf(request), request && 'frames' in request ? request.frames : DEFAULTS.frames);
   S.result = {id, request, result, mesh};
   $('results').hidden = false;
   $('dl-json').href = api.resultUrl(id);
   $('dl-json').setAttribute('download', `spinmodal-${id.slice(0, 12)}.json`);
   $('dl-csv').href = api.resultUrl(id, 'csv');
   $('dl-csv').setAttribute('download', `spinmodal-${id.slice(0, 12)}.csv`);
-
-  const md = result.model || {};
-  const cases = result.cases || [];
-  const bad = cases.filter((c) => c.status !== 'solved');
-  $('result-summary').textContent = `${cases.length} speed${cases.length === 1 ? '' : 's'}; model: ${md.nodes} nodes, ` +
-    `${md.elements} elements, ${md.frames} frames, ${md.coordinates} coordinates` +
-    (result.timing_ms ? `; ${sig((result.timing_ms.equilibrium || 0) + (result.timing_ms.linearize || 0) +
-      (result.timing_ms.eigen || 0), 3)} ms` : '') + '.';
-  const notes = $('case-notes');
-  notes.textContent = '';
-  for (const c of bad) {
-    const p = document.createElement('p');
-    p.className = 'note';
-    const d = c.diagnostics || {};
-    p.textContent = `Ω = ${sig(c.omega)} rad/s: ${c.status}` + (d.message ? ` — ${d.message}` : '') +
-      (typeof d.last_omega === 'number' ? ` (last speed reached ${sig(d.last_omega)} rad/s)` : '');
-    notes.append(p);
+  setBlobLink($('dl-json-req'), `spinmodal-${id.slice(0, 12)}-with-request.json`, 'application/json',
+    JSON.stringify({request, result}, null, 1));
+  const rw = api.warningsOf(result);
+  if (rw.length && JSON.stringify(request) === JSON.stringify(S.doc)) {
+    const have = new Set(S.warnings.map((w) => w.pointer + '\n' + w.message));
+    S.warnings = S.warnings.concat(rw.filter((w) => !have.has(w.pointer + '\n' + w.message)));
+    showErrors();
   }
-  // warnings (outside the model's validity): one note for all the speeds that carry one
-  const warned = cases.filter((c) => Array.isArray(c.warnings) && c.warnings.length > 0);
-  if (warned.length) {
-    const om = warned.map((c) => c.omega);
-    const p = document.createElement('p');
-    p.className = 'note warning';
-    p.textContent = `Warning at ${warned.length === 1 ? `Ω = ${sig(om[0])} rad/s` :
-      `${warned.length} speeds (Ω = ${sig(Math.min(...om))}…${sig(Math.max(...om))} rad/s)`}: ${warned[0].warnings[0]}`;
-    notes.append(p);
-  }
-
-  // speed selector: request order, default the highest speed that has modes
+  // a request in rpm is shown in rpm
+  if (request && request.analysis && 'rpm' in request.analysis && !('omega' in request.analysis)) $('speed-unit').value = 'rpm';
   const sel = $('mode-speed');
   sel.textContent = '';
   let best = -1;
+  const cases = result.cases || [];
   const hasModes = (c) => Array.isArray(c.modes) && c.modes.length > 0;
   cases.forEach((c, i) => {
     const o = document.createElement('option');
     o.value = String(i);
-    o.textContent = `${sig(c.omega)} rad/s${c.status === 'solved' ? '' : ' (' + c.status + ')'}`;
     sel.append(o);
     if (hasModes(c) && (best < 0 || c.omega >= cases[best].omega)) best = i;
   });
   if (best < 0) best = 0;
   sel.value = String(best);
   markStale();
+  showUnits();
+  startMode();
+  draw();
+}
+
+/** Everything of the results that depends on the units shown. */
+function showUnits() {
+  const R = S.result;
+  if (!R) return;
+  const result = R.result;
+  const md = result.model || {};
+  const cases = result.cases || [];
+  $('result-summary').textContent = `${cases.length} speed${cases.length === 1 ? '' : 's'}; model: ${md.nodes} nodes, ` +
+    `${md.elements} elements, ${md.frames} frames, ${md.coordinates} coordinates` +
+    (result.timing_ms ? `; ${sig((result.timing_ms.equilibrium || 0) + (result.timing_ms.linearize || 0) +
+      (result.timing_ms.eigen || 0), 3)} ms` : '') + '.';
+  const notes = $('case-notes');
+  notes.textContent = '';
+  // one note per distinct failure (status and message), naming its speeds
+  const bad = cases.filter((c) => c.status !== 'solved');
+  for (const g of groupBy(bad, (c) => {
+    const d = c.diagnostics || {};
+    return `${c.status}` + (d.message ? ` — ${d.message}` : '');
+  })) {
+    const p = document.createElement('p');
+    p.className = 'note';
+    p.textContent = `${speedsText(g.cases)}: ${g.text}`;
+    notes.append(p);
+  }
+  // warnings (outside the model's validity): one note per distinct warning, for all the speeds that carry it
+  const warned = cases.filter((c) => Array.isArray(c.warnings) && c.warnings.length > 0);
+  for (const g of groupBy(warned, (c) => c.warnings[0])) {
+    const p = document.createElement('p');
+    p.className = 'note warning';
+    p.textContent = `Warning at ${g.cases.length === 1 ? speedsText(g.cases) : speedsText(g.cases).replace(/^Ω = /, `${g.cases.length} speeds (Ω = `) + (g.cases.length <= 4 ? ')' : '')}: ${g.text}`;
+    notes.append(p);
+  }
+  if (bad.length || warned.length) {
+    const p = document.createElement('p');
+    p.className = 'hint';
+    p.textContent = 'On the Campbell diagram these speeds are hollow grey circles, left out of the lines and the crossings.';
+    notes.append(p);
+  }
+  const sel = $('mode-speed');
+  cases.forEach((c, i) => {
+    const o = sel.options[i];
+    if (o) o.textContent = speedText(c) + (c.status === 'solved' ? '' : ` (${c.status})`);
+  });
   freqTable(result);
   updateChart();
   modeSelectors();
   startMode();
   draw();
+  tableCsv();
+}
+
+/** The frequency table in the units shown: [[header…], [row…]…] (also the "CSV (units shown)" download). */
+function tableRows(result) {
+  const u = units();
+  const cases = (result.cases || []).slice().sort((a, b) => a.omega - b.omega);
+  const n = cases.reduce((m, c) => Math.max(m, (c.modes || []).length), 0);
+  const head = [`speed (${SPEED_UNITS[u.speed].label})`, 'status'];
+  for (let k = 1; k <= n; k++) head.push(`mode ${k} (${FREQ_UNITS[u.freq].label})`);
+  const rows = cases.map((c) => {
+    const sp = u.speed === 'rpm' ? (typeof c.rpm === 'number' ? c.rpm : c.omega * 60 / (2 * Math.PI)) : c.omega;
+    const r = [sp, c.status];
+    for (let k = 0; k < n; k++) r.push(freqIn(u.freq, (c.modes || [])[k], c.omega));
+    return r;
+  });
+  return {head, rows, cases, n};
 }
 
 function freqTable(result) {
-  const cases = (result.cases || []).slice().sort((a, b) => a.omega - b.omega);
-  const n = cases.reduce((m, c) => Math.max(m, (c.modes || []).length), 0);
+  const u = units();
+  const {rows, cases, n} = tableRows(result);
   const thead = $('freq-table').tHead, tbody = $('freq-table').tBodies[0];
   thead.textContent = '';
   tbody.textContent = '';
@@ -693,45 +940,92 @@ function freqTable(result) {
     e.innerHTML = t;
     return e;
   };
-  hr.append(th('Ω (rad/s)'), th('status'));
-  for (let k = 1; k <= n; k++) hr.append(th(`ω<sub>${k}</sub> (rad/s)`), th(`f<sub>${k}</sub> (Hz)`));
-  for (const c of cases) {
+  hr.append(th(`Ω (${SPEED_UNITS[u.speed].label})`), th('status'));
+  const fsym = u.freq === 'hz' ? 'f' : u.freq === 'rev' ? 'ω/Ω' : 'ω';
+  for (let k = 1; k <= n; k++) {
+    const lab = cases.map((c) => (c.modes || [])[k - 1]).find((m) => m && typeof m.label === 'string');
+    hr.append(th(`${fsym}<sub>${k}</sub> (${FREQ_UNITS[u.freq].label})` + (lab ? `<br><span class="mlabel">${lab.label}</span>` : '')));
+  }
+  rows.forEach((r, i) => {
+    const c = cases[i];
     const tr = tbody.insertRow();
+    if (flaggedCase(c)) tr.className = 'flagged';
     const h = document.createElement('th');
     h.scope = 'row';
-    h.textContent = sig(c.omega);
+    h.textContent = sig(r[0]);
     tr.append(h);
     const st = tr.insertCell();
-    st.textContent = c.status;
-    if (c.status !== 'solved') st.className = 'bad';
-    for (let k = 0; k < n; k++) {
-      const m = (c.modes || [])[k];
-      tr.insertCell().textContent = m ? sig(m.frequency_rad_s) : '–';
-      tr.insertCell().textContent = m ? sig(m.frequency_hz) : '–';
+    st.textContent = r[1];
+    if (Array.isArray(c.warnings) && c.warnings.length) {
+      st.title = c.warnings.join('\n');
+      st.className = 'warned';
     }
-  }
+    if (c.status !== 'solved') st.className = 'bad';
+    for (let k = 0; k < n; k++) tr.insertCell().textContent = r[2 + k] === null ? '–' : sig(r[2 + k]);
+  });
+}
+
+/** A download link for text made in the page. */
+function setBlobLink(a, name, type, text) {
+  if (a.dataset.url) URL.revokeObjectURL(a.dataset.url);
+  const u = URL.createObjectURL(new Blob([text], {type}));
+  a.dataset.url = u;
+  a.href = u;
+  a.setAttribute('download', name);
+}
+
+function csvCell(v) {
+  if (v === null || v === undefined) return '';
+  if (typeof v === 'number') return String(v);
+  const t = String(v);
+  return /[",\n]/.test(t) ? '"' + t.replace(/"/g, '""') + '"' : t;
+}
+
+/** The "CSV (units shown)" download: the table as shown, at full precision. */
+function tableCsv() {
+  const R = S.result;
+  if (!R) return;
+  const {head, rows} = tableRows(R.result);
+  const u = units();
+  const text = [head, ...rows].map((r) => r.map(csvCell).join(',')).join('\n') + '\n';
+  setBlobLink($('dl-csv-units'), `spinmodal-${R.id.slice(0, 12)}-${u.speed}-${u.freq}.csv`, 'text/csv', text);
+  $('dl-csv-units').dataset.csv = text;
 }
 
 function updateChart() {
   if (!S.result) return;
-  const orders = Math.max(0, Math.min(20, Math.floor(Number($('eo-count').value) || 0)));
-  const d = chart.update({result: S.result.result, orders, unit: $('freq-unit').value});
+  const orders = parseOrders($('eo-list').value);
+  const u = units();
+  const labels = [];
+  for (const c of S.result.result.cases || []) {
+    (c.modes || []).forEach((m, k) => {
+      if (!labels[k] && m && typeof m.label === 'string') labels[k] = m.label;
+    });
+  }
+  const ref = S.ref && S.ref.id !== S.result.id ? S.ref.result : null;
+  $('ref-note').hidden = !ref;
+  $('ref-note').textContent = ref ? `Dashed thin lines: the reference result ${S.ref.label}.` : '';
+  const d = chart.update({result: S.result.result, orders, units: u, ref, labels});
   const tb = $('crossings').tBodies[0];
+  $('cross-speed-h').textContent = `Ω (${SPEED_UNITS[u.speed].label})`;
+  $('cross-freq-h').textContent = `${FREQ_UNITS[u.freq].sym} (${FREQ_UNITS[u.freq].label})`;
   tb.textContent = '';
   for (const c of d.cross) {
     const tr = tb.insertRow();
-    for (const v of [`mode ${c.mode}`, `${c.order}×`, sig(c.omega, 5), sig(c.freq, 5), sig(c.freq / (2 * Math.PI), 5)]) {
-      tr.insertCell().textContent = v;
-    }
+    const sp = SPEED_UNITS[u.speed].of(c.omega);
+    const f = u.freq === 'rev' ? c.order : FREQ_UNITS[u.freq].of(c.freq, c.omega);
+    for (const v of [`mode ${c.mode}`, `${c.order}P`, sig(sp, 5), sig(f, 5)]) tr.insertCell().textContent = v;
   }
   if (!d.cross.length) {
     const td = tb.insertRow().insertCell();
-    td.colSpan = 5;
+    td.colSpan = 4;
     td.textContent = d.rows.length > 1 ? 'none in the speed range' : 'a sweep is needed';
   }
 }
-$('eo-count').addEventListener('input', updateChart);
-$('freq-unit').addEventListener('change', updateChart);
+$('eo-list').addEventListener('input', updateChart);
+$('freq-unit').addEventListener('change', showUnits);
+$('speed-unit').addEventListener('change', showUnits);
+$('zoom-reset').addEventListener('click', updateChart);
 
 // ---------------------------------------------------------- mode animation
 
@@ -743,7 +1037,7 @@ function modeSelectors() {
   (c && c.modes ? c.modes : []).forEach((m, k) => {
     const o = document.createElement('option');
     o.value = String(k);
-    o.textContent = `${k + 1}: ${sig(m.frequency_rad_s, 5)} rad/s`;
+    o.textContent = `${k + 1}: ${freqText(m, c, 5)}` + (typeof m.label === 'string' ? ` (${m.label})` : '');
     sel.append(o);
   });
   if (prev && Number(prev) < sel.options.length) sel.value = prev;
@@ -764,11 +1058,14 @@ function startMode() {
   }
   buildModeView();
   S.anim.omega = m ? m.frequency_rad_s : 0;
-  if (!m) desc.textContent = `no modes at Ω = ${sig(c.omega)} rad/s (${c.status})`;
+  if (!m) desc.textContent = `no modes at Ω = ${speedText(c)} (${c.status})`;
   else if (!m.shape) desc.textContent = 'no mode shapes in this result (turn "mode shapes" on and solve again)';
   else {
-    desc.textContent = `mode ${k + 1} at Ω = ${sig(c.omega)} rad/s: ω = ${sig(m.frequency_rad_s)} rad/s ` +
-      `(${sig(m.frequency_hz)} Hz)` + (m.shape.im ? ', complex (gyroscopic): u(t) = Re((re + i·im)·e^{iωt})' : '') +
+    const fu = units().freq;
+    const other = fu === 'hz' ? `${sig(m.frequency_rad_s)} rad/s` : `${sig(m.frequency_hz)} Hz`;
+    desc.textContent = `mode ${k + 1}${typeof m.label === 'string' ? ` (${m.label})` : ''} at Ω = ${speedText(c)}: ` +
+      `${FREQ_UNITS[fu].sym} = ${freqText(m, c)} (${other})` +
+      (m.shape.im ? ', complex (gyroscopic): u(t) = Re((re + i·im)·e^{iωt})' : '') +
       '. Grey: undeformed; blue line: steady shape; animated: the mode, one cycle every 2 s' +
       (modeIn3d() ? '; faint: its shadow on the hub plane. Drag to turn the view.' : '.');
   }
@@ -827,6 +1124,230 @@ $('mode-speed').addEventListener('change', () => {
 $('mode-index').addEventListener('change', startMode);
 $('mode-amp').addEventListener('input', startMode);
 
+// ------------------------------------------------------------ files
+
+function fileMsg(text, cls = '') {
+  const m = $('file-msg');
+  m.textContent = text;
+  m.className = 'file-msg ' + cls;
+}
+
+function readFile(f) {
+  return f.text ? f.text() : new Promise((res, rej) => {
+    const r = new FileReader();
+    r.onload = () => res(String(r.result));
+    r.onerror = () => rej(r.error);
+    r.readAsText(f);
+  });
+}
+
+$('open-request').addEventListener('change', async () => {
+  const f = $('open-request').files[0];
+  if (!f) return;
+  const text = await readFile(f);
+  let doc;
+  try {
+    doc = JSON.parse(text);
+  } catch (e) {
+    fileMsg(`${f.name}: not a JSON request (${e.message})`, 'bad');
+    $('open-request').value = '';
+    return;
+  }
+  // a "JSON + request" download holds {request, result}
+  const req = doc && typeof doc === 'object' && doc.request && doc.result ? doc.request : doc;
+  loadDoc(req);
+  if (doc && doc.request && doc.result) showResult(doc.result.solver ? 'file-' + f.name : 'file', doc.request, doc.result);
+  fileMsg(`opened ${f.name}`, 'ok');
+  $('open-request').value = '';
+});
+
+$('save-request').addEventListener('click', () => {
+  const name = ($('example').value && !S.blade ? $('example').value : 'request') + '.json';
+  saveBlob(new Blob([S.text.endsWith('\n') ? S.text : S.text + '\n'], {type: 'application/json'}), `spinmodal-${name}`);
+  fileMsg(`saved spinmodal-${name} (your downloads)`, 'ok');
+});
+
+// ------------------------------------------------------------ past jobs
+
+let jobsLoaded = 0;
+
+async function refreshJobs() {
+  if (Date.now() - jobsLoaded < 2000) return;
+  jobsLoaded = Date.now();
+  let items;
+  try {
+    items = await api.listJobs(30);
+  } catch (e) {
+    fileMsg(`past jobs: ${e.message}`, 'bad');
+    return;
+  }
+  const sel = $('past-jobs');
+  const prev = sel.value;
+  sel.textContent = '';
+  const none = document.createElement('option');
+  none.value = '';
+  none.textContent = items.length ? `— ${items.length} recent —` : '— none yet —';
+  sel.append(none);
+  for (const j of items) {
+    const o = document.createElement('option');
+    o.value = j.id;
+    const when = (j.created_at || '').replace('T', ' ').replace(/\.\d+Z$/, ' UTC');
+    o.textContent = `${when} · ${j.state} · ${j.progress ? j.progress.total : '?'} speed(s) · ${j.id.slice(0, 8)}`;
+    sel.append(o);
+  }
+  if (prev && Array.from(sel.options).some((o) => o.value === prev)) sel.value = prev;
+}
+$('past-jobs').addEventListener('focus', refreshJobs);
+$('past-jobs').addEventListener('pointerdown', refreshJobs);
+
+/** Reopen a past job: its request into the editor (GET …/request), its result if it has one. */
+async function reopenJob(id) {
+  if (!id) return;
+  fileMsg(`opening job ${id.slice(0, 12)}…`);
+  let request, st;
+  try {
+    request = await api.getRequest(id);
+    st = await api.getStatus(id);
+  } catch (e) {
+    fileMsg(`job ${id.slice(0, 12)}: ${e.message}`, 'bad');
+    return;
+  }
+  S.pollGen++;
+  loadDoc(request);
+  if (st && st.doc) {
+    showJob(st.doc);
+    S.submitted = {id, request: S.doc};
+    if (!TERMINAL.has(st.doc.state)) poll(st.doc, S.pollGen);
+    else if (st.doc.result) showResult(id, S.doc, st.doc.result);
+  }
+  fileMsg(`reopened job ${id.slice(0, 12)} (${st && st.doc ? st.doc.state : '?'})`, 'ok');
+}
+$('open-job').addEventListener('click', () => reopenJob($('past-jobs').value));
+
+// ------------------------------------------------------------ blade import
+
+const IMPORT_MAIN = {bmodes: 'BModes main file (.bmi)', elastodyn: 'ElastoDyn blade file (.dat)',
+  csv: 'CSV file (a header row naming the columns: s or r, mass_per_length, EI_flap …)'};
+
+function importFormat() {
+  const f = $('import-format').value;
+  $('import-main-label').textContent = IMPORT_MAIN[f];
+  $('import-sec-field').hidden = f !== 'bmodes';
+  $('import-tip').placeholder = f === 'bmodes' ? 'from the file' : 'required (m)';
+  $('import-error').textContent = '';
+}
+$('import-format').addEventListener('change', importFormat);
+$('open-blade').addEventListener('click', () => {
+  importFormat();
+  $('import-dialog').showModal();
+});
+
+/** Import the chosen files: POST /v1/import/{format}; the request goes into the editor. */
+async function importBlade() {
+  const format = $('import-format').value;
+  const main = $('import-main').files[0], sec = $('import-sec').files[0];
+  const err = $('import-error');
+  err.textContent = '';
+  if (!main) {
+    err.textContent = 'Choose the file to import.';
+    return;
+  }
+  if (format === 'bmodes' && !sec) {
+    err.textContent = 'A BModes import needs the section-properties file too (the one the .bmi names).';
+    return;
+  }
+  const body = {main: await readFile(main), name: main.name};
+  if (format === 'bmodes') body.sec_props = await readFile(sec);
+  const q = {tip_radius: $('import-tip').value.trim(), hub_radius: $('import-hub').value.trim(),
+    rpm: $('import-rpm').value.trim()};
+  let r;
+  try {
+    r = await api.importBlade(format, body, q);
+  } catch (e) {
+    err.textContent = `cannot reach the daemon: ${e.message}`;
+    return;
+  }
+  if (!r.ok) {
+    // 422: FILE:LINE: FIELD: what is wrong
+    const where = r.file ? `${r.file}${r.line ? `, line ${r.line}` : ''}${r.field ? `, field ${r.field}` : ''}` : '';
+    err.textContent = '';
+    const h = document.createElement('strong');
+    h.textContent = where ? `${where}: ` : `${r.status}: `;
+    const t = document.createElement('span');
+    t.textContent = r.message;
+    err.append(h, t);
+    err.dataset.file = r.file || '';
+    err.dataset.line = r.line ? String(r.line) : '';
+    err.dataset.field = r.field || '';
+    return;
+  }
+  $('import-dialog').close();
+  loadDoc(r.request);
+  const src = r.source || {};
+  $('import-notes').hidden = false;
+  $('import-source').textContent = `${src.file || main.name}${src.sec_props_file ? ' + ' + src.sec_props_file : ''}` +
+    (src.title ? ` — “${src.title}”` : '');
+  const ul = $('import-warnings');
+  ul.textContent = '';
+  for (const w of r.warnings) {
+    const li = document.createElement('li');
+    li.textContent = typeof w === 'string' ? w : [w.file && `${w.file}${w.line ? ':' + w.line : ''}`, w.field, w.message]
+      .filter(Boolean).join(': ') || JSON.stringify(w);
+    ul.append(li);
+  }
+  if (!r.warnings.length) {
+    const li = document.createElement('li');
+    li.className = 'ok';
+    li.textContent = 'no import warnings';
+    ul.append(li);
+  }
+  fileMsg(`imported ${main.name} (${format}): a blade of ${S.doc.blade && S.doc.blade.length} m — press Solve`, 'ok');
+}
+$('import-go').addEventListener('click', importBlade);
+
+// ------------------------------------------------------------ compare and export
+
+$('keep-ref').addEventListener('click', () => {
+  const R = S.result;
+  if (!R) return;
+  S.ref = {id: R.id, result: R.result, label: `${R.id.slice(0, 8)} (${(R.result.cases || []).length} speeds)`};
+  $('keep-ref').textContent = `Reference: ${R.id.slice(0, 8)} — keep this one instead`;
+  $('clear-ref').hidden = false;
+  updateChart();
+});
+$('clear-ref').addEventListener('click', () => {
+  S.ref = null;
+  $('keep-ref').textContent = 'Compare: keep as reference';
+  $('clear-ref').hidden = true;
+  updateChart();
+});
+
+function exportName(what, ext) {
+  return `spinmodal-${S.result ? S.result.id.slice(0, 12) : 'x'}-${what}.${ext}`;
+}
+
+function campbellExportSvg() {
+  const u = units();
+  return campbellSvg(chart.plot, chart.last, `Campbell diagram (${SPEED_UNITS[u.speed].label}, ${FREQ_UNITS[u.freq].label})`);
+}
+
+function modeExportSvg() {
+  return exportSvg($('mode-svg'), $('mode-desc').textContent.split('. ')[0]);
+}
+
+async function exportFile(kind, fmt) {
+  if (!S.result || !chart.plot) return;
+  const svg = kind === 'campbell' ? campbellExportSvg() : modeExportSvg();
+  const name = exportName(kind, fmt);
+  const blob = fmt === 'svg' ? new Blob([svg], {type: 'image/svg+xml'}) : await svgToPng(svg);
+  S.lastExport = {name, type: blob.type, size: blob.size};
+  saveBlob(blob, name);
+}
+$('campbell-svg').addEventListener('click', () => exportFile('campbell', 'svg'));
+$('campbell-png').addEventListener('click', () => exportFile('campbell', 'png'));
+$('mode-svg-dl').addEventListener('click', () => exportFile('mode', 'svg'));
+$('mode-png-dl').addEventListener('click', () => exportFile('mode', 'png'));
+
 // ------------------------------------------------------------------ start
 
 window.__spinmodal = {
@@ -853,9 +1374,33 @@ window.__spinmodal = {
   errors: () => S.localErrors.map((e) => ({pointer: e.pointer ?? null, message: e.message}))
     .concat(S.serverErrors.map((e) => ({...e}))),
   validateAvailable: () => api.validateAvailable(),
+  warnings: () => S.warnings.map((w) => ({...w})),
+  units,
+  campbellSvg: () => (chart.plot ? campbellExportSvg() : null),
+  modeSvg: () => modeExportSvg(),
+  tableCsv: () => $('dl-csv-units').dataset.csv || '',
+  lastExport: () => S.lastExport || null,
   loadExample,
+  loadDoc,
 };
 
 const reduce = window.matchMedia && window.matchMedia('(prefers-reduced-motion: reduce)').matches;
-loadExample('angled-90');
+// the design of the last visit, else the first example
+const kept = stored();
+let keptDoc = null;
+try {
+  keptDoc = kept ? JSON.parse(kept) : null;
+} catch {
+  keptDoc = null;
+}
+if (keptDoc && typeof keptDoc === 'object') {
+  loadDoc(keptDoc);
+  fileMsg('your request from the last visit (kept in this browser)', 'ok');
+} else if (kept && kept.trim()) {
+  loadExample('angled-90');
+  setText(kept); // half-typed JSON: shown as it was, with its syntax error
+  $('json').dispatchEvent(new Event('input'));
+} else {
+  loadExample('angled-90');
+}
 setRunning(!reduce);

@@ -369,6 +369,8 @@ export function linspace(a, b, n) {
  * or more speeds, {mode: 'list', list} for any other array (or anything else).
  */
 export function speedsForm(omega) {
+  const r = rangeOf(omega);
+  if (r) return {mode: 'sweep', from: fmtNum(r.from), to: fmtNum(r.to), count: String(r.steps + 1), range: true};
   if (typeof omega === 'number' || typeof omega === 'string' || omega === undefined) {
     return {mode: 'single', value: text(omega)};
   }
@@ -393,13 +395,94 @@ export function speedsValue(f) {
   if (f.mode === 'single') return {value: cellValue(f.value)};
   if (f.mode === 'sweep') {
     const a = cellValue(f.from), b = cellValue(f.to), n = cellValue(f.count);
-    if (typeof a !== 'number') return {error: 'the first speed must be a number (rad/s)', field: 'from'};
-    if (typeof b !== 'number') return {error: 'the last speed must be a number (rad/s)', field: 'to'};
+    const u = f.unit || 'rad/s';
+    if (typeof a !== 'number') return {error: `the first speed must be a number (${u})`, field: 'from'};
+    if (typeof b !== 'number') return {error: `the last speed must be a number (${u})`, field: 'to'};
     if (!Number.isInteger(n) || n < 2 || n > 100000) {
       return {error: 'the number of speeds must be an integer between 2 and 100000', field: 'count'};
     }
-    return {value: linspace(a, b, n)};
+    // a request that gave a range keeps the range form (steps + 1 speeds, DESIGN.md 8.1)
+    return {value: f.range ? {from: a, to: b, steps: n - 1} : linspace(a, b, n)};
   }
   const parts = String(f.list).split(/[\s,;]+/).filter((s) => s !== '');
   return {value: parts.map(cellValue)};
+}
+
+/**
+ * A range {from, to, steps} (DESIGN.md 8.1: steps + 1 speeds) as the sweep
+ * form reads it, or null for anything else.
+ */
+export function rangeOf(v) {
+  if (!isObj(v)) return null;
+  const {from, to, steps} = v;
+  if (![from, to, steps].every((x) => typeof x === 'number' && Number.isFinite(x))) return null;
+  return {from, to, steps};
+}
+
+/** The speeds of analysis.omega or analysis.rpm as numbers (a range expanded), in their own unit. */
+export function speedList(v) {
+  const r = rangeOf(v);
+  if (r) return r.steps >= 1 ? linspace(r.from, r.to, Math.round(r.steps) + 1) : [r.from];
+  if (typeof v === 'number') return [v];
+  if (Array.isArray(v)) return v.filter((x) => typeof x === 'number' && Number.isFinite(x));
+  return [];
+}
+
+// ------------------------------------------------------------------- units
+
+export const RPM_PER_RAD_S = 60 / (2 * Math.PI);
+
+/** Speed units: rad/s (the request's omega) or rpm (its rpm). */
+export const SPEED_UNITS = {
+  rad: {label: 'rad/s', of: (omega) => omega},
+  rpm: {label: 'rpm', of: (omega) => omega * RPM_PER_RAD_S},
+};
+
+/** Frequency units: rad/s, Hz, per-rev (ω/Ω, null at Ω = 0). */
+export const FREQ_UNITS = {
+  rad: {label: 'rad/s', sym: 'ω', of: (w) => w},
+  hz: {label: 'Hz', sym: 'f', of: (w) => w / (2 * Math.PI)},
+  rev: {label: 'per rev', sym: 'ω/Ω', of: (w, omega) => (omega > 0 ? w / omega : null)},
+};
+
+/** One speed value converted from rad/s to rpm or back, rounded to 12 significant digits. */
+export function convertSpeed(v, toRpm) {
+  return Number((toRpm ? v * RPM_PER_RAD_S : v / RPM_PER_RAD_S).toPrecision(12));
+}
+
+// ------------------------------------------------------------------ blades
+
+/**
+ * The structure a request in the blade form stands for (DESIGN.md 8.1), for
+ * the drawing and the mesh: b1 = (cos p, 0, sin p), b3 = (−sin p, 0, cos p)
+ * with p the precone; joints root = hub_radius·b1 and tip = (hub_radius +
+ * length)·b1; member "blade" (root → tip, elements, flap_direction b3,
+ * twist_deg = pitch); clamp root; the tip mass at the tip.  null when the
+ * blade lacks a usable length.  The daemon does the real expansion; this one
+ * only has to draw the same mesh (node numbering of core/mesh.c).
+ */
+export function expandBlade(b) {
+  if (!isObj(b) || typeof b.length !== 'number' || !(b.length > 0)) return null;
+  const num = (v, d) => (typeof v === 'number' && Number.isFinite(v) ? v : d);
+  const p = (num(b.precone_deg, 0) * Math.PI) / 180;
+  const hub = num(b.hub_radius, 0), len = b.length;
+  const b1 = [Math.cos(p), 0, Math.sin(p)], b3 = [-Math.sin(p), 0, Math.cos(p)];
+  const at = (r) => b1.map((c) => Number((r * c).toPrecision(15)));
+  const section = isObj(b.section) ? b.section : {};
+  const st = {
+    joints: {root: at(hub), tip: at(hub + len)},
+    sections: {blade: {EA: 1, EI_flap: 1, EI_edge: 1, GJ: 1, mass_per_length: 1, ...section}},
+    members: [{id: 'blade', from: 'root', to: 'tip', section: 'blade', elements: Number.isInteger(b.elements) ? b.elements : 48,
+      flap_direction: b3.map((c) => Number(c.toPrecision(15))), twist_deg: num(b.pitch_deg, 0)}],
+    clamp: 'root',
+  };
+  if (isObj(b.tip_mass)) st.point_masses = [{joint: 'tip', mass: b.tip_mass.mass}];
+  return st;
+}
+
+/** The structure of a request: its "structure", or its expanded "blade". */
+export function structureOf(doc) {
+  if (!isObj(doc)) return null;
+  if ('structure' in doc || !('blade' in doc)) return doc.structure;
+  return expandBlade(doc.blade);
 }

@@ -1,0 +1,192 @@
+// export.js — the Campbell diagram and the mode shape as SVG and PNG files.
+//
+// The mode shape is already an SVG: it is copied with the page's SVG style
+// rules inlined, so the file looks as on the screen anywhere.  The Campbell
+// diagram is a uPlot canvas: it is redrawn as SVG from what uPlot plots (its
+// scales, tick values and data, the same series styles), with the legend and
+// the engine-order labels, so the file is vector graphics, not a picture of
+// the canvas.  PNG is either SVG rasterised at twice its size.
+
+const NS = 'http://www.w3.org/2000/svg';
+
+function esc(t) {
+  return String(t).replace(/&/g, '&amp;').replace(/</g, '&lt;').replace(/>/g, '&gt;').replace(/"/g, '&quot;');
+}
+
+/** The page's style rules for SVG drawings (those starting with "svg"), as CSS text. */
+function svgRules() {
+  const out = [];
+  for (const sheet of Array.from(document.styleSheets)) {
+    let rules;
+    try {
+      rules = sheet.cssRules;
+    } catch {
+      continue;
+    }
+    for (const r of Array.from(rules || [])) if (r.selectorText && /^svg[ .[]/.test(r.selectorText)) out.push(r.cssText);
+  }
+  // the page's custom properties (var(--mode) …) mean nothing outside it: put their values in
+  const root = getComputedStyle(document.documentElement);
+  return out.join('\n').replace(/var\((--[\w-]+)\)/g, (m, name) => root.getPropertyValue(name).trim() || '#333');
+}
+
+/** A standalone SVG text of an <svg> of the page (styles inlined, white background, a title). */
+export function exportSvg(svg, title) {
+  const c = svg.cloneNode(true);
+  const vb = (svg.getAttribute('viewBox') || '0 0 600 360').split(/\s+/).map(Number);
+  c.setAttribute('xmlns', NS);
+  c.setAttribute('width', String(vb[2]));
+  c.setAttribute('height', String(vb[3]));
+  c.removeAttribute('tabindex');
+  c.removeAttribute('class');
+  const style = document.createElementNS(NS, 'style');
+  style.textContent = svgRules();
+  const bg = document.createElementNS(NS, 'rect');
+  for (const [k, v] of Object.entries({x: vb[0], y: vb[1], width: vb[2], height: vb[3], fill: '#ffffff'})) bg.setAttribute(k, v);
+  c.insertBefore(bg, c.firstChild);
+  c.insertBefore(style, c.firstChild);
+  if (title) {
+    const t = document.createElementNS(NS, 'title');
+    t.textContent = title;
+    c.insertBefore(t, c.firstChild);
+  }
+  return '<?xml version="1.0" encoding="UTF-8"?>\n' + new XMLSerializer().serializeToString(c) + '\n';
+}
+
+/** PNG blob of an SVG text, drawn at scale× its size on white. */
+export function svgToPng(text, scale = 2) {
+  return new Promise((resolve, reject) => {
+    const img = new Image();
+    const url = URL.createObjectURL(new Blob([text], {type: 'image/svg+xml'}));
+    img.onload = () => {
+      const cv = document.createElement('canvas');
+      cv.width = Math.round(img.width * scale);
+      cv.height = Math.round(img.height * scale);
+      const ctx = cv.getContext('2d');
+      ctx.fillStyle = '#ffffff';
+      ctx.fillRect(0, 0, cv.width, cv.height);
+      ctx.drawImage(img, 0, 0, cv.width, cv.height);
+      URL.revokeObjectURL(url);
+      cv.toBlob((b) => (b ? resolve(b) : reject(new Error('PNG encoding failed'))), 'image/png');
+    };
+    img.onerror = () => {
+      URL.revokeObjectURL(url);
+      reject(new Error('the SVG could not be drawn'));
+    };
+    img.src = url;
+  });
+}
+
+/** PNG blob of a canvas. */
+export function canvasPng(canvas) {
+  return new Promise((resolve, reject) => canvas.toBlob((b) => (b ? resolve(b) : reject(new Error('PNG encoding failed'))),
+    'image/png'));
+}
+
+/**
+ * The Campbell diagram as SVG text, from the uPlot instance u (scales, ticks,
+ * data, series styles) and what campbell.js drew (last: orders, flagged points).
+ */
+export function campbellSvg(u, last, title) {
+  const W = 760, H = 440, L = 70, R = 20, T = 34, B = 60;
+  const legendW = 150;
+  const pw = W - L - R - legendW, ph = H - T - B;
+  const xs = u.scales.x, ys = u.scales.y;
+  const X = (v) => L + ((v - xs.min) / (xs.max - xs.min || 1)) * pw;
+  const Y = (v) => T + ph - ((v - ys.min) / (ys.max - ys.min || 1)) * ph;
+  const r2 = (v) => Math.round(v * 100) / 100;
+  const out = [];
+  out.push(`<svg xmlns="${NS}" width="${W}" height="${H}" viewBox="0 0 ${W} ${H}" font-family="system-ui, sans-serif" font-size="12">`);
+  out.push(`<title>${esc(title || 'Campbell diagram')}</title>`);
+  out.push(`<rect x="0" y="0" width="${W}" height="${H}" fill="#ffffff"/>`);
+  if (title) out.push(`<text x="${L}" y="20" font-size="13" font-weight="600">${esc(title)}</text>`);
+  // grid and ticks (uPlot's own)
+  const ax = u.axes;
+  const ticks = (a, scale) => {
+    const sp = a._splits || [];
+    const vals = a._values || sp.map(String);
+    return sp.map((v, i) => [v, vals[i]]).filter(([v]) => v >= scale.min - 1e-12 && v <= scale.max + 1e-12);
+  };
+  for (const [v, t] of ticks(ax[0], xs)) {
+    out.push(`<line x1="${r2(X(v))}" y1="${T}" x2="${r2(X(v))}" y2="${T + ph}" stroke="#e5e7eb"/>`);
+    out.push(`<text x="${r2(X(v))}" y="${T + ph + 16}" text-anchor="middle" fill="#333">${esc(t)}</text>`);
+  }
+  for (const [v, t] of ticks(ax[1], ys)) {
+    out.push(`<line x1="${L}" y1="${r2(Y(v))}" x2="${L + pw}" y2="${r2(Y(v))}" stroke="#e5e7eb"/>`);
+    out.push(`<text x="${L - 6}" y="${r2(Y(v) + 4)}" text-anchor="end" fill="#333">${esc(t)}</text>`);
+  }
+  out.push(`<rect x="${L}" y="${T}" width="${pw}" height="${ph}" fill="none" stroke="#333"/>`);
+  out.push(`<text x="${L + pw / 2}" y="${H - 16}" text-anchor="middle" fill="#333">${esc(ax[0].label || '')}</text>`);
+  out.push(`<text transform="translate(18 ${T + ph / 2}) rotate(-90)" text-anchor="middle" fill="#333">${esc(ax[1].label || '')}</text>`);
+  out.push(`<clipPath id="plot"><rect x="${L}" y="${T}" width="${pw}" height="${ph}"/></clipPath><g clip-path="url(#plot)">`);
+  const xv = u.data[0];
+  const legend = [];
+  u.series.forEach((s, i) => {
+    if (i === 0) return;
+    const yv = u.data[i];
+    const stroke = typeof s.stroke === 'function' ? s.stroke(u, i) : s.stroke || '#333';
+    const dash = s.dash ? ` stroke-dasharray="${s.dash.join(' ')}"` : '';
+    if (s.label === 'crossings') {
+      for (let j = 0; j < xv.length; j++) {
+        if (typeof yv[j] === 'number') out.push(`<circle cx="${r2(X(xv[j]))}" cy="${r2(Y(yv[j]))}" r="4.5" fill="#fff" stroke="${stroke}" stroke-width="2"/>`);
+      }
+      legend.push({label: s.label, stroke, marker: 'ring'});
+      return;
+    }
+    let d = '', pen = false;
+    for (let j = 0; j < xv.length; j++) {
+      const v = yv[j];
+      if (v === undefined) continue; // joined over
+      if (v === null) {
+        pen = false;
+        continue;
+      }
+      d += `${pen ? 'L' : 'M'}${r2(X(xv[j]))} ${r2(Y(v))}`;
+      pen = true;
+    }
+    out.push(`<path d="${d}" fill="none" stroke="${stroke}" stroke-width="${s.width || 1}"${dash} stroke-linejoin="round"/>`);
+    if (/^\d+P$/.test(s.label)) { // the engine order's label where its line leaves the plot
+      let k = -1;
+      for (let j = 0; j < xv.length; j++) if (typeof yv[j] === 'number' && yv[j] <= ys.max && xv[j] <= xs.max) k = j;
+      if (k >= 0) {
+        const lx = Math.min(X(xv[k]) + 3, L + pw - 22), ly = Math.max(T + 10, Y(yv[k]) - 5);
+        out.push(`<text x="${r2(lx)}" y="${r2(ly)}" fill="#374151" font-size="11">${esc(s.label)}</text>`);
+      }
+    }
+    if (/^mode /.test(s.label)) {
+      for (let j = 0; j < xv.length; j++) {
+        if (typeof yv[j] === 'number') out.push(`<circle cx="${r2(X(xv[j]))}" cy="${r2(Y(yv[j]))}" r="2.2" fill="${stroke}"/>`);
+      }
+    }
+    legend.push({label: s.label, stroke, dash: s.dash, width: s.width});
+  });
+  for (const p of last.flagged || []) {
+    out.push(`<circle cx="${r2(X(p.x))}" cy="${r2(Y(p.y))}" r="4" fill="#fff" stroke="#9ca3af" stroke-width="1.5"/>`);
+  }
+  out.push('</g>');
+  if ((last.flagged || []).length) legend.push({label: 'flagged speeds', stroke: '#9ca3af', marker: 'ring'});
+  // legend
+  let ly = T + 6;
+  const lx = L + pw + 14;
+  for (const e of legend) {
+    if (e.marker === 'ring') out.push(`<circle cx="${lx + 10}" cy="${ly}" r="4" fill="#fff" stroke="${e.stroke}" stroke-width="2"/>`);
+    else out.push(`<line x1="${lx}" y1="${ly}" x2="${lx + 20}" y2="${ly}" stroke="${e.stroke}" stroke-width="${e.width || 1}"${e.dash ? ` stroke-dasharray="${e.dash.join(' ')}"` : ''}/>`);
+    out.push(`<text x="${lx + 26}" y="${ly + 4}" fill="#1b1f24">${esc(e.label)}</text>`);
+    ly += 17;
+    if (ly > H - 10) break;
+  }
+  out.push('</svg>');
+  return '<?xml version="1.0" encoding="UTF-8"?>\n' + out.join('\n') + '\n';
+}
+
+/** Offer a blob as a download named name. */
+export function saveBlob(blob, name) {
+  const a = document.createElement('a');
+  const url = URL.createObjectURL(blob);
+  a.href = url;
+  a.download = name;
+  document.body.append(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(url), 60000);
+}
