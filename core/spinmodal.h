@@ -388,6 +388,9 @@ typedef struct sm_case {
     double *shape_im;         /* same, NULL without Coriolis or mode shapes */
     /* timing, ms */
     double t_equilibrium, t_linearize, t_eigen;
+    /* error estimate (sm_estimate; NULL until it ran): n_modes each, NaN where none */
+    double *error_estimate;   /* estimated |frequency - converged beam-model frequency|, rad/s */
+    double *error_order;      /* convergence order used: observed, or SM_ESTIMATE_ORDER */
 } sm_case;
 
 typedef struct sm_result {
@@ -411,6 +414,73 @@ int sm_solve(const sm_model *m, const double *omegas, int n_omegas,
 
 /** Free a result; NULL is a no-op. */
 void sm_result_free(sm_result *r);
+
+/* ------------------------------------------------------- error estimate */
+
+/** Theoretical order of the frequency error in the element length h (lumped mass, linear axial
+ *  and torsion shape functions, frame kinematics: all O(h^2)); used when no order is observed. */
+#define SM_ESTIMATE_ORDER 2.0
+
+/** Settings of sm_estimate; fill with sm_estimate_default_options first. */
+typedef struct sm_estimate_options {
+    int levels;          /* refined levels to solve: 2 (h/2 and h/4: observed order, default) or
+                            1 (h/2: SM_ESTIMATE_ORDER); fewer when the limits below say so */
+    int max_elements;    /* a refined model may have at most this many FE elements; 0 = no cap */
+    int max_coordinates; /* ... this many modal coordinates when solved on the dense path
+                            (sm_model_info.structured == 0); 0 = no cap */
+    int max_frame_dofs;  /* ... this many DOF in one frame's component-mode problem (3 per free
+                            node planar, 6 spatial); 0 = no cap */
+    double min_mac;      /* modes of two levels match only with a MAC at least this, default 0.5 */
+} sm_estimate_options;
+
+/** Fill *o with the defaults listed in sm_estimate_options (no caps). */
+void sm_estimate_default_options(sm_estimate_options *o);
+
+/**
+ * The discretisation of refinement level `level` (0 = as given, 1 = h/2, 2 = h/4) of st/opt
+ * (DESIGN.md 9): every member's elements x 2^level; frames {"per_member": k} become
+ * k x 2^level, "per_element" and {"elements_per_frame": n} keep their rule (so the frames
+ * double with the elements), "single" stays one frame.  members (st->n_members entries,
+ * the caller's) receives the refined members; *st_out points into it and st's other arrays
+ * (borrowed).  *opt_out is opt.  Returns SM_OK, SM_INVALID_INPUT (level outside 0..2) or
+ * SM_LIMIT (a member would pass INT_MAX/4 elements).
+ */
+int sm_estimate_refine(const sm_structure *st, const sm_options *opt, int level,
+                       sm_member *members, sm_structure *st_out, sm_options *opt_out);
+
+/**
+ * How many refined levels of st/opt sm_estimate would solve: the largest L <= est->levels
+ * whose level-L model passes est's caps (sm_structure_check sizes, no model is built) into
+ * *levels, the sizes of that finest model into *finest (may be NULL).  L = 0 (none fits)
+ * returns SM_LIMIT with diag->message naming the cap and the size; the paper basis
+ * (which converges to a different answer as frames are added, DESIGN.md 1.2) returns
+ * SM_INVALID_INPUT with diag->item SM_ITEM_OPTIONS, field "substructure_modes".  Other
+ * returns as sm_structure_check.  diag may be NULL.
+ */
+int sm_estimate_plan(const sm_structure *st, const sm_options *opt,
+                     const sm_estimate_options *est, int *levels, sm_model_info *finest,
+                     sm_diag *diag);
+
+/**
+ * Error estimate of every frequency of res, the result of sm_solve(m, omegas, n) with m built
+ * from st and opt (DESIGN.md 9): solves the refined levels of sm_estimate_plan at the same
+ * speeds (with mode shapes, and more modes than asked so that reordered modes are found),
+ * matches each mode level to level by MAC on the nodes of m (never by index), and
+ * Richardson-extrapolates: with three levels and an observed ratio r = (f1 - f2)/(f0 - f1) in
+ * (0, 2^-1/2] the order is -log2 r and the estimate |f0 - f1|/(1 - r); otherwise, or with two
+ * levels, the order SM_ESTIMATE_ORDER (three levels that did not converge regularly:
+ * max(|f0 - f1|, |f1 - f2|) with that order).  Fills each case's error_estimate and
+ * error_order (allocated here, n_modes each; NaN for a mode that was not matched or a case
+ * without modes at the base or first refined level).  If res's cases carry no mode shapes, m is solved
+ * once more with shapes.  cb (may be NULL) is called as in sm_solve with done and total
+ * counting speeds over all solves of the estimate; nonzero cancels (SM_CANCELED).  Returns
+ * SM_OK, SM_LIMIT, SM_INVALID_INPUT (as sm_estimate_plan, or res not of n cases),
+ * SM_CANCELED, SM_NOMEM, or a model-build or solve failure of a refined level (diag says
+ * which).  res is modified only on SM_OK.  diag may be NULL.
+ */
+int sm_estimate(const sm_model *m, const sm_structure *st, const sm_options *opt,
+                const double *omegas, int n_omegas, const sm_estimate_options *est,
+                sm_progress_fn cb, void *user, sm_result *res, sm_diag *diag);
 
 #ifdef __cplusplus
 }

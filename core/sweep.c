@@ -35,6 +35,8 @@ void sm_result_free(sm_result *r)
         free(c->previous_index);
         free(c->shape_re);
         free(c->shape_im);
+        free(c->error_estimate);
+        free(c->error_order);
     }
     free(r->cases);
     free(r);

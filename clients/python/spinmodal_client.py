@@ -440,8 +440,9 @@ class Client:
 
 def parse_csv(text):
     """Rows of the daemon's frequency CSV as dicts (omega, mode, frequency_rad_s, frequency_hz,
-    status, mac_to_previous, per_rev, rpm); numbers as float/int, empty fields as None (per_rev
-    at omega = 0, or from a daemon before these columns)."""
+    status, mac_to_previous, per_rev, rpm, error_estimate); numbers as float/int, empty fields
+    as None (per_rev at omega = 0, error_estimate without "error_estimate": true, or from a
+    daemon before these columns)."""
     rows = []
     for r in _csv.DictReader(io.StringIO(text)):
         rows.append({
@@ -453,6 +454,7 @@ def parse_csv(text):
             "mac_to_previous": _num(r.get("mac_to_previous")),
             "per_rev": _num(r.get("per_rev")),
             "rpm": _num(r.get("rpm")),
+            "error_estimate": _num(r.get("error_estimate_rad_s")),
         })
     return rows
 
@@ -466,26 +468,35 @@ TABLE_COLUMNS = (("omega", "omega_rad_s", 4), ("rpm", "rpm", 2), ("mode", "mode"
 def table_rows(result):
     """The rows of a result document (DESIGN.md 4): one dict per speed and mode with omega, rpm,
     mode, frequency_rad_s, frequency_hz, per_rev and status (mode and frequencies None for a
-    speed without modes; per_rev None at rest)."""
+    speed without modes; per_rev None at rest), and error_estimate (None without one)."""
     rows = []
     for c in result.get("cases", []):
         base = {"omega": c.get("omega"), "rpm": c.get("rpm"), "status": c.get("status")}
         for k, m in enumerate(c.get("modes") or [None]):
             m = m or {}
             rows.append(dict(base, mode=k + 1 if m else None, frequency_rad_s=m.get("frequency_rad_s"),
-                             frequency_hz=m.get("frequency_hz"), per_rev=m.get("per_rev")))
+                             frequency_hz=m.get("frequency_hz"), per_rev=m.get("per_rev"),
+                             error_estimate=m.get("error_estimate")))
     return rows
+
+
+def _estimate_cell(row, key):
+    """" +/- e" after the frequency in rad/s when the row has an error estimate (DESIGN.md 9)."""
+    e = row.get("error_estimate")
+    return " +/- %.1e" % e if key == "frequency_rad_s" and e is not None else ""
 
 
 def format_table(rows):
     """rows (table_rows or parse_csv) as an aligned text table: speed in rad/s and rpm, mode, the
-    frequency in rad/s, Hz and per revolution, status; every number of a column with the same
+    frequency in rad/s (with " +/- e" when the row has an error estimate), Hz and per
+    revolution, status; every number of a column with the same
     decimals, right-aligned; "-" for a missing value (the spinmodal CLI's --table)."""
     def cell(v, dec):
         if v is None:
             return "-"
         return "%.*f" % (dec, v) if dec is not None else str(v)
-    cells = [[cell(r.get(k), dec) for k, _, dec in TABLE_COLUMNS] for r in rows]
+    cells = [[cell(r.get(k), dec) + _estimate_cell(r, k) for k, _, dec in TABLE_COLUMNS]
+             for r in rows]
     heads = [h for _, h, _ in TABLE_COLUMNS]
     width = [max([len(h)] + [len(c[j]) for c in cells]) for j, h in enumerate(heads)]
     lines = []

@@ -190,6 +190,16 @@ static void cli_cell_num(char *cell, size_t n, const json_t *x, int d)
         snprintf(cell, n, "-");
 }
 
+/* analysis.error_estimate (DESIGN.md 9): " +/- e" (e in %.1e, so the column stays aligned) after the
+ * frequency in rad/s when the mode has a number there. */
+static void cli_cell_estimate(char *cell, size_t n, const json_t *x)
+{
+    size_t len = strlen(cell);
+
+    if (json_is_number(x) && len < n)
+        snprintf(cell + len, n - len, " +/- %.1e", json_number_value(x));
+}
+
 /* The cells of one table row of case c and mode m (NULL: a case without modes). */
 static void cli_table_row(char cells[CLI_TABLE_COLS][40], const json_t *c, const json_t *m, int k)
 {
@@ -200,6 +210,7 @@ static void cli_table_row(char cells[CLI_TABLE_COLS][40], const json_t *c, const
     else
         snprintf(cells[2], 40, "-");
     cli_cell_num(cells[3], 40, json_object_get(m, "frequency_rad_s"), cli_table_cols[3].decimals);
+    cli_cell_estimate(cells[3], 40, json_object_get(m, "error_estimate"));
     cli_cell_num(cells[4], 40, json_object_get(m, "frequency_hz"), cli_table_cols[4].decimals);
     cli_cell_num(cells[5], 40, json_object_get(m, "per_rev"), cli_table_cols[5].decimals);
     snprintf(cells[6], 40, "%.39s", json_string_value(json_object_get(c, "status")));

@@ -154,6 +154,13 @@ const double *codec_request_rpm(const codec_request *r, int *n);
  */
 const json_t *codec_request_input_warnings(const codec_request *r);
 
+/**
+ * analysis.error_estimate (DESIGN.md 9): 0 when not asked, else the refined levels to solve
+ * (2: h/2 and h/4, the observed order; 1: h/2 only, the refined h/4 model being over the
+ * limits the request was validated with).
+ */
+int codec_request_error_estimate(const codec_request *r);
+
 /** Name of joint j (the joints are indexed in sorted name order), borrowed; NULL if out of range. */
 const char *codec_request_joint_name(const codec_request *r, int j);
 

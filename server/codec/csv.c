@@ -9,6 +9,8 @@
  * The columns per_rev (frequency / omega, empty at rest) and rpm (the
  * case's speed in rev/min, DESIGN.md 8) come last, after the columns of
  * before, so a reader that takes columns by position still works.
+ * With an error estimate (DESIGN.md 9) a last column error_estimate_rad_s
+ * follows; without one the table is as before.
  */
 #include "codec_internal.h"
 
@@ -23,15 +25,29 @@ static void csv_num(FILE *f, double x)
         fprintf(f, "%.17g", x);
 }
 
-/* The columns after status: per_rev (frequency / omega, empty at rest) and rpm. */
-static void csv_tail(FILE *f, double freq, double omega, double rpm)
+/* The columns after status: per_rev (frequency / omega, empty at rest) and rpm; the line
+ * ends unless est (a table with error estimates), which adds the last column. */
+static void csv_tail(FILE *f, double freq, double omega, double rpm, int est, double err)
 {
     fputc(',', f);
     if (omega > 0)
         csv_num(f, freq / omega);
     fputc(',', f);
     csv_num(f, rpm);
+    if (est) {
+        fputc(',', f);
+        csv_num(f, err);
+    }
     fputc('\n', f);
+}
+
+/* 1 when a case of res carries error estimates (sm_estimate ran). */
+static int csv_has_estimate(const sm_result *res)
+{
+    for (int i = 0; i < res->n_cases; i++)
+        if (res->cases[i].error_estimate)
+            return 1;
+    return 0;
 }
 
 int codec_result_csv(char **out, size_t *len, const codec_request *r, const sm_result *res)
@@ -40,7 +56,7 @@ int codec_result_csv(char **out, size_t *len, const codec_request *r, const sm_r
     size_t n = 0;
     FILE *f = open_memstream(&buf, &n);
     const double *rpm = NULL;
-    int i, k, n_rpm = 0;
+    int i, k, n_rpm = 0, est = csv_has_estimate(res);
 
     *out = NULL;
     if (!f)
@@ -48,7 +64,8 @@ int codec_result_csv(char **out, size_t *len, const codec_request *r, const sm_r
     if (r)
         rpm = codec_request_rpm(r, &n_rpm);
     fputs("omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,"
-          "per_rev,rpm\n", f);
+          "per_rev,rpm", f);
+    fputs(est ? ",error_estimate_rad_s\n" : "\n", f);
     for (i = 0; i < res->n_cases; i++) {
         const sm_case *c = &res->cases[i];
         const char *st = codec_case_status_name(c->status);
@@ -56,7 +73,7 @@ int codec_result_csv(char **out, size_t *len, const codec_request *r, const sm_r
         if (c->n_modes == 0) {
             csv_num(f, c->omega);
             fprintf(f, ",,,,,,,%s", st);
-            csv_tail(f, NAN, 0, case_rpm);
+            csv_tail(f, NAN, 0, case_rpm, est, NAN);
         }
         for (k = 0; k < c->n_modes; k++) {
             double mac = c->mac_to_previous ? c->mac_to_previous[k] : -1;
@@ -73,7 +90,8 @@ int codec_result_csv(char **out, size_t *len, const codec_request *r, const sm_r
             if (mac >= 0)
                 csv_num(f, mac);
             fprintf(f, ",%s", st);
-            csv_tail(f, c->frequency[k], c->omega, case_rpm);
+            csv_tail(f, c->frequency[k], c->omega, case_rpm, est,
+                     c->error_estimate ? c->error_estimate[k] : NAN);
         }
     }
     if (ferror(f)) {

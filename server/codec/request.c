@@ -46,6 +46,8 @@ struct codec_request {
     sm_structure st;            /* points into the arrays above */
     sm_options opt;             /* from the analysis and frames fields */
     sm_model_info info;         /* sizes of its model (sm_structure_check) */
+    int estimate_levels;        /* analysis.error_estimate: refined levels that fit the
+                                   limits (sm_estimate_plan: 2, or 1), 0 when not asked */
 };
 
 /* qsort/bsearch order of two (const char *) elements. */
@@ -518,6 +520,37 @@ static int req_check_conditioning(const codec_request *r, codec_errors *errs)
 }
 
 /*
+ * analysis.error_estimate (DESIGN.md 9): the refined models (elements x 2 and x 4) must pass
+ * the same limits as a request (elements, frame DOF, dense coordinates).  h/4 over a limit:
+ * two levels and the theoretical order (the result is still estimated); h/2 over a limit: a
+ * 422 at /analysis/error_estimate naming the limit.  Returns SM_OK, SM_INVALID_INPUT or
+ * SM_NOMEM.
+ */
+static int req_check_estimate(codec_request *r, const codec_limits *lim, codec_errors *errs)
+{
+    sm_estimate_options eo;
+    sm_diag d;
+    int rc;
+
+    if (!json_is_true(json_object_get(json_object_get(r->canon, "analysis"), "error_estimate")))
+        return SM_OK;
+    sm_estimate_default_options(&eo);
+    eo.max_elements = lim->max_elements;
+    eo.max_coordinates = lim->max_coordinates;
+    eo.max_frame_dofs = lim->max_frame_dofs;
+    memset(&d, 0, sizeof(d));
+    rc = sm_estimate_plan(&r->st, &r->opt, &eo, &r->estimate_levels, NULL, &d);
+    if (rc == SM_LIMIT || rc == SM_INVALID_INPUT) {
+        if (codec_errors_add(errs, "/analysis/error_estimate",
+                             "%s: ask for fewer elements, or leave error_estimate out",
+                             d.message) == SM_NOMEM)
+            return SM_NOMEM;
+        return SM_INVALID_INPUT;
+    }
+    return rc;
+}
+
+/*
  * codec_request_from_json; core_check 0 leaves out the core's structure
  * check and the cost bounds (req_parse_codec_only).
  */
@@ -555,6 +588,7 @@ static int req_from_json(codec_request **out, const json_t *root, const codec_li
         (rc = req_build_tables(r)) || (rc = req_build_structure(r)) ||
         (rc = req_build_options(r)) ||
         (core_check && (rc = req_check_model(r, lim, errs))) ||
+        (core_check && (rc = req_check_estimate(r, lim, errs))) ||
         (rc = req_check_conditioning(r, errs)))
         goto fail;
     rc = SM_NOMEM;
@@ -716,4 +750,9 @@ const char *codec_request_canonical_text(const codec_request *r)
 const char *codec_request_sha256(const codec_request *r)
 {
     return r->sha;
+}
+
+int codec_request_error_estimate(const codec_request *r)
+{
+    return r->estimate_levels;
 }

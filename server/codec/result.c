@@ -20,6 +20,10 @@
  * "input_warnings" when the request has any (warn.c).  These are appended
  * after the keys of before, so a result of before reads the same with
  * them removed.
+ *
+ * Error estimate (DESIGN.md 9, analysis.error_estimate): each mode ends
+ * with "error_estimate" (rad/s, null where no mode of the refined levels
+ * matched); without the option the key is absent and the bytes unchanged.
  */
 #include "codec_internal.h"
 
@@ -163,6 +167,9 @@ static json_t *res_mode(const sm_case *c, int k, int shapes)
             goto fail;
     }
     if (json_object_set_new(md, "per_rev", res_per_rev(c->frequency[k], c->omega)))
+        goto fail;
+    if (c->error_estimate &&
+        json_object_set_new(md, "error_estimate", res_real(c->error_estimate[k])))
         goto fail;
     return md;
 fail:

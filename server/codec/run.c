@@ -32,14 +32,25 @@ typedef struct run_progress {
     void *user;
     int done;
     int total;     /* speeds requested */
+    int solves;    /* 1 + the refined levels of an error estimate: the speeds reported are
+                      done/solves, so progress stays within the speeds and keeps rising */
 } run_progress;
 
 static int run_progress_cb(void *user, int done, int total)
 {
     run_progress *p = user;
 
-    p->done = done;
-    return p->cb ? p->cb(p->user, done, total) : 0;
+    p->done = p->solves > 1 ? done / p->solves : done;
+    return p->cb ? p->cb(p->user, p->done, total) : 0;
+}
+
+/* The refined solves of an error estimate: speeds solved after the request's own. */
+static int run_estimate_cb(void *user, int done, int total)
+{
+    run_progress *p = user;
+
+    (void)total;
+    return run_progress_cb(user, p->total + done, p->total);
 }
 
 /* While the model is built: no speed is done yet; the caller may stop it. */
@@ -120,10 +131,44 @@ static int run_encode(const codec_request *req, const sm_model *m, const sm_resu
     return run_outcome_of(res, out);
 }
 
+/*
+ * analysis.error_estimate (DESIGN.md 9): sm_estimate on the refined levels the request was
+ * validated for; fills res's error_estimate.  SM_OK, SM_NOMEM, or the outcome set in out
+ * (canceled, failed) and its status.
+ */
+static int run_estimate(const codec_request *req, const sm_model *m, sm_result *res,
+                        run_progress *prog, codec_run_out *out)
+{
+    sm_estimate_options eo;
+    const double *speeds;
+    char detail[400];
+    sm_diag d;
+    int n, st;
+
+    sm_estimate_default_options(&eo);
+    eo.levels = prog->solves - 1;
+    speeds = codec_request_speeds(req, &n);
+    memset(&d, 0, sizeof(d));
+    st = sm_estimate(m, codec_request_structure(req), codec_request_options(req), speeds, n, &eo,
+                     run_estimate_cb, prog, res, &d);
+    out->status = st;
+    if (st == SM_OK || st == SM_NOMEM)
+        return st;
+    out->speeds_done = prog->done;
+    if (st == SM_CANCELED) {
+        out->outcome = CODEC_RUN_CANCELED;
+        return st;
+    }
+    snprintf(detail, sizeof(detail), "the error estimate failed: %s%s%s", sm_strerror(st),
+             d.message[0] ? ": " : "", d.message);
+    run_fail(out, CODEC_RUN_FAILED, "solver_error", "Error estimate failed", detail, NULL);
+    return st;
+}
+
 codec_run_outcome codec_run(const codec_request *req, unsigned want, sm_progress_fn cb,
                             void *user, codec_errors *errs, codec_run_out *out)
 {
-    run_progress prog = {cb, user, 0, 0};
+    run_progress prog = {cb, user, 0, 0, 1};
     sm_model *m = NULL;
     sm_result *res = NULL;
     const double *speeds;
@@ -136,6 +181,7 @@ codec_run_outcome codec_run(const codec_request *req, unsigned want, sm_progress
     out->seconds = -1;
     speeds = codec_request_speeds(req, &n);
     out->speeds_total = prog.total = n;
+    prog.solves = 1 + codec_request_error_estimate(req);
     memset(&d, 0, sizeof(d));
     st = codec_model_build(&m, req, run_build_cb, &prog, errs, &d);
     out->seconds = run_clock() - t0;
@@ -174,6 +220,14 @@ codec_run_outcome codec_run(const codec_request *req, unsigned want, sm_progress
                  st == SM_INVALID_INPUT ? "invalid" : "solver_error", "Solver error", detail,
                  run_errors(errs));
         goto done;
+    }
+    if (prog.solves > 1) {
+        st = run_estimate(req, m, res, &prog, out);
+        out->seconds = run_clock() - t0;
+        if (st == SM_NOMEM)
+            goto nomem;
+        if (st != SM_OK)
+            goto done;
     }
     if (run_encode(req, m, res, want, out) != SM_OK)
         goto nomem;

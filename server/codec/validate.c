@@ -625,12 +625,39 @@ static void val_frames(val_ctx *v, const json_t *root, json_t *canon)
     field_set(v, canon, "frames", c);
 }
 
+/*
+ * analysis.error_estimate (DESIGN.md 9): a boolean, default false.  Only true goes into the
+ * canonical request, so a request without it keeps its canonical text and job id.  The
+ * paper basis has no error estimate (it does not converge to the beam model as frames are
+ * added); the refined models are checked against the limits in request.c.
+ */
+static void val_error_estimate(val_ctx *v, const json_t *an, json_t *can)
+{
+    const json_t *x = json_object_get(an, "error_estimate");
+    const char *basis = json_string_value(json_object_get(can, "substructure_modes"));
+
+    if (!x || json_is_false(x))
+        return;
+    if (!json_is_true(x)) {
+        field_error(v, "/analysis/error_estimate", "must be true or false, not %s",
+                    field_type_name(x));
+        return;
+    }
+    if (basis && !strcmp(basis, "paper")) {
+        field_error(v, "/analysis/error_estimate",
+                    "no error estimate with the \"paper\" basis: it does not converge to the "
+                    "beam model as frames are added (DESIGN.md 1.2); use \"augmented\"");
+        return;
+    }
+    field_set(v, can, "error_estimate", json_true());
+}
+
 /* The analysis object: omega or rpm (speeds.c), modes and the options, with their defaults. */
 static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
 {
     static const char *const keys[] = {"omega", "rpm", "modes", "geometric_stiffening", "coriolis",
                                        "mass", "substructure_modes", "modes_per_frame",
-                                       "mode_shapes", NULL};
+                                       "mode_shapes", "error_estimate", NULL};
     static const char *const mass[] = {"lumped", "consistent", NULL};
     static const char *const basis[] = {"augmented", "paper", NULL};
     static const char *base = "/analysis";
@@ -668,6 +695,7 @@ static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
                     "must be \"all\" or a positive integer, not %s",
                     json_is_string(mpf) ? "another string" : field_type_name(mpf));
     field_bool(v, an, "mode_shapes", base, can, 1);
+    val_error_estimate(v, an, can);
     field_set(v, canon, "analysis", can);
 }
 

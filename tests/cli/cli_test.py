@@ -367,6 +367,65 @@ def t_blade(tmp):
     check(rc == 64, "blade: --csv with --table is a usage error (%d)" % rc)
 
 
+# The keys of a mode and the CSV header without analysis.error_estimate (as before it existed).
+MODE_KEYS = ["frequency_rad_s", "frequency_hz", "eigenvalue", "mac_to_previous", "previous_index",
+             "shape", "per_rev"]
+CSV_HEADER = "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm"
+
+
+def t_error_estimate(tmp):
+    """(i) analysis.error_estimate (DESIGN.md 9): every mode ends with error_estimate, the CSV
+    with error_estimate_rad_s, within 3x of the true error of a 6-element cantilever at rest;
+    without the option (absent or false) the keys, the CSV bytes and the frequencies are those
+    of before."""
+    length, n = 10.0, 6
+    base = cantilever(length=length, elements=n)
+    off = json.loads(json.dumps(base))
+    off["analysis"]["error_estimate"] = False
+    on = json.loads(json.dumps(base))
+    on["analysis"]["error_estimate"] = True
+    docs, csvs = {}, {}
+    for name, req in (("absent", base), ("false", off), ("true", on)):
+        path = write_request(tmp, "estimate-%s.json" % name, req)
+        rc, out, err = run(["solve", path])
+        check(rc == 0, "error_estimate %s: exit 0 (got %d; %.200s)" % (name, rc, err))
+        docs[name] = parse_json(out, "error_estimate %s" % name)
+        rc, out, err = run(["solve", "--csv", path])
+        check(rc == 0, "error_estimate %s: --csv exit 0" % name)
+        csvs[name] = out
+    if not all(docs.values()):
+        return
+    check(csvs["absent"] == csvs["false"], "error_estimate false: CSV bytes as without the option")
+    check(csvs["absent"].splitlines()[0] == CSV_HEADER, "without error_estimate: the CSV header of before")
+    for name in ("absent", "false"):
+        modes = docs[name]["cases"][0]["modes"]
+        check(all(list(m) == MODE_KEYS for m in modes),
+              "error_estimate %s: mode keys %s" % (name, list(modes[0])))
+    check(docs["absent"]["solver"] == docs["false"]["solver"],
+          "error_estimate false: the request_sha256 of the request without it")
+    check(docs["true"]["solver"]["request_sha256"] != docs["absent"]["solver"]["request_sha256"],
+          "error_estimate true: another request_sha256 (another job)")
+    plain = docs["absent"]["cases"][0]["modes"]
+    est = docs["true"]["cases"][0]["modes"]
+    check(all(list(m) == MODE_KEYS + ["error_estimate"] for m in est),
+          "error_estimate true: error_estimate is the last key of every mode")
+    check([m["frequency_rad_s"] for m in est] == [m["frequency_rad_s"] for m in plain],
+          "error_estimate true: the frequencies unchanged")
+    base_w = math.sqrt(E * INERTIA / (MU * length ** 4))
+    for k, bl in enumerate((1.875104069, 4.694091133, 7.854757438)):
+        true_err = abs(est[k]["frequency_rad_s"] - bl * bl * base_w)
+        ratio = est[k]["error_estimate"] / true_err
+        check(1 / 3 <= ratio <= 3, "error_estimate: mode %d of %d elements: true error %.3e, "
+              "estimate %.3e (ratio %.2f)" % (k + 1, n, true_err, est[k]["error_estimate"], ratio))
+    lines = csvs["true"].splitlines()
+    check(lines[0] == CSV_HEADER + ",error_estimate_rad_s", "error_estimate true: CSV last column")
+    check([l.rsplit(",", 1)[0] for l in lines[1:]] == csvs["absent"].splitlines()[1:] and
+          [float(l.rsplit(",", 1)[1]) for l in lines[1:]] == [m["error_estimate"] for m in est],
+          "error_estimate true: CSV rows as before plus the estimate of the JSON")
+    rc, out, err = run(["solve", "--table", write_request(tmp, "estimate-true.json", on)])
+    check(rc == 0 and out.count("+/-") == 3, "error_estimate true: --table prints +/- per mode")
+
+
 SCENARIOS = {
     "cantilever": t_cantilever,
     "invalid": t_invalid,
@@ -376,6 +435,7 @@ SCENARIOS = {
     "usage": t_usage,
     "spatial": t_spatial,
     "blade": t_blade,
+    "error_estimate": t_error_estimate,
 }
 
 

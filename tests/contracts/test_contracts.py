@@ -396,6 +396,7 @@ def t_cli():
             ("coriolis", angled(6.0, coriolis=True, modes=4), 0),
             ("no-coriolis", angled(6.0, coriolis=False, modes=4), 0),
             ("no-shapes", angled(6.0, mode_shapes=False), 0),
+            ("error-estimate", angled([0, 6.0], mode_shapes=False, error_estimate=True), 0),
             ("sweep-paper-consistent", angled([0, 3, 6], {"per_member": 2}, mass="consistent",
                                               substructure_modes="paper", modes_per_frame=6), 0),
             ("no-equilibrium", angled([10, 20], "single", geometric_stiffening=True), 3),
@@ -450,6 +451,14 @@ def t_cli():
         d = docs.get("no-shapes")
         if d:
             check(all("shape" not in m for c in d["cases"] for m in c["modes"]), "no-shapes: no shape")
+        d = docs.get("error-estimate")
+        if d:
+            modes = [m for c in d["cases"] for m in c["modes"]]
+            check(modes and all(list(m)[-1] == "error_estimate" and m["error_estimate"] > 0
+                                for m in modes), "error-estimate: error_estimate last, > 0")
+            e = copy.deepcopy(d)
+            e["cases"][0]["modes"][0]["error_estimate"] = -1.0
+            rejected(e, "result", "a negative error_estimate")
         d = docs.get("no-equilibrium")
         if d:
             st = [c["status"] for c in d["cases"]]
