@@ -17,8 +17,8 @@
  * of the element that ends there) times the squared component, plus the rotary
  * inertia halves (i_flap + i_edge on tx, i_flap on p2.r, i_edge on p3.r).  A complex
  * shape (Coriolis) counts the real and the imaginary part: |x|^2 = re^2 + im^2.
- * Fractions only: the common factors (1/2, w^2) cancel.  The steady deflection and
- * the section offsets are left out of the split (it classifies; it does not add up
+ * Fractions only: the common factors (1/2, w^2) cancel.  The section offsets and
+ * the consistent mass are left out of the split (lumped halves always) (it classifies; it does not add up
  * to the modal energy of the model to round-off).
  *
  * The label comes from the strain fractions: a member that moves rigidly along its
@@ -60,20 +60,52 @@ char *sm_mode_label(int kind, int ordinal, char *buf, size_t size)
     return buf;
 }
 
-/* Principal axes of element e at rest: t (n1 -> n2), p2, p3 = t x p2, hub frame. */
-static void lab_axes(const sm_model *m, const sm_elem *e, double t[3], double p2[3], double p3[3])
+static double lab_dot(const double *a, const double *b);
+
+/* v rotated by the rotation vector psi (Rodrigues): v cos + (k x v) sin + k (k.v)(1 - cos). */
+static void lab_rotate(const double psi[3], double v[3])
 {
-    if (m->spatial) {
-        for (int k = 0; k < 3; k++) {
-            t[k] = e->ax[k];
-            p2[k] = e->ax[3 + k];
-            p3[k] = e->ax[6 + k];
-        }
+    double th = sqrt(lab_dot(psi, psi));
+    if (!(th > 0))
+        return;
+    double k[3] = {psi[0] / th, psi[1] / th, psi[2] / th}, kv = lab_dot(k, v), cs = cos(th), sn = sin(th);
+    double x[3] = {k[1] * v[2] - k[2] * v[1], k[2] * v[0] - k[0] * v[2], k[0] * v[1] - k[1] * v[0]};
+    for (int i = 0; i < 3; i++)
+        v[i] = v[i] * cs + x[i] * sn + k[i] * kv * (1 - cs);
+}
+
+/* Principal axes of element e at the equilibrium of case c: t along the deformed chord n1 -> n2,
+ * p2 the rest p2 turned by the mean rotation of the two nodes and made normal to t, p3 = t x p2
+ * (planar: p2 the in-plane normal, p3 = z), hub frame. */
+static void lab_axes(const sm_model *m, const sm_case *c, const sm_elem *e, double t[3], double p2[3],
+                     double p3[3])
+{
+    int dof = m->spatial ? 6 : 3;
+    const double *a = c->nodes + (size_t)dof * e->n1, *b = c->nodes + (size_t)dof * e->n2;
+    t[0] = b[0] - a[0], t[1] = b[1] - a[1], t[2] = m->spatial ? b[2] - a[2] : 0;
+    double n = sqrt(lab_dot(t, t));
+    for (int k = 0; k < 3; k++)
+        t[k] /= n;
+    if (!m->spatial) {
+        p2[0] = -t[1], p2[1] = t[0], p2[2] = 0;
+        p3[0] = 0, p3[1] = 0, p3[2] = 1;
         return;
     }
-    t[0] = cos(e->angle), t[1] = sin(e->angle), t[2] = 0;
-    p2[0] = -t[1], p2[1] = t[0], p2[2] = 0;
-    p3[0] = 0, p3[1] = 0, p3[2] = 1;
+    double psi[3];
+    for (int k = 0; k < 3; k++) {
+        p2[k] = e->ax[3 + k];
+        psi[k] = 0.5 * (a[3 + k] + b[3 + k]);
+    }
+    lab_rotate(psi, p2);
+    double d = lab_dot(p2, t);
+    for (int k = 0; k < 3; k++)
+        p2[k] -= d * t[k];
+    n = sqrt(lab_dot(p2, p2));
+    for (int k = 0; k < 3; k++)
+        p2[k] /= n;
+    p3[0] = t[1] * p2[2] - t[2] * p2[1];
+    p3[1] = t[2] * p2[0] - t[0] * p2[2];
+    p3[2] = t[0] * p2[1] - t[1] * p2[0];
 }
 
 static double lab_dot(const double *a, const double *b)
@@ -104,13 +136,13 @@ static double lab_bending(double EI, double l, double v1, double s1, double v2, 
 
 /* e[0..3] += kinetic (axial, edge, flap, torsion), e[4..7] += strain of element el for one
  * real shape s (a part of a complex one). */
-static void lab_element(const sm_model *m, int el, const double *s, double e[SM_ENERGY_PARTS])
+static void lab_element(const sm_model *m, const sm_case *c, int el, const double *s, double e[SM_ENERGY_PARTS])
 {
     const sm_elem *E = &m->elems[el];
     double t[3], p2[3], p3[3], d[2][3], r[2][3], u[2], v[2], w[2], tx[2], r2[2], r3[2];
     int nd[2] = {E->n1, E->n2};
 
-    lab_axes(m, E, t, p2, p3);
+    lab_axes(m, c, E, t, p2, p3);
     for (int h = 0; h < 2; h++) {
         lab_node(m, s, nd[h], d[h], r[h]);
         u[h] = lab_dot(t, d[h]);
@@ -145,36 +177,36 @@ static void lab_element(const sm_model *m, int el, const double *s, double e[SM_
 }
 
 /* Point-mass rotary inertia of node k (spatial) in the axes (t, p2, p3): its diagonal. */
-static void lab_point_rot(const sm_model *m, int el, const double *s, double e[SM_ENERGY_PARTS])
+static void lab_point_rot(const sm_model *m, const sm_case *c, int el, const double *s, double e[SM_ENERGY_PARTS])
 {
     const sm_elem *E = &m->elems[el];
     const double *P = m->nodes[E->n2].point_rot;
     double t[3], p2[3], p3[3], d[3], r[3], *ax[3] = {t, p2, p3};
     int slot[3] = {3, 2, 1}; /* about t: torsion; about p2: flap; about p3: edge */
 
-    lab_axes(m, E, t, p2, p3);
+    lab_axes(m, c, E, t, p2, p3);
     lab_node(m, s, E->n2, d, r);
     for (int a = 0; a < 3; a++) {
-        double Pa[3], c = lab_dot(ax[a], r);
+        double Pa[3], ra = lab_dot(ax[a], r);
         for (int i = 0; i < 3; i++)
             Pa[i] = P[i] * ax[a][0] + P[i + 3] * ax[a][1] + P[i + 6] * ax[a][2];
-        e[slot[a]] += lab_dot(ax[a], Pa) * c * c; /* (a' P a) (a.r)^2 */
+        e[slot[a]] += lab_dot(ax[a], Pa) * ra * ra; /* (a' P a) (a.r)^2 */
     }
 }
 
 /* Energy fractions of one nodal shape (re, and im or NULL) into f[SM_ENERGY_PARTS]. */
-static void lab_energy(const sm_model *m, const double *re, const double *im, double f[SM_ENERGY_PARTS])
+static void lab_energy(const sm_model *m, const sm_case *c, const double *re, const double *im, double f[SM_ENERGY_PARTS])
 {
     double e[SM_ENERGY_PARTS] = {0};
 
     for (int el = 0; el < m->n_elems; el++) {
-        lab_element(m, el, re, e);
+        lab_element(m, c, el, re, e);
         if (im)
-            lab_element(m, el, im, e);
+            lab_element(m, c, el, im, e);
         if (m->spatial) {
-            lab_point_rot(m, el, re, e);
+            lab_point_rot(m, c, el, re, e);
             if (im)
-                lab_point_rot(m, el, im, e);
+                lab_point_rot(m, c, el, im, e);
         }
     }
     for (int h = 0; h < 2; h++) {
@@ -206,7 +238,7 @@ int lab_case(const sm_model *m, sm_case *c)
     size_t stride = (size_t)dof * (size_t)m->n_nodes;
     int count[SM_MODE_BENDING + 1] = {0};
 
-    if (k <= 0 || !c->shape_re)
+    if (k <= 0 || !c->shape_re || !c->nodes)
         return SM_OK;
     c->energy = malloc((size_t)k * SM_ENERGY_PARTS * sizeof(double));
     c->label_kind = malloc((size_t)k * sizeof(int));
@@ -216,7 +248,7 @@ int lab_case(const sm_model *m, sm_case *c)
         return SM_NOMEM;
     for (int j = 0; j < k; j++) { /* modes are in ascending frequency: ordinals count up */
         double *f = c->energy + (size_t)j * SM_ENERGY_PARTS;
-        lab_energy(m, c->shape_re + j * stride, c->shape_im ? c->shape_im + j * stride : NULL, f);
+        lab_energy(m, c, c->shape_re + j * stride, c->shape_im ? c->shape_im + j * stride : NULL, f);
         c->label_kind[j] = lab_kind(m, f, &c->label_confidence[j]);
         c->label_ordinal[j] = c->label_kind[j] == SM_MODE_COUPLED ? 0 : ++count[c->label_kind[j]];
     }
