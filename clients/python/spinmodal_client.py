@@ -418,8 +418,9 @@ class Client:
 
 def parse_csv(text):
     """Rows of the daemon's frequency CSV as dicts (omega, mode, frequency_rad_s, frequency_hz,
-    status, mac_to_previous, per_rev, rpm); numbers as float/int, empty fields as None (per_rev
-    at omega = 0, or from a daemon before these columns)."""
+    status, mac_to_previous, per_rev, rpm, label, label_confidence, tracked_index, tracking_flag);
+    numbers as float/int, empty fields as None (per_rev at omega = 0, or from a daemon before these
+    columns)."""
     rows = []
     for r in _csv.DictReader(io.StringIO(text)):
         rows.append({
@@ -431,6 +432,11 @@ def parse_csv(text):
             "mac_to_previous": _num(r.get("mac_to_previous")),
             "per_rev": _num(r.get("per_rev")),
             "rpm": _num(r.get("rpm")),
+            # DESIGN.md 9.1 (None from a daemon before these columns)
+            "label": r.get("label") or None,
+            "label_confidence": _num(r.get("label_confidence")),
+            "tracked_index": _num(r.get("tracked_index"), int),
+            "tracking_flag": r.get("tracking_flag") or None,
         })
     return rows
 
@@ -438,26 +444,27 @@ def parse_csv(text):
 # Columns of format_table: key in a row, header, decimals (None: an integer or text).
 TABLE_COLUMNS = (("omega", "omega_rad_s", 4), ("rpm", "rpm", 2), ("mode", "mode", None),
                  ("frequency_rad_s", "freq_rad_s", 6), ("frequency_hz", "freq_hz", 6),
-                 ("per_rev", "per_rev", 4), ("status", "status", None))
+                 ("per_rev", "per_rev", 4), ("status", "status", None), ("label", "label", None))
 
 
 def table_rows(result):
     """The rows of a result document (DESIGN.md 4): one dict per speed and mode with omega, rpm,
-    mode, frequency_rad_s, frequency_hz, per_rev and status (mode and frequencies None for a
-    speed without modes; per_rev None at rest)."""
+    mode, frequency_rad_s, frequency_hz, per_rev, status and label (mode, frequencies and label
+    None for a speed without modes; per_rev None at rest)."""
     rows = []
     for c in result.get("cases", []):
         base = {"omega": c.get("omega"), "rpm": c.get("rpm"), "status": c.get("status")}
         for k, m in enumerate(c.get("modes") or [None]):
             m = m or {}
             rows.append(dict(base, mode=k + 1 if m else None, frequency_rad_s=m.get("frequency_rad_s"),
-                             frequency_hz=m.get("frequency_hz"), per_rev=m.get("per_rev")))
+                             frequency_hz=m.get("frequency_hz"), per_rev=m.get("per_rev"),
+                             label=m.get("label")))
     return rows
 
 
 def format_table(rows):
     """rows (table_rows or parse_csv) as an aligned text table: speed in rad/s and rpm, mode, the
-    frequency in rad/s, Hz and per revolution, status; every number of a column with the same
+    frequency in rad/s, Hz and per revolution, status, the mode label; every number of a column with the same
     decimals, right-aligned; "-" for a missing value (the spinmodal CLI's --table)."""
     def cell(v, dec):
         if v is None:
