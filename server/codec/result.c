@@ -158,7 +158,7 @@ static int res_trust(json_t *md, const sm_case *c, int k)
     int spatial = res_node_dof(c) == 6, flag;
     const double *f;
 
-    if (c->label_kind) {
+    if (c->label_kind && c->energy) {
         f = c->energy + (size_t)k * SM_ENERGY_PARTS;
         sm_mode_label(c->label_kind[k], c->label_ordinal[k], lab, sizeof(lab));
         if (json_object_set_new(md, "label", json_string(lab)) ||

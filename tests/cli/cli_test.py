@@ -198,11 +198,14 @@ def t_csv(tmp):
     lines = out.splitlines()
     check(rc == 0, "csv: exit 0 (got %d; %.200s)" % (rc, err))
     check(lines[:1] == ["omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,"
-                        "per_rev,rpm"],
+                        "per_rev,rpm,label,label_confidence,tracked_index,tracking_flag"],
           "csv: header")
     check(len(lines) == 1 + 3 * 4, "csv: 12 rows for 3 speeds x 4 modes (got %d)" % (len(lines) - 1))
     rows = [l.split(",") for l in lines[1:]]
-    check(all(len(r) == 10 for r in rows), "csv: 10 fields per row")
+    check(all(len(r) == 14 for r in rows), "csv: 14 fields per row")
+    check(all(r[10] == "%d%s bending" % (int(r[1]), {1: "st", 2: "nd", 3: "rd"}.get(int(r[1]), "th"))
+              and float(r[11]) > 0.9 and r[12] == str(int(r[1]) - 1) and r[13] == "" for r in rows),
+          "csv: the cantilever's modes are 1st..4th bending, tracked on lines 0..3, no flags")
     check(rows and rows[0][1] == "1" and rows[0][6] == "" and rows[-1][6] != "",
           "csv: modes numbered from 1, MAC empty at the first speed only")
     rc, out, err = run(["solve", "--csv", write_request(tmp, "angled.json", angled_beam(20, "single"))])
@@ -299,7 +302,7 @@ def t_spatial(tmp):
               "spatial %s: in-plane frequencies are the planar ones to 1e-7 (%s vs %s)" % (what, got, want))
         rc, csv, err = run(["solve", "--csv", path])
         lines = csv.splitlines()
-        check(rc == 0 and lines[0] == "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm"
+        check(rc == 0 and lines[0] == "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm,label,label_confidence,tracked_index,tracking_flag"
               and len(lines) == 17, "spatial %s: CSV header and one row per mode (%d lines)" % (what, len(lines)))
     # validate: the canonical form writes the spatial defaults out
     rc, out, err = run(["validate", write_request(tmp, "spatial.json", blade(variants[0][1], 4))])
@@ -335,10 +338,13 @@ def t_blade(tmp):
     rc, out, err = run(["solve", "--table", example])
     lines = out.splitlines()
     check(rc == 0 and lines and lines[0].split() == ["omega_rad_s", "rpm", "mode", "freq_rad_s", "freq_hz",
-                                                     "per_rev", "status"],
+                                                     "per_rev", "status", "label"],
           "blade --table: header (%s)" % lines[:1])
     rows = [l.split() for l in lines[1:]]
-    check(len(rows) == 5 * 4 and all(len(r) == 7 for r in rows), "blade --table: 20 rows of 7 cells")
+    check(len(rows) == 5 * 4 and all(len(r) == 9 for r in rows), "blade --table: 20 rows of 7 cells and a label")
+    labels = [" ".join(r[7:]) for r in rows]
+    jl = [m.get("label") for c in res["cases"] for m in c["modes"]]
+    check(labels == jl, "blade --table: the label column is the JSON's (%s)" % labels[:4])
     check(len(set(len(l) for l in lines)) == 1, "blade --table: every line equally long (aligned)")
     for col, dec in ((0, 4), (1, 2), (3, 6), (4, 6), (5, 4)):
         cells = [r[col] for r in rows if r[col] != "-"]
