@@ -374,6 +374,60 @@ def t_blade(tmp):
     check(rc == 64, "blade: --csv with --table is a usage error (%d)" % rc)
 
 
+def t_trust(tmp):
+    """(h) DESIGN.md 9.1: the straight blade (EI_edge = 4 EI_flap) swept 0..12 rad/s with
+    engine_orders [1, 2]: modes carry labels, tracked indices and the flap/edge crossing flag;
+    critical_speeds in the JSON (rad/s and rpm, label) equal the --critical-csv rows; a solve at
+    the reported 1P speed of the 1st edge mode gives w = Omega to 1e-6; bad engine orders are
+    422s with their pointers; a request without engine_orders has no critical_speeds key."""
+    req = {"blade": {"length": 31.623, "elements": 24,
+                     "section": {"EA": 1e14, "EI_flap": 1e8, "EI_edge": 4e8, "GJ": 1e8, "mass_per_length": 100,
+                                 "flap_inertia": 1e-3, "edge_inertia": 1e-3}},
+           "analysis": {"omega": {"from": 0, "to": 12, "steps": 12}, "modes": 4, "mode_shapes": False,
+                        "engine_orders": [1, 2]}}
+    path = write_request(tmp, "trust.json", req)
+    rc, out, err = run(["solve", path])
+    check(rc == 0, "trust: solves (exit %d; %.200s)" % (rc, err))
+    res = json.loads(out) if rc == 0 else {"cases": [], "critical_speeds": []}
+    keys = list(res["cases"][0]["modes"][0]) if res["cases"] else []
+    check(keys[-6:] == ["label", "label_confidence", "energy", "tracked_index", "tracking_flag", "tracking_partner"]
+          and keys[:6] == ["frequency_rad_s", "frequency_hz", "eigenvalue", "mac_to_previous", "previous_index",
+                           "per_rev"], "trust: new mode keys appended after the old ones (%s)" % keys)
+    check(list(res)[-1] == "critical_speeds", "trust: critical_speeds last in the document (%s)" % list(res))
+    first = [m["label"] for m in res["cases"][0]["modes"]]
+    check(first == ["1st flap", "1st edge", "2nd flap", "2nd edge"], "trust: labels at rest (%s)" % first)
+    flags = [(c["omega"], m["label"], m["tracking_flag"]) for c in res["cases"] for m in c["modes"] if m["tracking_flag"]]
+    check(len(flags) == 2 and all(f[2] == "crossing" for f in flags), "trust: one flap/edge crossing (%s)" % flags)
+    crit = res.get("critical_speeds", [])
+    e1 = [c for c in crit if c["order"] == 1 and c["label"] == "1st edge"]
+    check(len(e1) == 1 and e1[0]["refined"] and abs(e1[0]["rpm"] - e1[0]["omega"] * 60 / (2 * math.pi)) < 1e-9,
+          "trust: 1P crossing of the 1st edge mode, refined, rpm = omega 60/2pi (%s)" % e1)
+    rc, out, err = run(["solve", "--critical-csv", path])
+    lines = out.splitlines()
+    check(rc == 0 and lines[0] == "order,tracked_index,label,label_confidence,omega,rpm,frequency_rad_s,frequency_hz,"
+          "refined,omega_interpolated" and len(lines) == 1 + len(crit), "trust --critical-csv: header + %d rows (%s)"
+          % (len(crit), lines[:2]))
+    rows = [l.split(",") for l in lines[1:]]
+    check(all(float(r[4]) == c["omega"] and r[2] == c["label"] for r, c in zip(rows, crit)),
+          "trust --critical-csv: the rows are the JSON's critical speeds")
+    if e1:
+        one = json.loads(json.dumps(req))
+        one["analysis"] = {"omega": e1[0]["omega"], "modes": 4, "mode_shapes": False}
+        rc, out, err = run(["solve", write_request(tmp, "one.json", one)])
+        doc = json.loads(out) if rc == 0 else {"cases": [{"modes": []}]}
+        w = [m["frequency_rad_s"] for m in doc["cases"][0]["modes"] if m.get("label") == "1st edge"]
+        check(len(w) == 1 and abs(w[0] / e1[0]["omega"] - 1) < 1e-6,
+              "trust: independent solve at Omega* = %.10f: w_1E = %s (1e-6)" % (e1[0]["omega"], w))
+        check("critical_speeds" not in doc, "trust: no engine_orders, no critical_speeds key")
+    for bad, ptr in (([0], "/analysis/engine_orders/0"), ([1, "x"], "/analysis/engine_orders/1"),
+                     ([2, 2], "/analysis/engine_orders/1"), ([], "/analysis/engine_orders"),
+                     (list(range(1, 18)), "/analysis/engine_orders")):
+        r2 = json.loads(json.dumps(req))
+        r2["analysis"]["engine_orders"] = bad
+        rc, out, err = run(["validate", write_request(tmp, "bad.json", r2)])
+        check(rc == 2 and ptr in err, "trust: engine_orders %s is a 422 at %s (exit %d)" % (str(bad)[:20], ptr, rc))
+
+
 SCENARIOS = {
     "cantilever": t_cantilever,
     "invalid": t_invalid,
@@ -383,6 +437,7 @@ SCENARIOS = {
     "usage": t_usage,
     "spatial": t_spatial,
     "blade": t_blade,
+    "trust": t_trust,
 }
 
 
