@@ -379,4 +379,26 @@ typedef struct eig_root {
 /** qsort order of eig_root by key, ascending. */
 int eig_root_cmp(const void *a, const void *b);
 
+/* ------------------------------------------- labels.c, track.c, critical.c (DESIGN.md 9.1) */
+/** Energy fractions, label kind, ordinal and confidence of every mode of c (allocated into c,
+ *  freed by sm_result_free) from its nodal shapes; nothing when c has no modes or no shapes.
+ *  Returns SM_OK or SM_NOMEM. */
+int lab_case(const sm_model *m, sm_case *c);
+/** MAC of mode a of case A and mode b of case B over the nodal translations (both with shapes,
+ *  same model), in [0, 1]. */
+double track_mac(const sm_case *A, int a, const sm_case *B, int b);
+/** Optimal assignment maximising the sum of mac (nr x nc, row-major, rows = current modes,
+ *  columns = previous ones): match[r] = column of row r, or -1 when nr > nc leaves it out.
+ *  Hungarian method, O(max(nr, nc)^3).  Returns SM_OK or SM_NOMEM. */
+int track_assign(int nr, int nc, const double *mac, int *match);
+/** Tracking of the sweep r (ord: the n case indices in ascending speed; shapes present):
+ *  mac_to_previous, previous_index, tracked_index, track_flag, track_partner.  SM_OK or SM_NOMEM. */
+int track_sweep(sm_result *r, const int *ord, int n);
+/** Solve at one speed with shapes kept and labels (sweep.c, for the refinement of critical
+ *  speeds; no tracking).  *out owned by the caller.  Returns as sm_solve. */
+int sweep_single(const sm_model *m, double omega, sm_progress_fn cb, void *user, sm_result **out);
+/** Critical speeds of the tracked sweep r for m->opt.engine_orders into r->critical (cb, user:
+ *  the caller's cancel callback, asked between refining solves).  SM_OK, SM_NOMEM, SM_CANCELED. */
+int crit_find(const sm_model *m, sm_result *r, const int *ord, int n, sm_progress_fn cb, void *user);
+
 #endif

@@ -181,6 +181,9 @@ typedef enum sm_basis {
     SM_BASIS_PAPER                   /* Kim & Yoo's condensed component modes */
 } sm_basis;
 
+/** Most engine orders one solve looks for (sm_options.engine_orders, DESIGN.md 9.1). */
+#define SM_MAX_ENGINE_ORDERS 16
+
 /** Analysis options; fill with sm_default_options first. */
 typedef struct sm_options {
     sm_frame_scheme frames;          /* default SM_FRAMES_PER_ELEMENT */
@@ -200,6 +203,10 @@ typedef struct sm_options {
      * round-off): SM_SOLVER_AUTO (default) picks by size; the others force a path (tests,
      * benchmarks). */
     int solver;                      /* sm_solver */
+    /* DESIGN.md 9.1: engine orders n > 0 (finite, at most SM_MAX_ENGINE_ORDERS) whose critical
+     * speeds (w(Omega) = n Omega along each tracked mode) sm_solve finds in a sweep; 0: none */
+    int n_engine_orders;
+    double engine_orders[SM_MAX_ENGINE_ORDERS];
 } sm_options;
 
 /** Linear-algebra path of a solve (sm_options.solver). */
@@ -391,12 +398,70 @@ typedef struct sm_case {
     /* error estimate (sm_estimate; NULL until it ran): n_modes each, NaN where none */
     double *error_estimate;   /* estimated |frequency - converged beam-model frequency|, rad/s */
     double *error_order;      /* convergence order used: observed, or SM_ESTIMATE_ORDER */
+    /* DESIGN.md 9.1 (trust), each n_modes long, NULL when the case has no modes: */
+    double *energy;           /* n_modes * SM_ENERGY_PARTS fractions: kinetic (axial, edge, flap,
+                                 torsion) then strain (same order); each four sum to 1.  Planar:
+                                 the edge slot holds the in-plane bending, flap and torsion are 0 */
+    int *label_kind;          /* sm_mode_kind, from the strain fractions (dominant part > 60 %,
+                                 else SM_MODE_COUPLED) */
+    int *label_ordinal;       /* 1-based count among the modes of the same kind of this case in
+                                 ascending frequency; 0 for SM_MODE_COUPLED */
+    double *label_confidence; /* the dominant strain fraction */
+    int *tracked_index;       /* the Campbell line (tracked mode) this mode belongs to, 0-based */
+    int *track_flag;          /* 0, SM_TRACK_CROSSING or SM_TRACK_VEERING */
+    int *track_partner;       /* tracked index of the other mode of the flagged pair, or -1 */
 } sm_case;
+
+/** Values per mode in sm_case.energy: kinetic axial, edge, flap, torsion, then strain. */
+#define SM_ENERGY_PARTS 8
+
+/** Kind of a mode (sm_case.label_kind, DESIGN.md 9.1). */
+typedef enum sm_mode_kind {
+    SM_MODE_AXIAL = 0,        /* axial (stretching) */
+    SM_MODE_EDGE,             /* edgewise: bending in the p2 direction (in-plane for a blade) */
+    SM_MODE_FLAP,             /* flapwise: bending in the p3 direction (out of plane) */
+    SM_MODE_TORSION,          /* torsion about the member axis */
+    SM_MODE_COUPLED,          /* no part above 60 % of the strain energy */
+    SM_MODE_BENDING           /* planar models: in-plane bending */
+} sm_mode_kind;
+
+/** Flags of sm_case.track_flag (DESIGN.md 9.1). */
+enum sm_track_flag {
+    SM_TRACK_CROSSING = 1,    /* two tracked modes swapped order since the previous speed, each
+                                 keeping its shape (MAC >= 0.9): a true crossing */
+    SM_TRACK_VEERING = 2      /* two tracked modes came close and exchanged shape: a veering */
+};
+
+/** A critical speed (DESIGN.md 9.1): a tracked mode meets an engine order, w(Omega) = n Omega. */
+typedef struct sm_critical {
+    double order;             /* engine order n */
+    int tracked_index;        /* the tracked mode (sm_case.tracked_index) */
+    double omega;             /* rad/s: refined speed (the interpolated one when refined == 0) */
+    double omega_interpolated; /* rad/s: linear interpolation of w - n Omega between the sweep
+                                  speeds omega_below and omega_above */
+    double omega_below, omega_above; /* the bracketing speeds of the sweep, rad/s */
+    double frequency;         /* rad/s: the mode's frequency at omega */
+    int refined;              /* 1: solves at single speeds converged on w = n Omega */
+    int iterations;           /* single-speed solves spent refining */
+    double residual;          /* |w(omega) - n omega| / (n omega) of the last refining solve, or
+                                 of the interpolation when refined == 0 */
+    int label_kind, label_ordinal; /* the mode's label at omega (or at the nearer sweep speed) */
+    double label_confidence;
+} sm_critical;
 
 typedef struct sm_result {
     int n_cases;
     sm_case *cases;           /* n_cases, in the order of the requested speeds */
+    int n_critical;           /* DESIGN.md 9.1: critical speeds found (engine orders given) */
+    sm_critical *critical;    /* n_critical, by order then speed, or NULL */
 } sm_result;
+
+/** The text of a label: "1st flap", "2nd edge", "3rd torsion", "1st axial", "1st bending",
+ *  "coupled" into buf (size bytes, always terminated).  Returns buf. */
+char *sm_mode_label(int kind, int ordinal, char *buf, size_t size);
+
+/** The name of a kind ("axial", "edge", "flap", "torsion", "coupled", "bending"); never NULL. */
+const char *sm_mode_kind_name(int kind);
 
 /**
  * Solve at each speed of omegas (rad/s, finite, >= 0 in any order: they are

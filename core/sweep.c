@@ -37,8 +37,16 @@ void sm_result_free(sm_result *r)
         free(c->shape_im);
         free(c->error_estimate);
         free(c->error_order);
+        free(c->energy);
+        free(c->label_kind);
+        free(c->label_ordinal);
+        free(c->label_confidence);
+        free(c->tracked_index);
+        free(c->track_flag);
+        free(c->track_partner);
     }
     free(r->cases);
+    free(r->critical);
     free(r);
 }
 
@@ -181,63 +189,6 @@ static void sweep_shapes(const sm_model *m, sweep_lin *L, const sm_eig_out *e, d
             yi[c] = cimag(v);
         }
     }
-}
-
-/* MAC between mode a of case A and mode b of case B (translations only). */
-static double sweep_mac(const sm_case *A, int a, const sm_case *B, int b)
-{
-    int nn = A->n_nodes, dof = A->node_dof;
-    const double *ar = A->shape_re + (size_t)a * dof * nn, *ai = A->shape_im + (size_t)a * dof * nn;
-    const double *br = B->shape_re + (size_t)b * dof * nn, *bi = B->shape_im + (size_t)b * dof * nn;
-    double complex dot = 0;
-    double na = 0, nb = 0;
-    for (int c = 0; c < dof * nn; c++) {
-        if (!sweep_translation(c, dof))
-            continue;
-        double complex u = ar[c] + _Complex_I * ai[c], v = br[c] + _Complex_I * bi[c];
-        dot += conj(u) * v;
-        na += creal(conj(u) * u);
-        nb += creal(conj(v) * v);
-    }
-    return na > 0 && nb > 0 ? creal(dot * conj(dot)) / (na * nb) : 0.0;
-}
-
-/* Greedy MAC assignment of the modes of cur to those of prev. */
-static void sweep_track(sm_case *cur, const sm_case *prev)
-{
-    int nc = cur->n_modes, np = prev ? prev->n_modes : 0;
-    for (int j = 0; j < nc; j++) {
-        cur->mac_to_previous[j] = -1;
-        cur->previous_index[j] = -1;
-    }
-    if (!np || !prev->shape_re)
-        return;
-    double *mac = malloc((size_t)nc * np * sizeof(double));
-    if (!mac)
-        return;
-    for (int j = 0; j < nc; j++)
-        for (int i = 0; i < np; i++)
-            mac[(size_t)j * np + i] = sweep_mac(cur, j, prev, i);
-    for (int t = 0; t < nc && t < np; t++) {
-        int bj = -1, bi = -1;
-        double best = -1;
-        for (int j = 0; j < nc; j++)
-            for (int i = 0; i < np; i++)
-                if (mac[(size_t)j * np + i] > best) {
-                    best = mac[(size_t)j * np + i];
-                    bj = j;
-                    bi = i;
-                }
-        if (bj < 0)
-            break;
-        cur->mac_to_previous[bj] = best;
-        cur->previous_index[bj] = bi;
-        for (int i = 0; i < np; i++)
-            mac[(size_t)bj * np + i] = -2;
-        for (int j = 0; j < nc; j++)
-            mac[(size_t)j * np + bi] = -2;
-    }
-    free(mac);
 }
 
 /* Fill equilibrium outputs of case c at q (kinematics of q in L). */
@@ -393,8 +344,26 @@ static int sweep_key_cmp(const void *a, const void *b)
     return x->index - y->index;
 }
 
-int sm_solve(const sm_model *m, const double *omegas, int n_omegas, sm_progress_fn cb, void *user,
-             sm_result **out, sm_diag *diag)
+/* The speeds of omegas in ascending order (ties in input order) into ord (n case indices). */
+static int sweep_order(const double *omegas, int n, int *ord)
+{
+    sweep_key *key = malloc((size_t)(n ? n : 1) * sizeof *key);
+    if (!key)
+        return SM_NOMEM;
+    for (int i = 0; i < n; i++) {
+        key[i].omega = omegas[i];
+        key[i].index = i;
+    }
+    qsort(key, (size_t)n, sizeof *key, sweep_key_cmp);
+    for (int i = 0; i < n; i++)
+        ord[i] = key[i].index;
+    free(key);
+    return SM_OK;
+}
+
+/* Every speed of omegas: equilibrium, modes and nodal shapes (kept), no tracking. */
+static int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress_fn cb, void *user,
+                     sm_result **out, sm_diag *diag)
 {
     sm_diag scratch;
     sm_diag *d = diag ? diag : &scratch;
@@ -441,7 +410,6 @@ int sm_solve(const sm_model *m, const double *omegas, int n_omegas, sm_progress_
     sm_progress pr = {cb, user, 0, n_omegas};
     double s_prev = 0;
     int from_rest = 1;
-    const sm_case *prev = NULL;
     for (int t = 0; t < n_omegas; t++) {
         sm_case *c = &r->cases[key[t].index];
         double s = c->omega * c->omega, t0 = sweep_ms();
@@ -473,17 +441,10 @@ int sm_solve(const sm_model *m, const double *omegas, int n_omegas, sm_progress_
             c->status = SM_CASE_NO_EQUILIBRIUM;
             snprintf(c->message, sizeof c->message, "%s", eo.message);
             from_rest = 1;
-            prev = NULL;
         } else {
             if ((rc = sweep_modes(m, q, &L, c)) < 0)
                 goto fail;
-            if (c->status == SM_CASE_EIGEN_FAILED) {
-                prev = NULL; /* nothing to track against */
-            } else {
-                sweep_track(c, prev);
-                prev = c;
-            }
-            s_prev = s;
+            s_prev = s; /* tracking (track.c) runs once every speed is solved */
             from_rest = 0;
         }
         pr.done = t + 1;
@@ -492,16 +453,6 @@ int sm_solve(const sm_model *m, const double *omegas, int n_omegas, sm_progress_
             goto fail;
         }
     }
-    if (!m->opt.mode_shapes || !m->opt.coriolis)
-        for (int i = 0; i < n_omegas; i++) {
-            sm_case *c = &r->cases[i];
-            if (!m->opt.mode_shapes) {
-                free(c->shape_re);
-                c->shape_re = NULL;
-            }
-            free(c->shape_im);
-            c->shape_im = NULL;
-        }
     sweep_lin_free(&L);
     free(key);
     free(q);
@@ -517,4 +468,63 @@ fail:
     if (!d->message[0])
         snprintf(d->message, sizeof d->message, "%s", sm_strerror(rc));
     return rc;
+}
+
+int sweep_single(const sm_model *m, double omega, sm_progress_fn cb, void *user, sm_result **out)
+{
+    int rc = sweep_run(m, &omega, 1, cb, user, out, NULL);
+    if (rc == SM_OK && (rc = lab_case(m, &(*out)->cases[0])) < 0) {
+        sm_result_free(*out);
+        *out = NULL;
+    }
+    return rc;
+}
+
+/* DESIGN.md 9.1 on a solved sweep: labels, tracking, critical speeds (shapes still present). */
+static int sweep_trust(const sm_model *m, sm_result *r, const double *omegas, int n, sm_progress_fn cb,
+                       void *user)
+{
+    int *ord = malloc((size_t)(n ? n : 1) * sizeof(int)), rc = SM_NOMEM;
+    if (!ord || sweep_order(omegas, n, ord) < 0)
+        goto done;
+    for (int i = 0; i < n; i++)
+        if ((rc = lab_case(m, &r->cases[i])) < 0)
+            goto done;
+    if ((rc = track_sweep(r, ord, n)) < 0)
+        goto done;
+    rc = crit_find(m, r, ord, n, cb, user);
+done:
+    free(ord);
+    return rc;
+}
+
+int sm_solve(const sm_model *m, const double *omegas, int n_omegas, sm_progress_fn cb, void *user,
+             sm_result **out, sm_diag *diag)
+{
+    sm_result *r = NULL;
+    int rc = sweep_run(m, omegas, n_omegas, cb, user, &r, diag);
+    if (rc < 0)
+        return rc;
+    if ((rc = sweep_trust(m, r, omegas, n_omegas, cb, user)) < 0) {
+        sm_result_free(r);
+        if (diag) {
+            memset(diag, 0, sizeof *diag);
+            diag->item_index = -1;
+            diag->status = rc;
+            snprintf(diag->message, sizeof diag->message, "%s", sm_strerror(rc));
+        }
+        return rc;
+    }
+    if (!m->opt.mode_shapes || !m->opt.coriolis)
+        for (int i = 0; i < n_omegas; i++) {
+            sm_case *c = &r->cases[i];
+            if (!m->opt.mode_shapes) {
+                free(c->shape_re);
+                c->shape_re = NULL;
+            }
+            free(c->shape_im);
+            c->shape_im = NULL;
+        }
+    *out = r;
+    return SM_OK;
 }

@@ -440,9 +440,9 @@ class Client:
 
 def parse_csv(text):
     """Rows of the daemon's frequency CSV as dicts (omega, mode, frequency_rad_s, frequency_hz,
-    status, mac_to_previous, per_rev, rpm, error_estimate); numbers as float/int, empty fields
-    as None (per_rev at omega = 0, error_estimate without "error_estimate": true, or from a
-    daemon before these columns)."""
+    status, mac_to_previous, per_rev, rpm, label, label_confidence, tracked_index, tracking_flag,
+    error_estimate); numbers as float/int, empty fields as None (per_rev at omega = 0,
+    error_estimate without "error_estimate": true, or from a daemon before these columns)."""
     rows = []
     for r in _csv.DictReader(io.StringIO(text)):
         rows.append({
@@ -454,6 +454,11 @@ def parse_csv(text):
             "mac_to_previous": _num(r.get("mac_to_previous")),
             "per_rev": _num(r.get("per_rev")),
             "rpm": _num(r.get("rpm")),
+            # DESIGN.md 9.1 (None from a daemon before these columns)
+            "label": r.get("label") or None,
+            "label_confidence": _num(r.get("label_confidence")),
+            "tracked_index": _num(r.get("tracked_index"), int),
+            "tracking_flag": r.get("tracking_flag") or None,
             "error_estimate": _num(r.get("error_estimate_rad_s")),
         })
     return rows
@@ -462,13 +467,13 @@ def parse_csv(text):
 # Columns of format_table: key in a row, header, decimals (None: an integer or text).
 TABLE_COLUMNS = (("omega", "omega_rad_s", 4), ("rpm", "rpm", 2), ("mode", "mode", None),
                  ("frequency_rad_s", "freq_rad_s", 6), ("frequency_hz", "freq_hz", 6),
-                 ("per_rev", "per_rev", 4), ("status", "status", None))
+                 ("per_rev", "per_rev", 4), ("status", "status", None), ("label", "label", None))
 
 
 def table_rows(result):
     """The rows of a result document (DESIGN.md 4): one dict per speed and mode with omega, rpm,
-    mode, frequency_rad_s, frequency_hz, per_rev and status (mode and frequencies None for a
-    speed without modes; per_rev None at rest), and error_estimate (None without one)."""
+    mode, frequency_rad_s, frequency_hz, per_rev, status and label (mode, frequencies and label
+    None for a speed without modes; per_rev None at rest), and error_estimate (None without one)."""
     rows = []
     for c in result.get("cases", []):
         base = {"omega": c.get("omega"), "rpm": c.get("rpm"), "status": c.get("status")}
@@ -476,7 +481,7 @@ def table_rows(result):
             m = m or {}
             rows.append(dict(base, mode=k + 1 if m else None, frequency_rad_s=m.get("frequency_rad_s"),
                              frequency_hz=m.get("frequency_hz"), per_rev=m.get("per_rev"),
-                             error_estimate=m.get("error_estimate")))
+                             label=m.get("label"), error_estimate=m.get("error_estimate")))
     return rows
 
 
@@ -489,7 +494,7 @@ def _estimate_cell(row, key):
 def format_table(rows):
     """rows (table_rows or parse_csv) as an aligned text table: speed in rad/s and rpm, mode, the
     frequency in rad/s (with " +/- e" when the row has an error estimate), Hz and per
-    revolution, status; every number of a column with the same
+    revolution, status, the mode label; every number of a column with the same
     decimals, right-aligned; "-" for a missing value (the spinmodal CLI's --table)."""
     def cell(v, dec):
         if v is None:

@@ -43,11 +43,12 @@ typedef struct cli_args {
     const char *path;    /* request file, "-" = stdin */
     int csv;             /* --csv: frequency table instead of JSON */
     int table;           /* --table: aligned frequency table for a terminal */
+    int critical_csv;    /* --critical-csv: the critical speeds as CSV (DESIGN.md 9.1) */
     int pretty;          /* --pretty: indented JSON */
 } cli_args;
 
 static const char cli_usage_text[] =
-    "usage: spinmodal solve [--csv | --table] [--pretty] FILE|-\n"
+    "usage: spinmodal solve [--csv | --table | --critical-csv] [--pretty] FILE|-\n"
     "       spinmodal validate [--pretty] FILE|-\n"
     "       spinmodal import bmodes|elastodyn|csv FILE [--tip-radius R] [--hub-radius H]\n"
     "                        [--rpm N] [--pretty] [--full]\n"
@@ -67,7 +68,8 @@ static void cli_help(void)
            "options:\n"
            "  --csv            print the frequency table as CSV instead of JSON\n"
            "  --table          print an aligned table: speed (rad/s, rpm), mode,\n"
-           "                   frequency in rad/s, Hz and per revolution, status\n"
+           "                   frequency in rad/s, Hz and per revolution, status, label\n"
+           "  --critical-csv   print the critical speeds (analysis.engine_orders) as CSV\n"
            "  --pretty         indent the JSON output\n"
            "  -h, --help       show this help\n"
            "  -V, --version    show the version\n\n"
@@ -172,13 +174,13 @@ static int cli_fail(const char *what, int status)
 }
 
 /* Columns of --table: header, decimals (-1: an integer or text). */
-#define CLI_TABLE_COLS 7
+#define CLI_TABLE_COLS 8
 static const struct {
     const char *head;
     int decimals;
 } cli_table_cols[CLI_TABLE_COLS] = {
     {"omega_rad_s", 4}, {"rpm", 2}, {"mode", -1}, {"freq_rad_s", 6}, {"freq_hz", 6},
-    {"per_rev", 4}, {"status", -1},
+    {"per_rev", 4}, {"status", -1}, {"label", -1},
 };
 
 /* Cell text of a number with d decimals, "-" for null or absent. */
@@ -214,6 +216,8 @@ static void cli_table_row(char cells[CLI_TABLE_COLS][40], const json_t *c, const
     cli_cell_num(cells[4], 40, json_object_get(m, "frequency_hz"), cli_table_cols[4].decimals);
     cli_cell_num(cells[5], 40, json_object_get(m, "per_rev"), cli_table_cols[5].decimals);
     snprintf(cells[6], 40, "%.39s", json_string_value(json_object_get(c, "status")));
+    snprintf(cells[7], 40, "%.39s", json_is_string(json_object_get(m, "label"))
+                                        ? json_string_value(json_object_get(m, "label")) : "-");
 }
 
 /* Print or measure (print 0: widen w) every row of the result's cases. */
@@ -276,6 +280,13 @@ static int cli_output(const cli_args *a, const codec_run_out *out)
     } else if (a->table) {
         if (cli_print_table(stdout, out->result))
             rc = CLI_FAILED;
+    } else if (a->critical_csv) {
+        char *csv = NULL;
+        size_t n = 0;
+        if (codec_critical_speeds_csv(&csv, &n, out->result) != SM_OK ||
+            fwrite(csv, 1, n, stdout) != n || fflush(stdout))
+            rc = CLI_FAILED;
+        free(csv);
     } else if (cli_print_json(stdout, out->result, a->pretty)) {
         rc = CLI_FAILED;
     }
@@ -433,7 +444,7 @@ static int cli_export_main(int argc, char **argv)
 
 int main(int argc, char **argv)
 {
-    cli_args a = {NULL, NULL, 0, 0, 0};
+    cli_args a = {NULL, NULL, 0, 0, 0, 0};
     int i, opts_done = 0;
 
     if (argc < 2)
@@ -458,6 +469,8 @@ int main(int argc, char **argv)
             a.csv = 1;
         } else if (!opts_done && !strcmp(s, "--table")) {
             a.table = 1;
+        } else if (!opts_done && !strcmp(s, "--critical-csv")) {
+            a.critical_csv = 1;
         } else if (!opts_done && !strcmp(s, "--pretty")) {
             a.pretty = 1;
         } else if (!opts_done && s[0] == '-' && s[1] != '\0') {
@@ -479,9 +492,9 @@ int main(int argc, char **argv)
         return cli_usage("a command is required");
     if (!a.path)
         return cli_usage("a request file (or - for standard input) is required");
-    if ((a.csv || a.table) && strcmp(a.command, "solve"))
-        return cli_usage("--csv and --table apply to solve only");
-    if (a.csv && a.table)
-        return cli_usage("give --csv or --table, not both");
+    if ((a.csv || a.table || a.critical_csv) && strcmp(a.command, "solve"))
+        return cli_usage("--csv, --table and --critical-csv apply to solve only");
+    if (a.csv + a.table + a.critical_csv > 1)
+        return cli_usage("give one of --csv, --table and --critical-csv");
     return cli_run(&a);
 }

@@ -228,7 +228,8 @@ int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
 
 /**
  * Encode the frequency table as CSV (header omega,mode,frequency_rad_s,
- * frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm; one row
+ * frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm,label,
+ * label_confidence,tracked_index,tracking_flag (DESIGN.md 9.1); one row
  * per speed and mode, one row with empty mode fields for a speed without
  * modes).  r (may be NULL: rpm from omega) gives the rpm of each case.
  * *out receives a malloc'd NUL-terminated string (free), *len its length
@@ -248,6 +249,16 @@ int codec_result_csv(char **out, size_t *len, const codec_request *r, const sm_r
  */
 int codec_result_spanwise(char **out, size_t *len, const json_t *result, int bmodes,
                           char *err, size_t errcap);
+
+/**
+ * The critical speeds of a result document (its "critical_speeds", DESIGN.md 9.1) as CSV:
+ * header order,tracked_index,label,label_confidence,omega,rpm,frequency_rad_s,frequency_hz,
+ * refined,omega_interpolated; one row per critical speed (just the header when the document
+ * has none).  Works on a stored document, so the daemon can serve it without solving again.
+ * result is borrowed; *out receives a malloc'd NUL-terminated string (free), *len its length
+ * (len may be NULL).  Returns SM_OK or SM_NOMEM.
+ */
+int codec_critical_speeds_csv(char **out, size_t *len, const json_t *result);
 
 /* --------------------------------------------------- problem (problem.c) */
 

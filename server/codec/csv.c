@@ -8,9 +8,12 @@
  * full precision (%.17g); a value that is not finite is an empty field.
  * The columns per_rev (frequency / omega, empty at rest) and rpm (the
  * case's speed in rev/min, DESIGN.md 8) come last, after the columns of
- * before, so a reader that takes columns by position still works.
- * With an error estimate (DESIGN.md 9) a last column error_estimate_rad_s
- * follows; without one the table is as before.
+ * before, so a reader that takes columns by position still works; the
+ * columns label, label_confidence, tracked_index, tracking_flag (DESIGN.md
+ * 9.1) follow them for the same reason.  codec_critical_speeds_csv writes
+ * the critical speeds of a result document as a second table.  With an
+ * error estimate (DESIGN.md 9) a last column error_estimate_rad_s follows;
+ * without one the table is as before.
  */
 #include "codec_internal.h"
 
@@ -25,15 +28,38 @@ static void csv_num(FILE *f, double x)
         fprintf(f, "%.17g", x);
 }
 
-/* The columns after status: per_rev (frequency / omega, empty at rest) and rpm; the line
- * ends unless est (a table with error estimates), which adds the last column. */
-static void csv_tail(FILE *f, double freq, double omega, double rpm, int est, double err)
+/* The columns after status: per_rev (frequency / omega, empty at rest) and rpm. */
+static void csv_tail(FILE *f, double freq, double omega, double rpm)
 {
     fputc(',', f);
     if (omega > 0)
         csv_num(f, freq / omega);
     fputc(',', f);
     csv_num(f, rpm);
+}
+
+/* The columns after rpm (DESIGN.md 9.1): label, label_confidence, tracked_index (0-based, as
+ * in the JSON), tracking_flag; empty where the case has none (k < 0: a row without a mode). */
+static void csv_trust(FILE *f, const sm_case *c, int k)
+{
+    char lab[32];
+    int flag = k >= 0 && c->track_flag ? c->track_flag[k] : 0;
+
+    if (k >= 0 && c->label_kind) {
+        fprintf(f, ",%s,", sm_mode_label(c->label_kind[k], c->label_ordinal[k], lab, sizeof(lab)));
+        csv_num(f, c->label_confidence[k]);
+    } else {
+        fputs(",,", f);
+    }
+    fputc(',', f);
+    if (k >= 0 && c->tracked_index)
+        fprintf(f, "%d", c->tracked_index[k]);
+    fprintf(f, ",%s", flag == SM_TRACK_CROSSING ? "crossing" : flag == SM_TRACK_VEERING ? "veering" : "");
+}
+
+/* The end of a row: the error estimate when the table has that column (est), the newline. */
+static void csv_est(FILE *f, int est, double err)
+{
     if (est) {
         fputc(',', f);
         csv_num(f, err);
@@ -64,7 +90,7 @@ int codec_result_csv(char **out, size_t *len, const codec_request *r, const sm_r
     if (r)
         rpm = codec_request_rpm(r, &n_rpm);
     fputs("omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,"
-          "per_rev,rpm", f);
+          "per_rev,rpm,label,label_confidence,tracked_index,tracking_flag", f);
     fputs(est ? ",error_estimate_rad_s\n" : "\n", f);
     for (i = 0; i < res->n_cases; i++) {
         const sm_case *c = &res->cases[i];
@@ -73,7 +99,9 @@ int codec_result_csv(char **out, size_t *len, const codec_request *r, const sm_r
         if (c->n_modes == 0) {
             csv_num(f, c->omega);
             fprintf(f, ",,,,,,,%s", st);
-            csv_tail(f, NAN, 0, case_rpm, est, NAN);
+            csv_tail(f, NAN, 0, case_rpm);
+            csv_trust(f, c, -1);
+            csv_est(f, est, NAN);
         }
         for (k = 0; k < c->n_modes; k++) {
             double mac = c->mac_to_previous ? c->mac_to_previous[k] : -1;
@@ -90,9 +118,64 @@ int codec_result_csv(char **out, size_t *len, const codec_request *r, const sm_r
             if (mac >= 0)
                 csv_num(f, mac);
             fprintf(f, ",%s", st);
-            csv_tail(f, c->frequency[k], c->omega, case_rpm, est,
-                     c->error_estimate ? c->error_estimate[k] : NAN);
+            csv_tail(f, c->frequency[k], c->omega, case_rpm);
+            csv_trust(f, c, k);
+            csv_est(f, est, c->error_estimate ? c->error_estimate[k] : NAN);
         }
+    }
+    if (ferror(f)) {
+        fclose(f);
+        free(buf);
+        return SM_NOMEM;
+    }
+    if (fclose(f)) {
+        free(buf);
+        return SM_NOMEM;
+    }
+    *out = buf;
+    if (len)
+        *len = n;
+    return SM_OK;
+}
+
+/* A number of a JSON object o[key] for the CSV, empty when absent or null. */
+static void csv_json_num(FILE *f, const json_t *o, const char *key)
+{
+    const json_t *x = json_object_get(o, key);
+    if (json_is_number(x))
+        csv_num(f, json_number_value(x));
+}
+
+int codec_critical_speeds_csv(char **out, size_t *len, const json_t *result)
+{
+    char *buf = NULL;
+    size_t n = 0, i;
+    FILE *f = open_memstream(&buf, &n);
+    const json_t *cs = json_object_get(result, "critical_speeds"), *c;
+
+    *out = NULL;
+    if (!f)
+        return SM_NOMEM;
+    fputs("order,tracked_index,label,label_confidence,omega,rpm,frequency_rad_s,frequency_hz,"
+          "refined,omega_interpolated\n", f);
+    json_array_foreach(cs, i, c) {
+        const char *lab = json_string_value(json_object_get(c, "label"));
+        csv_json_num(f, c, "order");
+        fputc(',', f);
+        csv_json_num(f, c, "tracked_index");
+        fprintf(f, ",%s,", lab ? lab : "");
+        csv_json_num(f, c, "label_confidence");
+        fputc(',', f);
+        csv_json_num(f, c, "omega");
+        fputc(',', f);
+        csv_json_num(f, c, "rpm");
+        fputc(',', f);
+        csv_json_num(f, c, "frequency_rad_s");
+        fputc(',', f);
+        csv_json_num(f, c, "frequency_hz");
+        fprintf(f, ",%s,", json_is_true(json_object_get(c, "refined")) ? "true" : "false");
+        csv_json_num(f, c, "omega_interpolated");
+        fputc('\n', f);
     }
     if (ferror(f)) {
         fclose(f);

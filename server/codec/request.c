@@ -249,6 +249,18 @@ static int req_build_structure(codec_request *r)
     return req_build_stations(r, mems);
 }
 
+/* sm_options.engine_orders from the canonical analysis.engine_orders (DESIGN.md 9.1). */
+static void req_engine_orders(sm_options *o, const json_t *eo)
+{
+    size_t i;
+    const json_t *x;
+
+    o->n_engine_orders = 0;
+    json_array_foreach(eo, i, x)
+        if (i < SM_MAX_ENGINE_ORDERS)
+            o->engine_orders[o->n_engine_orders++] = json_number_value(x);
+}
+
 /* sm_options and speeds from frames and analysis. */
 static int req_build_options(codec_request *r)
 {
@@ -278,6 +290,7 @@ static int req_build_options(codec_request *r)
     r->opt.geometric_stiffening = json_is_true(json_object_get(an, "geometric_stiffening"));
     r->opt.coriolis = json_is_true(json_object_get(an, "coriolis"));
     r->opt.mode_shapes = json_is_true(json_object_get(an, "mode_shapes"));
+    req_engine_orders(&r->opt, json_object_get(an, "engine_orders"));
 
     r->speeds = malloc(n * sizeof(double));
     r->rpm = malloc(n * sizeof(double));

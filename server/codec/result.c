@@ -24,6 +24,10 @@
  * Error estimate (DESIGN.md 9, analysis.error_estimate): each mode ends
  * with "error_estimate" (rad/s, null where no mode of the refined levels
  * matched); without the option the key is absent and the bytes unchanged.
+ * Trust (DESIGN.md 9.1): each mode then ends with "label", "label_confidence",
+ * "energy", "tracked_index", "tracking_flag", "tracking_partner", and the
+ * document with "critical_speeds" when the request gives engine_orders;
+ * appended likewise (frequencies and shapes are unchanged).
  */
 #include "codec_internal.h"
 
@@ -137,6 +141,51 @@ static json_t *res_per_rev(double f, double omega)
     return omega > 0 ? res_real(f / omega) : json_null();
 }
 
+/* {"axial", "edge", "flap", "torsion"} (planar: {"axial", "bending"}) from 4 fractions. */
+static json_t *res_parts(const double *f, int spatial)
+{
+    if (!spatial)
+        return json_pack("{s:o, s:o}", "axial", res_real(f[0]), "bending", res_real(f[1]));
+    return json_pack("{s:o, s:o, s:o, s:o}", "axial", res_real(f[0]), "edge", res_real(f[1]),
+                     "flap", res_real(f[2]), "torsion", res_real(f[3]));
+}
+
+/*
+ * DESIGN.md 9.1, appended to mode k: "label", "label_confidence", "energy" {"kinetic",
+ * "strain"}, "tracked_index", "tracking_flag" ("crossing", "veering" or null) and
+ * "tracking_partner" (the other tracked index of the flagged pair, or null).  Nothing for a
+ * case the core gave no labels (hand-built results).  Returns 0, or -1 out of memory.
+ */
+static int res_trust(json_t *md, const sm_case *c, int k)
+{
+    char lab[32];
+    int spatial = res_node_dof(c) == 6, flag;
+    const double *f;
+
+    if (c->label_kind && c->energy) {
+        f = c->energy + (size_t)k * SM_ENERGY_PARTS;
+        sm_mode_label(c->label_kind[k], c->label_ordinal[k], lab, sizeof(lab));
+        if (json_object_set_new(md, "label", json_string(lab)) ||
+            json_object_set_new(md, "label_confidence", res_real(c->label_confidence[k])) ||
+            json_object_set_new(md, "energy", json_pack("{s:o, s:o}", "kinetic",
+                                                        res_parts(f, spatial), "strain",
+                                                        res_parts(f + 4, spatial))))
+            return -1;
+    }
+    if (c->tracked_index) {
+        flag = c->track_flag[k];
+        if (json_object_set_new(md, "tracked_index", json_integer(c->tracked_index[k])) ||
+            json_object_set_new(md, "tracking_flag",
+                                flag == SM_TRACK_CROSSING  ? json_string("crossing")
+                                : flag == SM_TRACK_VEERING ? json_string("veering")
+                                                           : json_null()) ||
+            json_object_set_new(md, "tracking_partner",
+                                flag ? json_integer(c->track_partner[k]) : json_null()))
+            return -1;
+    }
+    return 0;
+}
+
 /* One mode of a case. */
 static json_t *res_mode(const sm_case *c, int k, int shapes)
 {
@@ -166,7 +215,8 @@ static json_t *res_mode(const sm_case *c, int k, int shapes)
             json_object_set_new(shape, "im", res_rows(c->shape_im + k * stride, c->n_nodes, dof)))
             goto fail;
     }
-    if (json_object_set_new(md, "per_rev", res_per_rev(c->frequency[k], c->omega)))
+    if (json_object_set_new(md, "per_rev", res_per_rev(c->frequency[k], c->omega)) ||
+        res_trust(md, c, k))
         goto fail;
     if (c->error_estimate &&
         json_object_set_new(md, "error_estimate", res_real(c->error_estimate[k])))
@@ -305,6 +355,40 @@ fail:
     return NULL;
 }
 
+/* One critical speed (DESIGN.md 9.1). */
+static json_t *res_critical(const sm_critical *c)
+{
+    char lab[32];
+
+    sm_mode_label(c->label_kind, c->label_ordinal, lab, sizeof(lab));
+    return json_pack("{s:o, s:i, s:s, s:o, s:o, s:o, s:o, s:o, s:b, s:i, s:o, s:o, s:[o, o]}",
+                     "order", res_real(c->order), "tracked_index", c->tracked_index, "label", lab,
+                     "label_confidence", res_real(c->label_confidence), "omega",
+                     res_real(c->omega), "rpm", res_real(c->omega * 60 / CODEC_TWO_PI),
+                     "frequency_rad_s", res_real(c->frequency), "frequency_hz",
+                     res_real(c->frequency / CODEC_TWO_PI), "refined", c->refined,
+                     "refine_solves", c->iterations, "residual", res_real(c->residual),
+                     "omega_interpolated", res_real(c->omega_interpolated), "bracket",
+                     res_real(c->omega_below), res_real(c->omega_above));
+}
+
+/* The document's "critical_speeds" (only when the request gives engine_orders). */
+static int res_critical_speeds(json_t *doc, const codec_request *r, const sm_result *res)
+{
+    json_t *a;
+    int i;
+
+    if (codec_request_options(r)->n_engine_orders <= 0)
+        return 0;
+    a = json_array();
+    if (json_object_set_new(doc, "critical_speeds", a))
+        return -1;
+    for (i = 0; i < res->n_critical; i++)
+        if (json_array_append_new(a, res_critical(&res->critical[i])))
+            return -1;
+    return 0;
+}
+
 int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
                         const sm_result *res)
 {
@@ -343,6 +427,8 @@ int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
         goto fail;
     if (json_array_size(warnings) &&
         json_object_set_new(doc, "input_warnings", json_deep_copy(warnings)))
+        goto fail;
+    if (res_critical_speeds(doc, r, res))
         goto fail;
     *out = doc;
     return SM_OK;

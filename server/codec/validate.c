@@ -652,12 +652,57 @@ static void val_error_estimate(val_ctx *v, const json_t *an, json_t *can)
     field_set(v, can, "error_estimate", json_true());
 }
 
+/*
+ * analysis.engine_orders (DESIGN.md 9.1): 1..SM_MAX_ENGINE_ORDERS distinct positive numbers
+ * (n of w = n Omega, at most 1000), each checked at /analysis/engine_orders/<i>.  Written to
+ * the canonical request only when given, so a request without it keeps its job id.
+ */
+static void val_engine_orders(val_ctx *v, const json_t *an, json_t *can)
+{
+    const json_t *eo = json_object_get(an, "engine_orders"), *x;
+    char ptr[64];
+    double d[SM_MAX_ENGINE_ORDERS];
+    size_t i, j;
+    json_t *c;
+
+    if (!eo)
+        return;
+    if (!json_is_array(eo) || json_array_size(eo) == 0 ||
+        json_array_size(eo) > SM_MAX_ENGINE_ORDERS) {
+        field_error(v, "/analysis/engine_orders",
+                    "must be a list of 1 to %d engine orders (n of w = n Omega, e.g. [1, 2, 3, 4])",
+                    SM_MAX_ENGINE_ORDERS);
+        return;
+    }
+    c = json_array();
+    if (!c) {
+        v->nomem = 1;
+        return;
+    }
+    json_array_foreach(eo, i, x) {
+        snprintf(ptr, sizeof(ptr), "/analysis/engine_orders/%zu", i);
+        if (!field_check_real(v, x, ptr, FIELD_POSITIVE, "", &d[i]))
+            continue;
+        if (d[i] > 1000) {
+            field_error(v, ptr, "an engine order above 1000 (%g) is not a rotor harmonic", d[i]);
+            continue;
+        }
+        for (j = 0; j < i; j++)
+            if (d[j] == d[i])
+                field_error(v, ptr, "engine order %g is given twice", d[i]);
+        if (json_array_append_new(c, json_real(d[i])))
+            v->nomem = 1;
+    }
+    field_set(v, can, "engine_orders", c);
+}
+
 /* The analysis object: omega or rpm (speeds.c), modes and the options, with their defaults. */
 static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
 {
     static const char *const keys[] = {"omega", "rpm", "modes", "geometric_stiffening", "coriolis",
                                        "mass", "substructure_modes", "modes_per_frame",
-                                       "mode_shapes", "error_estimate", NULL};
+                                       "mode_shapes", "error_estimate", "engine_orders",
+                                       NULL};
     static const char *const mass[] = {"lumped", "consistent", NULL};
     static const char *const basis[] = {"augmented", "paper", NULL};
     static const char *base = "/analysis";
@@ -696,6 +741,7 @@ static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
                     json_is_string(mpf) ? "another string" : field_type_name(mpf));
     field_bool(v, an, "mode_shapes", base, can, 1);
     val_error_estimate(v, an, can);
+    val_engine_orders(v, an, can);
     field_set(v, canon, "analysis", can);
 }
 

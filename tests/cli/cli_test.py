@@ -198,11 +198,14 @@ def t_csv(tmp):
     lines = out.splitlines()
     check(rc == 0, "csv: exit 0 (got %d; %.200s)" % (rc, err))
     check(lines[:1] == ["omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,"
-                        "per_rev,rpm"],
+                        "per_rev,rpm,label,label_confidence,tracked_index,tracking_flag"],
           "csv: header")
     check(len(lines) == 1 + 3 * 4, "csv: 12 rows for 3 speeds x 4 modes (got %d)" % (len(lines) - 1))
     rows = [l.split(",") for l in lines[1:]]
-    check(all(len(r) == 10 for r in rows), "csv: 10 fields per row")
+    check(all(len(r) == 14 for r in rows), "csv: 14 fields per row")
+    check(all(r[10] == "%d%s bending" % (int(r[1]), {1: "st", 2: "nd", 3: "rd"}.get(int(r[1]), "th"))
+              and float(r[11]) > 0.9 and r[12] == str(int(r[1]) - 1) and r[13] == "" for r in rows),
+          "csv: the cantilever's modes are 1st..4th bending, tracked on lines 0..3, no flags")
     check(rows and rows[0][1] == "1" and rows[0][6] == "" and rows[-1][6] != "",
           "csv: modes numbered from 1, MAC empty at the first speed only")
     rc, out, err = run(["solve", "--csv", write_request(tmp, "angled.json", angled_beam(20, "single"))])
@@ -299,7 +302,7 @@ def t_spatial(tmp):
               "spatial %s: in-plane frequencies are the planar ones to 1e-7 (%s vs %s)" % (what, got, want))
         rc, csv, err = run(["solve", "--csv", path])
         lines = csv.splitlines()
-        check(rc == 0 and lines[0] == "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm"
+        check(rc == 0 and lines[0] == "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm,label,label_confidence,tracked_index,tracking_flag"
               and len(lines) == 17, "spatial %s: CSV header and one row per mode (%d lines)" % (what, len(lines)))
     # validate: the canonical form writes the spatial defaults out
     rc, out, err = run(["validate", write_request(tmp, "spatial.json", blade(variants[0][1], 4))])
@@ -335,10 +338,14 @@ def t_blade(tmp):
     rc, out, err = run(["solve", "--table", example])
     lines = out.splitlines()
     check(rc == 0 and lines and lines[0].split() == ["omega_rad_s", "rpm", "mode", "freq_rad_s", "freq_hz",
-                                                     "per_rev", "status"],
+                                                     "per_rev", "status", "label"],
           "blade --table: header (%s)" % lines[:1])
     rows = [l.split() for l in lines[1:]]
-    check(len(rows) == 5 * 4 and all(len(r) == 7 for r in rows), "blade --table: 20 rows of 7 cells")
+    check(len(rows) == 5 * 4 and all(len(r) in (8, 9) for r in rows),
+          "blade --table: 20 rows of 7 cells and a label (\"coupled\" or \"1st flap\")")
+    labels = [" ".join(r[7:]) for r in rows]
+    jl = [m.get("label") for c in res["cases"] for m in c["modes"]]
+    check(labels == jl, "blade --table: the label column is the JSON's (%s)" % labels[:4])
     check(len(set(len(l) for l in lines)) == 1, "blade --table: every line equally long (aligned)")
     for col, dec in ((0, 4), (1, 2), (3, 6), (4, 6), (5, 4)):
         cells = [r[col] for r in rows if r[col] != "-"]
@@ -369,8 +376,10 @@ def t_blade(tmp):
 
 # The keys of a mode and the CSV header without analysis.error_estimate (as before it existed).
 MODE_KEYS = ["frequency_rad_s", "frequency_hz", "eigenvalue", "mac_to_previous", "previous_index",
-             "shape", "per_rev"]
-CSV_HEADER = "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm"
+             "shape", "per_rev", "label", "label_confidence", "energy", "tracked_index",
+             "tracking_flag", "tracking_partner"]
+CSV_HEADER = ("omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm,"
+              "label,label_confidence,tracked_index,tracking_flag")
 
 
 def t_error_estimate(tmp):
@@ -426,6 +435,60 @@ def t_error_estimate(tmp):
     check(rc == 0 and out.count("+/-") == 3, "error_estimate true: --table prints +/- per mode")
 
 
+def t_trust(tmp):
+    """(h) DESIGN.md 9.1: the straight blade (EI_edge = 4 EI_flap) swept 0..12 rad/s with
+    engine_orders [1, 2]: modes carry labels, tracked indices and the flap/edge crossing flag;
+    critical_speeds in the JSON (rad/s and rpm, label) equal the --critical-csv rows; a solve at
+    the reported 1P speed of the 1st edge mode gives w = Omega to 1e-6; bad engine orders are
+    422s with their pointers; a request without engine_orders has no critical_speeds key."""
+    req = {"blade": {"length": 31.623, "elements": 24,
+                     "section": {"EA": 1e14, "EI_flap": 1e8, "EI_edge": 4e8, "GJ": 1e8, "mass_per_length": 100,
+                                 "flap_inertia": 1e-3, "edge_inertia": 1e-3}},
+           "analysis": {"omega": {"from": 0, "to": 12, "steps": 12}, "modes": 4, "mode_shapes": False,
+                        "engine_orders": [1, 2]}}
+    path = write_request(tmp, "trust.json", req)
+    rc, out, err = run(["solve", path])
+    check(rc == 0, "trust: solves (exit %d; %.200s)" % (rc, err))
+    res = json.loads(out) if rc == 0 else {"cases": [], "critical_speeds": []}
+    keys = list(res["cases"][0]["modes"][0]) if res["cases"] else []
+    check(keys[-6:] == ["label", "label_confidence", "energy", "tracked_index", "tracking_flag", "tracking_partner"]
+          and keys[:6] == ["frequency_rad_s", "frequency_hz", "eigenvalue", "mac_to_previous", "previous_index",
+                           "per_rev"], "trust: new mode keys appended after the old ones (%s)" % keys)
+    check(list(res)[-1] == "critical_speeds", "trust: critical_speeds last in the document (%s)" % list(res))
+    first = [m["label"] for m in res["cases"][0]["modes"]]
+    check(first == ["1st flap", "1st edge", "2nd flap", "2nd edge"], "trust: labels at rest (%s)" % first)
+    flags = [(c["omega"], m["label"], m["tracking_flag"]) for c in res["cases"] for m in c["modes"] if m["tracking_flag"]]
+    check(len(flags) == 2 and all(f[2] == "crossing" for f in flags), "trust: one flap/edge crossing (%s)" % flags)
+    crit = res.get("critical_speeds", [])
+    e1 = [c for c in crit if c["order"] == 1 and c["label"] == "1st edge"]
+    check(len(e1) == 1 and e1[0]["refined"] and abs(e1[0]["rpm"] - e1[0]["omega"] * 60 / (2 * math.pi)) < 1e-9,
+          "trust: 1P crossing of the 1st edge mode, refined, rpm = omega 60/2pi (%s)" % e1)
+    rc, out, err = run(["solve", "--critical-csv", path])
+    lines = out.splitlines()
+    check(rc == 0 and lines[0] == "order,tracked_index,label,label_confidence,omega,rpm,frequency_rad_s,frequency_hz,"
+          "refined,omega_interpolated" and len(lines) == 1 + len(crit), "trust --critical-csv: header + %d rows (%s)"
+          % (len(crit), lines[:2]))
+    rows = [l.split(",") for l in lines[1:]]
+    check(all(float(r[4]) == c["omega"] and r[2] == c["label"] for r, c in zip(rows, crit)),
+          "trust --critical-csv: the rows are the JSON's critical speeds")
+    if e1:
+        one = json.loads(json.dumps(req))
+        one["analysis"] = {"omega": e1[0]["omega"], "modes": 4, "mode_shapes": False}
+        rc, out, err = run(["solve", write_request(tmp, "one.json", one)])
+        doc = json.loads(out) if rc == 0 else {"cases": [{"modes": []}]}
+        w = [m["frequency_rad_s"] for m in doc["cases"][0]["modes"] if m.get("label") == "1st edge"]
+        check(len(w) == 1 and abs(w[0] / e1[0]["omega"] - 1) < 1e-6,
+              "trust: independent solve at Omega* = %.10f: w_1E = %s (1e-6)" % (e1[0]["omega"], w))
+        check("critical_speeds" not in doc, "trust: no engine_orders, no critical_speeds key")
+    for bad, ptr in (([0], "/analysis/engine_orders/0"), ([1, "x"], "/analysis/engine_orders/1"),
+                     ([2, 2], "/analysis/engine_orders/1"), ([], "/analysis/engine_orders"),
+                     (list(range(1, 18)), "/analysis/engine_orders")):
+        r2 = json.loads(json.dumps(req))
+        r2["analysis"]["engine_orders"] = bad
+        rc, out, err = run(["validate", write_request(tmp, "bad.json", r2)])
+        check(rc == 2 and ptr in err, "trust: engine_orders %s is a 422 at %s (exit %d)" % (str(bad)[:20], ptr, rc))
+
+
 SCENARIOS = {
     "cantilever": t_cantilever,
     "invalid": t_invalid,
@@ -436,6 +499,7 @@ SCENARIOS = {
     "spatial": t_spatial,
     "blade": t_blade,
     "error_estimate": t_error_estimate,
+    "trust": t_trust,
 }
 
 

@@ -162,7 +162,7 @@ def scenario_solve(d):
 
     text = c.csv(st["id"])
     lines = text.strip().split("\n")
-    check(lines[0] == "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm",
+    check(lines[0] == "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm,label,label_confidence,tracked_index,tracking_flag",
           "csv(): header")
     check(len(lines) == 4, "csv(): 3 rows (%d)" % (len(lines) - 1))
     row = lines[1].split(",")
@@ -435,7 +435,7 @@ def scenario_python_cli(d):
                          timeout=B(120), env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
     lines = p.stdout.splitlines()
     check(p.returncode == 0 and lines and lines[0].split() == ["omega_rad_s", "rpm", "mode", "freq_rad_s",
-                                                               "freq_hz", "per_rev", "status"]
+                                                               "freq_hz", "per_rev", "status", "label"]
           and len(set(len(l) for l in lines)) == 1,
           "solve --table: header, aligned rows (%d) %s" % (p.returncode, p.stderr[-200:]))
     check(p.stdout == cli.stdout, "solve --table: the same table as `spinmodal solve --table`:\n%s\n%s"

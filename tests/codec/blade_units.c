@@ -37,13 +37,14 @@ static void blade_check_csv(test_case *tc, const json_t *cases, char *csv)
     size_t i, k;
 
     if (!line || strcmp(line, "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,"
-                              "mac_to_previous,status,per_rev,rpm"))
+                              "mac_to_previous,status,per_rev,rpm,label,label_confidence,"
+                              "tracked_index,tracking_flag"))
         fail(tc, "blade CSV header '%s'", line ? line : "(none)");
     json_array_foreach(cases, i, c) {
         json_array_foreach(json_object_get(c, "modes"), k, m) {
             const json_t *pr = json_object_get(m, "per_rev");
             line = strtok(NULL, "\n");
-            if (!line || blade_csv_fields(line, f) != 10) {
+            if (!line || blade_csv_fields(line, f) != 10) { /* 10 or more: the first 10 */
                 fail(tc, "blade CSV: row of case %zu mode %zu missing or short", i, k);
                 return;
             }

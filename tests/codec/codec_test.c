@@ -697,16 +697,20 @@ static void unit_csv(test_case *tc)
     double freq[2] = {3.5, 20}, re[2] = {0, 0}, im[2] = {3.5, 20}, mac[2] = {-1, -1};
     int prev[2] = {-1, -1};
     sm_case cases[2];
-    sm_result res = {2, cases};
+    sm_result res = {2, cases, 0, NULL};
     char *csv = NULL;
     size_t len = 0;
     /* per_rev is empty at rest; rpm = omega 60 / (2 pi) without a request */
+    /* DESIGN.md 9.1 columns: label, confidence, tracked index, flag; empty without a mode */
+    int kind[2] = {SM_MODE_FLAP, SM_MODE_EDGE}, ord[2] = {1, 2}, track[2] = {0, 3};
+    int flag[2] = {0, SM_TRACK_VEERING}, partner[2] = {-1, 0};
+    double conf[2] = {0.5, 0.75};
     const char *want =
         "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,"
-        "rpm\n"
-        "0,1,3.5,0.55704230082163375,0,3.5,,solved,,0\n"
-        "0,2,20,3.183098861837907,0,20,,solved,,0\n"
-        "20,,,,,,,no_equilibrium,,190.9859317102744\n";
+        "rpm,label,label_confidence,tracked_index,tracking_flag\n"
+        "0,1,3.5,0.55704230082163375,0,3.5,,solved,,0,1st flap,0.5,0,\n"
+        "0,2,20,3.183098861837907,0,20,,solved,,0,2nd edge,0.75,3,veering\n"
+        "20,,,,,,,no_equilibrium,,190.9859317102744,,,,\n";
 
     memset(cases, 0, sizeof(cases));
     cases[0].status = SM_CASE_SOLVED;
@@ -716,6 +720,12 @@ static void unit_csv(test_case *tc)
     cases[0].eig_im = im;
     cases[0].mac_to_previous = mac;
     cases[0].previous_index = prev;
+    cases[0].label_kind = kind;
+    cases[0].label_ordinal = ord;
+    cases[0].label_confidence = conf;
+    cases[0].tracked_index = track;
+    cases[0].track_flag = flag;
+    cases[0].track_partner = partner;
     cases[1].omega = 20;
     cases[1].status = SM_CASE_NO_EQUILIBRIUM;
     if (codec_result_csv(&csv, &len, NULL, &res) != SM_OK || strcmp(csv, want) || len != strlen(want))

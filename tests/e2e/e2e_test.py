@@ -55,7 +55,7 @@ DONE_TIMEOUT = 120.0
 ID_RE = re.compile(r"^[0-9a-f]{64}$")
 TS_RE = re.compile(r"^\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{3}Z$")
 STATES = ("queued", "running", "done", "failed", "canceled")
-CSV_HEADER = "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm"
+CSV_HEADER = "omega,mode,frequency_rad_s,frequency_hz,eig_re,eig_im,mac_to_previous,status,per_rev,rpm,label,label_confidence,tracked_index,tracking_flag"
 
 
 # ------------------------------------------------------------------ checks
