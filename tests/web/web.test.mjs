@@ -348,8 +348,10 @@ async function flapMode(page, result) {
     `max |dz| ${dz}, max |dx, dy| ${dxy}`);
   await page.selectOption('#mode-speed', String(ci));
   await page.selectOption('#mode-index', '0');
-  ok(await waitFor(page, () => /^mode 1 at Ω = 0 rad\/s/.test(document.getElementById('mode-desc').textContent), null,
+  ok(await waitFor(page, () => /^mode 1( \([^)]*\))? at Ω = 0 rad\/s/.test(document.getElementById('mode-desc').textContent), null,
     'mode 1 at rest'), 'flapping-blade: mode 1 at 0 rad/s selected', await page.textContent('#mode-desc'));
+  ok((await page.textContent('#mode-desc')).startsWith(`mode 1 (${m.label}) at`) && m.label === '1st flap',
+    'flapping-blade: the mode description names the result\'s label (1st flap)', `${m.label}`);
   // frames of the animation as drawn, until the tip has been well out of the plane and has
   // travelled on the screen (a cycle takes 2 s; the budget allows for a slow machine)
   const seen = [];
@@ -832,7 +834,7 @@ async function run() {
     const c20 = result.cases.find((c) => c.omega === 20);
     const plotted = await page.evaluate(() => window.__spinmodal.campbell());
     const xi = plotted.x.indexOf(20);
-    const m1 = plotted.series.find((s) => s.label === 'mode 1');
+    const m1 = plotted.series.find((s) => s.label === 'mode 1' || s.label.startsWith('mode 1 ('));
     const f20 = m1 && xi >= 0 ? m1.values[xi] : NaN;
     const api20 = c20.modes[0].frequency_rad_s;
     console.log(`# Campbell mode 1 at 20 rad/s: plotted ${f20}, API ${api20}`);
