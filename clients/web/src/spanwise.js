@@ -150,7 +150,7 @@ function fmt(v) {
   return Number(v.toPrecision(3)).toString();
 }
 
-/** A range [lo, hi] holding 0 and every value, a little wider. */
+/** A range [lo, hi] holding 0 and every value, a little wider (0 strictly inside). */
 function range(vals) {
   let lo = Math.min(0, ...vals), hi = Math.max(0, ...vals);
   if (hi - lo < 1e-12) {
@@ -158,7 +158,19 @@ function range(vals) {
     hi = 1;
   }
   const pad = 0.06 * (hi - lo);
-  return [lo < 0 ? lo - pad : lo, hi > 0 ? hi + pad : hi];
+  return [lo - pad, hi + pad];
+}
+
+/** Widen the ranges so that 0 is at the same height on both axes (one zero line). */
+function alignZero(a, b) {
+  const below = (r) => -r[0] / (r[1] - r[0]);
+  const p = Math.max(below(a), below(b));
+  const q = Math.max(1 - below(a), 1 - below(b)); // the share above 0
+  const fit = (r) => {
+    const unit = Math.max(-r[0] / p, r[1] / q); // axis length per unit share
+    return [-p * unit, q * unit];
+  };
+  return [fit(a), fit(b)];
 }
 
 export const SPAN_SERIES = [
@@ -175,8 +187,7 @@ export function drawSpanwise(svg, pts) {
   svg.textContent = '';
   const W = 600, H = 200, L = 52, R = 56, T = 26, B = 34;
   const X = (x) => L + x * (W - L - R);
-  const dr = range(pts.flatMap((p) => [p.flap, p.edge]));
-  const tr = range(pts.map((p) => p.twist));
+  const [dr, tr] = alignZero(range(pts.flatMap((p) => [p.flap, p.edge])), range(pts.map((p) => p.twist)));
   const Y = (v, r) => T + (r[1] - v) / (r[1] - r[0]) * (H - T - B);
   const g = el('g', {class: 'sw-axes'}, svg);
   el('rect', {x: L, y: T, width: W - L - R, height: H - T - B, class: 'sw-frame'}, g);
@@ -190,8 +201,8 @@ export function drawSpanwise(svg, pts) {
     text(g, L - 5, Y(v, dr) + 4, fmt(v), 'sw-tick', 'end');
   }
   for (const v of ticks(tr[0], tr[1])) text(g, W - R + 5, Y(v, tr) + 4, fmt(v), 'sw-tick sw-twist-tick', 'start');
-  text(g, 12, (T + H - B) / 2, 'm', 'sw-title');
-  text(g, W - 10, (T + H - B) / 2, 'rad', 'sw-title sw-twist-tick');
+  text(g, L - 5, T - 8, 'm', 'sw-title', 'end');
+  text(g, W - R + 5, T - 8, 'rad', 'sw-title sw-twist-tick', 'start');
   let lx = L;
   for (const s of SPAN_SERIES) {
     const r = s.key === 'twist' ? tr : dr;
