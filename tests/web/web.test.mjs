@@ -561,7 +561,7 @@ async function flaggedSpeeds(page) {
  * is drawn, solves at its 60 rpm; a broken file names file, line and field;
  * a unit slip is a warning next to its field; speeds in rpm and as a range.
  */
-async function blades(page) {
+async function blades(page, base) {
   // a broken section file: the error names the file, line and field
   await page.click('#open-blade');
   await page.selectOption('#import-format', 'bmodes');
@@ -620,6 +620,7 @@ async function blades(page) {
       'the blade mode'), 'the blade\'s mode shape is animated on the expanded mesh (49 nodes)');
   }
   await shot(page, '15-bmodes-solved.png');
+  if (r) await spanwiseShapes(page, base, r);
 
   // a unit slip: a warning next to the field (not an error), from /v1/validate
   await page.fill('#blade-length', '33.25');
@@ -653,6 +654,97 @@ async function blades(page) {
   await page.selectOption('#speed-in-unit', 'rpm');
   an = await page.evaluate(() => window.__spinmodal.doc.analysis);
   ok(!('omega' in an) && Math.abs(an.rpm.to - 300) < 1e-9, 'and back to rpm', JSON.stringify(an.rpm));
+  await bmodesOwnMesh(page, bmi, sec);
+}
+
+const SPANWISE_HEADER = 'omega,rpm,mode,frequency_hz,per_rev,member,member_id,s,r_m,flap,flap_slope,edge,edge_slope,twist,axial';
+
+/**
+ * Span-wise mode shapes (DESIGN.md 8.3) of the solved Test01 blade: the two
+ * downloads are the daemon's ?format=spanwise|bmodes bytes, and the plot under
+ * the mode is the CSV's rows of the selected mode.
+ */
+async function spanwiseShapes(page, base, result) {
+  const id = await page.evaluate(() => window.__spinmodal.job.id);
+  const sw = await page.evaluate(() => window.__spinmodal.spanwise());
+  ok(sw.available && sw.buttons.every((b) => !b.disabled) && Array.isArray(result.model.members) &&
+    result.model.members.length === 1, 'a spatial result with shapes (model.members): the span-wise downloads are offered',
+  JSON.stringify(sw));
+  const csv = await downloadText(page, '#dl-spanwise');
+  const api = Buffer.from(await (await fetch(`${base}/v1/analyses/${id}/result?format=spanwise`)).arrayBuffer());
+  const lines = csv.text.trim().split('\n');
+  ok(lines[0] === SPANWISE_HEADER, 'the span-wise CSV has the header omega,rpm,mode,…,twist,axial', lines[0]);
+  ok(csv.buf.equals(api) && api.length > 0, 'the span-wise CSV download is the daemon\'s ?format=spanwise, byte for byte',
+    `${csv.buf.length} vs ${api.length} bytes`);
+  ok(lines.length === 1 + 20 * 49 && csv.name === `spinmodal-${id.slice(0, 12)}-spanwise.csv`,
+    'one row per mode and node (20 × 49), the file named from the job id', `${lines.length} lines, ${csv.name}`);
+  const bt = await downloadText(page, '#dl-bmodes');
+  const bapi = Buffer.from(await (await fetch(`${base}/v1/analyses/${id}/result?format=bmodes`)).arrayBuffer());
+  ok(bt.text.includes('span_loc\tflap disp') && bt.buf.equals(bapi) && bt.name === `spinmodal-${id.slice(0, 12)}-bmodes.txt`,
+    'the BModes-style table: "span_loc\\tflap disp" columns, the daemon\'s ?format=bmodes bytes', `${bt.name} ${bt.buf.length} bytes`);
+  // the plot under the mode: mode 1's points are the CSV's rows of mode 1 (span fraction s of the one member)
+  await page.selectOption('#mode-index', '0');
+  ok(await waitFor(page, () => {
+    const p = window.__spinmodal.spanwise().plot;
+    return p && p.mode === 1 && p.points.length === 49;
+  }, null, 'the span-wise plot of mode 1'), 'the span-wise plot shows mode 1 along the blade (49 nodes)');
+  const plot = (await page.evaluate(() => window.__spinmodal.spanwise())).plot;
+  const rows1 = lines.slice(1).map((l) => l.split(',')).filter((f) => f[2] === '1');
+  const tip = rows1[rows1.length - 1].map(Number);
+  const pt = plot.points[plot.points.length - 1];
+  ok(pt.x === 1 && pt.flap === tip[9] && pt.edge === tip[11] && pt.twist === tip[13] && Math.abs(tip[9]) === 1,
+    'the plotted tip of mode 1 is the CSV\'s (flap 1 m: the 1st flap mode scaled to 1 m)',
+    JSON.stringify({pt, tip: [tip[9], tip[11], tip[13]]}));
+  const drawn = await page.$$eval('#spanwise-svg polyline.sw-line', (ls) => ls.map((l) => [l.dataset.series,
+    l.getAttribute('points').split(' ').length]));
+  ok(JSON.stringify(drawn) === '[["flap",49],["edge",49],["twist",49]]', 'flap, edge and twist are drawn', JSON.stringify(drawn));
+  await page.locator('#results .downloads').scrollIntoViewIfNeeded();
+  await shot(page, '20-spanwise-controls.png');
+}
+
+/**
+ * "BModes' own mesh (reproduce BModes)" in the import dialog: ?bmodes_mesh=8
+ * gives BModes' 12 elements as uniform members in the structure form; it is
+ * loaded, drawn and solved, and its first frequency is BModes' published one.
+ */
+async function bmodesOwnMesh(page, bmi, sec) {
+  await page.click('#open-blade');
+  await page.selectOption('#import-format', 'bmodes');
+  ok(await page.isVisible('#import-bmodes-mesh') && await page.isDisabled('#import-bmodes-k') &&
+    await page.inputValue('#import-bmodes-k') === '8' && /element midpoints/.test(await page.textContent('#import-bmesh-hint')),
+  'the import dialog offers BModes\' own mesh (8 elements per BModes element by default), with its one-line explanation');
+  await page.check('#import-bmodes-mesh');
+  ok(!await page.isDisabled('#import-bmodes-k'), 'checking it enables the elements field');
+  await page.setInputFiles('#import-main', {name: 'Test01_nonunif_blade.bmi', mimeType: 'text/plain', buffer: bmi});
+  await page.setInputFiles('#import-sec', {name: 'blade_sec_props.dat', mimeType: 'text/plain', buffer: Buffer.from(sec)});
+  await shot(page, '21-import-bmodes-mesh.png');
+  await page.selectOption('#import-format', 'csv');
+  ok(!await page.isVisible('#import-bmodes-mesh'), 'the option is shown for BModes only');
+  await page.selectOption('#import-format', 'bmodes');
+  const [req] = await Promise.all([page.waitForRequest((q) => /\/v1\/import\/bmodes/.test(q.url())), page.click('#import-go')]);
+  ok(new URL(req.url()).searchParams.get('bmodes_mesh') === '8', 'the import sends ?bmodes_mesh=8', req.url());
+  ok(await waitFor(page, () => !document.getElementById('import-dialog').open && window.__spinmodal.doc.structure &&
+    (window.__spinmodal.doc.structure.members || []).length === 12, null, 'the BModes-mesh request'),
+  'BModes\' own mesh loads as a structure of 12 members');
+  const doc = await page.evaluate(() => window.__spinmodal.doc);
+  ok(!('blade' in doc) && doc.structure.members.every((m) => m.elements === 8) && doc.structure.clamp === 'root' &&
+    await page.locator('#members tbody tr').count() === 12 && await page.locator('#structure-svg line.member').count() === 12,
+  'the members table and the drawing show the 12 members (8 elements each)', JSON.stringify(doc.structure.members.map((m) => m.id)));
+  ok(/BModes' own mesh/.test(await page.textContent('#file-msg')), 'the file message says BModes\' own mesh',
+    await page.textContent('#file-msg'));
+  await page.click('#submit');
+  const done = await waitFor(page, () => document.body.dataset.jobState === 'done' && window.__spinmodal.result &&
+    (window.__spinmodal.result.model.members || []).length === 12, null, 'the BModes-mesh job', 180000);
+  const r = await page.evaluate(() => window.__spinmodal.result);
+  const f1 = done && r ? r.cases[0].modes[0].frequency_hz : NaN;
+  console.log(`# BModes' own mesh, Test01 at 60 rpm: f1 = ${f1} Hz (BModes 1.7517 Hz)`);
+  ok(done && r.model.nodes === 97 && Math.abs(f1 - 1.7517) <= 0.01 * 1.7517,
+    'solved: its first frequency is within 1 % of BModes\' published 1.7517 Hz (Test01 mode 1)', `${f1} Hz`);
+  ok(await waitFor(page, () => {
+    const p = window.__spinmodal.spanwise().plot;
+    return p && p.points.length === 97 && p.points[96].x === 1;
+  }, null, 'the span-wise plot of the 12 members'), 'the span-wise plot runs root → tip across the 12 members (97 nodes)');
+  await shot(page, '22-bmodes-mesh-solved.png');
 }
 
 /** A design is never lost: a reload keeps the request, a file saves and opens it, a past job reopens. */
@@ -886,6 +978,13 @@ async function run() {
     const [dj] = await Promise.all([page.waitForEvent('download'), page.click('#dl-json')]);
     const jdoc = JSON.parse(fs.readFileSync(await dj.path(), 'utf8'));
     ok(jdoc.cases && jdoc.cases.length === 11, 'JSON download is the result document');
+    // span-wise shapes: a planar result has none (the daemon answers 409): both downloads disabled, saying why
+    const sw0 = await page.evaluate(() => window.__spinmodal.spanwise());
+    ok(!sw0.available && sw0.buttons.every((b) => b.disabled && /planar result has no span-wise shapes/.test(b.title)) &&
+      await page.isDisabled('#dl-spanwise') && await page.isDisabled('#dl-bmodes') && sw0.plot === null &&
+      !await page.isVisible('#spanwise-box'),
+    'a planar result: "Span-wise shapes (CSV)" and "BModes-style table" disabled, the tooltip says why',
+    JSON.stringify(sw0));
     await unitsAndCampbell(page, result);
     await exportsAndCompare(page, result);
 
@@ -956,7 +1055,7 @@ async function run() {
     'and back: the planar section as it was, the hub-plane view', JSON.stringify(trunk));
 
     await spatial(page, base);
-    await blades(page);
+    await blades(page, base);
     await keepTheDesign(page, base);
 
     // without POST /v1/validate (an older daemon: 404), errors come from the submission

@@ -115,6 +115,28 @@ export async function getResult(id) {
   return ans.body;
 }
 
+/**
+ * GET /v1/analyses/{id}/result?format=F as a file: {ok: true, blob, type} with
+ * the daemon's bytes unchanged (its Content-Type), or {ok: false, status,
+ * message} (409 no-spanwise-shapes: a planar result or one without shapes).
+ */
+export async function getResultFile(id, format) {
+  const headers = {};
+  const tok = getToken();
+  if (tok) headers.Authorization = 'Bearer ' + tok;
+  const res = await fetch(resultUrl(id, format), {headers, cache: 'no-store'});
+  const type = res.headers.get('Content-Type') || 'application/octet-stream';
+  if (res.ok) return {ok: true, blob: await res.blob(), type};
+  const text = await res.text();
+  let b = null;
+  try {
+    b = /json/.test(type) ? JSON.parse(text) : null;
+  } catch {
+    b = null;
+  }
+  return {ok: false, status: res.status, message: (b && (b.detail || b.title)) || `HTTP ${res.status}`};
+}
+
 export function resultUrl(id, format) {
   return url(`v1/analyses/${encodeURIComponent(id)}/result` + (format ? `?format=${format}` : ''));
 }
@@ -129,7 +151,8 @@ export function warningsOf(doc) {
 
 /**
  * POST /v1/import/{format} (DAEMON.md, Importers): body {main, sec_props?, name}
- * (JSON, the files' texts), query tip_radius, hub_radius, rpm.  Returns
+ * (JSON, the files' texts), query tip_radius, hub_radius, rpm, bmodes_mesh
+ * (BModes' own mesh: the answer's request is then in the structure form).  Returns
  * {ok: true, request, warnings, source} or {ok: false, status, message, file,
  * line, field, errors}.
  */

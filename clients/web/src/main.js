@@ -17,6 +17,7 @@ import {campbellChart, parseOrders, freqIn, flaggedCase} from './campbell.js';
 import {exportSvg, svgToPng, campbellSvg, saveBlob} from './export.js';
 import {StructureEditor} from './editor.js';
 import {EXAMPLES} from './examples.js';
+import {spanwiseAvailability, parseSpanwise, bladeChain, spanPoints, drawSpanwise} from './spanwise.js';
 import * as api from './api.js';
 
 const $ = (id) => document.getElementById(id);
@@ -833,6 +834,8 @@ function showResult(id, request, result) {
   $('dl-csv').setAttribute('download', `spinmodal-${id.slice(0, 12)}.csv`);
   setBlobLink($('dl-json-req'), `spinmodal-${id.slice(0, 12)}-with-request.json`, 'application/json',
     JSON.stringify({request, result}, null, 1));
+  dlMsg('');
+  spanwiseControls();
   const rw = api.warningsOf(result);
   if (rw.length && JSON.stringify(request) === JSON.stringify(S.doc)) {
     const have = new Set(S.warnings.map((w) => w.pointer + '\n' + w.message));
@@ -1054,6 +1057,7 @@ function startMode() {
   if (!R || !R.mesh.ok || !c) {
     svg.textContent = '';
     desc.textContent = R && !R.mesh.ok ? `cannot draw: ${R.mesh.reason}` : '';
+    showSpanwisePlot();
     return;
   }
   buildModeView();
@@ -1071,6 +1075,7 @@ function startMode() {
   }
   svg.dataset.mode = String(k);
   svg.dataset.case = $('mode-speed').value;
+  showSpanwisePlot();
 }
 
 /** (Re)build the mode view of the selected case and mode, in the plane or in 3D, at the current phase. */
@@ -1233,10 +1238,13 @@ function importFormat() {
   const f = $('import-format').value;
   $('import-main-label').textContent = IMPORT_MAIN[f];
   $('import-sec-field').hidden = f !== 'bmodes';
+  $('import-bmesh-field').hidden = f !== 'bmodes';
+  $('import-bmodes-k').disabled = !$('import-bmodes-mesh').checked;
   $('import-tip').placeholder = f === 'bmodes' ? 'from the file' : 'required (m)';
   $('import-error').textContent = '';
 }
 $('import-format').addEventListener('change', importFormat);
+$('import-bmodes-mesh').addEventListener('change', importFormat);
 $('open-blade').addEventListener('click', () => {
   importFormat();
   $('import-dialog').showModal();
@@ -1260,6 +1268,16 @@ async function importBlade() {
   if (format === 'bmodes') body.sec_props = await readFile(sec);
   const q = {tip_radius: $('import-tip').value.trim(), hub_radius: $('import-hub').value.trim(),
     rpm: $('import-rpm').value.trim()};
+  const ownMesh = format === 'bmodes' && $('import-bmodes-mesh').checked;
+  if (ownMesh) {
+    // BModes' own model: its elements as uniform members, K FE elements each (DAEMON.md, Importers)
+    const k = $('import-bmodes-k').value.trim();
+    if (!/^\d+$/.test(k) || Number(k) < 1 || Number(k) > 1000) {
+      err.textContent = 'FE elements per BModes element: a whole number from 1 to 1000.';
+      return;
+    }
+    q.bmodes_mesh = k;
+  }
   let r;
   try {
     r = await api.importBlade(format, body, q);
@@ -1301,9 +1319,120 @@ async function importBlade() {
     li.textContent = 'no import warnings';
     ul.append(li);
   }
-  fileMsg(`imported ${main.name} (${format}): a blade of ${S.doc.blade && S.doc.blade.length} m — press Solve`, 'ok');
+  const st = S.doc.structure;
+  fileMsg(ownMesh && st && Array.isArray(st.members)
+    ? `imported ${main.name} (BModes' own mesh): ${st.members.length} members of ${q.bmodes_mesh} elements — press Solve`
+    : `imported ${main.name} (${format}): a blade of ${S.doc.blade && S.doc.blade.length} m — press Solve`, 'ok');
 }
 $('import-go').addEventListener('click', importBlade);
+
+// ------------------------------------------------------------ span-wise shapes
+
+const SHAPE_FILES = {
+  spanwise: {button: 'dl-spanwise', suffix: 'spanwise.csv', what: 'span-wise shapes',
+    title: 'Flap, edge, their slopes, twist and axial motion of every mode along each member, each mode scaled to ' +
+      '1 m at its largest (GET …/result?format=spanwise; DESIGN.md §8.3)'},
+  bmodes: {button: 'dl-bmodes', suffix: 'bmodes.txt', what: 'the BModes-style table',
+    title: 'The span-wise shapes in the layout of BModes\' .out: span_loc, flap disp, flap slope, lag disp, lag slope, ' +
+      'twist, with BModes\' signs (GET …/result?format=bmodes)'},
+};
+
+function dlMsg(text, cls = '') {
+  const m = $('dl-msg');
+  m.textContent = text;
+  m.className = 'dl-msg ' + cls;
+}
+
+/** Offer the span-wise downloads only for a result the daemon has them for (else disabled, saying why). */
+function spanwiseControls() {
+  const R = S.result;
+  const av = R ? spanwiseAvailability(R.id, R.result) : {ok: false, why: 'no result'};
+  for (const [, f] of Object.entries(SHAPE_FILES)) {
+    const b = $(f.button);
+    b.disabled = !av.ok || b.dataset.busy === '1';
+    b.title = av.ok ? f.title : av.why;
+  }
+  const wrap = $('spanwise-dl');
+  wrap.title = av.ok ? '' : av.why; // a disabled button shows no tooltip in some browsers: its wrapper does
+  wrap.dataset.available = av.ok ? 'yes' : 'no';
+  return av;
+}
+
+/** Fetch ?format=spanwise|bmodes from the daemon and save it as the daemon wrote it. */
+async function downloadShapes(format) {
+  const R = S.result;
+  const f = SHAPE_FILES[format];
+  if (!R || !spanwiseControls().ok) return;
+  const b = $(f.button);
+  b.dataset.busy = '1';
+  b.disabled = true;
+  dlMsg(`fetching ${f.what}…`);
+  let r;
+  try {
+    r = await api.getResultFile(R.id, format);
+  } catch (e) {
+    r = {ok: false, message: `cannot reach the daemon: ${e.message}`};
+  }
+  delete b.dataset.busy;
+  spanwiseControls();
+  if (!r.ok) {
+    dlMsg(`${f.what}: ${r.status ? r.status + ' ' : ''}${r.message}`, 'bad');
+    return;
+  }
+  const name = `spinmodal-${R.id.slice(0, 12)}-${f.suffix}`;
+  S.lastExport = {name, type: r.blob.type, size: r.blob.size};
+  saveBlob(r.blob, name);
+  dlMsg(`saved ${name} (your downloads)`, 'ok');
+}
+$('dl-spanwise').addEventListener('click', () => downloadShapes('spanwise'));
+$('dl-bmodes').addEventListener('click', () => downloadShapes('bmodes'));
+
+let spanSeq = 0;
+
+/**
+ * For a blade (members in one straight chain) with span-wise shapes: the
+ * selected mode's flap, edge and twist against the span fraction, from the
+ * daemon's span-wise CSV (fetched once per result).
+ */
+async function showSpanwisePlot() {
+  const seq = ++spanSeq;
+  const R = S.result;
+  const box = $('spanwise-box');
+  const c = selectedCase();
+  const k = Number($('mode-index').value) || 0;
+  const m = c && c.modes ? c.modes[k] : null;
+  const av = R ? spanwiseAvailability(R.id, R.result) : {ok: false};
+  const chain = av.ok ? bladeChain(R.result.model.members) : null;
+  S.spanPlot = null;
+  if (!chain || !m || !m.shape) {
+    box.hidden = true;
+    return;
+  }
+  if (!R.spanwise) {
+    R.spanwise = api.getResultFile(R.id, 'spanwise')
+      .then(async (r) => (r.ok ? {rows: parseSpanwise(await r.blob.text())} : {error: `${r.status} ${r.message}`}))
+      .catch((e) => ({error: e.message}));
+  }
+  const sw = await R.spanwise;
+  if (seq !== spanSeq) return; // another mode or result meanwhile
+  const cap = $('spanwise-cap');
+  box.hidden = false;
+  if (sw.error) {
+    $('spanwise-svg').textContent = '';
+    cap.textContent = `span-wise shapes: ${sw.error}`;
+    return;
+  }
+  const pts = spanPoints(sw.rows, chain, c.omega, k + 1);
+  if (!pts.length) {
+    box.hidden = true;
+    return;
+  }
+  const ranges = drawSpanwise($('spanwise-svg'), pts);
+  S.spanPlot = {omega: c.omega, mode: k + 1, points: pts, ranges};
+  cap.textContent = `Span-wise shape of mode ${k + 1} at Ω = ${speedText(c)}: flap (out of the rotor plane) and ` +
+    'edge (in it) in m, the mode scaled to 1 m at its largest; twist in rad on the right axis ' +
+    `(the span-wise CSV, ${chain.parts.length === 1 ? 'one member' : `${chain.parts.length} members`} root → tip).`;
+}
 
 // ------------------------------------------------------------ compare and export
 
@@ -1380,6 +1509,10 @@ window.__spinmodal = {
   modeSvg: () => modeExportSvg(),
   tableCsv: () => $('dl-csv-units').dataset.csv || '',
   lastExport: () => S.lastExport || null,
+  // the span-wise downloads ({available, why}) and the plotted span-wise shape ({omega, mode, points} or null)
+  spanwise: () => ({available: $('spanwise-dl').dataset.available === 'yes', why: $('spanwise-dl').title,
+    buttons: ['dl-spanwise', 'dl-bmodes'].map((id) => ({id, disabled: $(id).disabled, title: $(id).title})),
+    plot: S.spanPlot || null}),
   loadExample,
   loadDoc,
 };
