@@ -169,8 +169,9 @@ enum MHD_Result http_get_analysis(struct MHD_Connection *c, http_req *r)
 
 /*
  * The stored result document text[len] as span-wise shapes (codec_result_spanwise: bmodes 0
- * CSV, 1 the BModes-style table); takes text.  409 for a result without them (planar, or
- * without mode shapes).
+ * CSV, 1 the BModes-style table; 409 for a result without them: planar, or without mode
+ * shapes) or, bmodes 2, its critical speeds (codec_critical_speeds_csv: the header alone
+ * without engine_orders); takes text.
  */
 static enum MHD_Result http_spanwise(struct MHD_Connection *c, http_req *r, char *text,
                                      size_t len, int bmodes)
@@ -178,7 +179,9 @@ static enum MHD_Result http_spanwise(struct MHD_Connection *c, http_req *r, char
     json_t *doc = json_loadb(text, len, 0, NULL);
     char *out = NULL, why[256];
     size_t n = 0;
-    int st = doc ? codec_result_spanwise(&out, &n, doc, bmodes, why, sizeof why) : SM_NOMEM;
+    int st = !doc          ? SM_NOMEM
+             : bmodes == 2 ? codec_critical_speeds_csv(&out, &n, doc)
+                           : codec_result_spanwise(&out, &n, doc, bmodes, why, sizeof why);
 
     json_decref(doc);
     free(text);
@@ -189,11 +192,11 @@ static enum MHD_Result http_spanwise(struct MHD_Connection *c, http_req *r, char
         return http_problem(c, r, MHD_HTTP_SERVICE_UNAVAILABLE, "out-of-memory",
                             "Out Of Memory", "The shapes could not be written.", NULL, 0);
     return http_respond(c, r, MHD_HTTP_OK,
-                        bmodes ? "text/plain; charset=utf-8" : "text/csv; charset=utf-8", out,
-                        n, 1, NULL, 0);
+                        bmodes == 1 ? "text/plain; charset=utf-8" : "text/csv; charset=utf-8",
+                        out, n, 1, NULL, 0);
 }
 
-/* GET /v1/analyses/{id}/result[?format=json|csv|spanwise|bmodes] */
+/* GET /v1/analyses/{id}/result[?format=json|csv|spanwise|bmodes|critical] */
 enum MHD_Result http_get_result(struct MHD_Connection *c, http_req *r)
 {
     const char *format = NULL;
@@ -201,7 +204,7 @@ enum MHD_Result http_get_result(struct MHD_Connection *c, http_req *r)
     store_job jb;
     char *text;
     size_t len;
-    int csv = 0, rc, shapes = -1; /* shapes: -1 no, 0 span-wise CSV, 1 BModes table */
+    int csv = 0, rc, shapes = -1; /* -1 no, 0 span-wise CSV, 1 BModes table, 2 critical */
 
     if (!r->id_ok)
         return http_not_found(c, r, 1);
@@ -212,8 +215,11 @@ enum MHD_Result http_get_result(struct MHD_Connection *c, http_req *r)
             shapes = 0;
         else if (format && !strcmp(format, "bmodes"))
             shapes = 1;
+        else if (format && !strcmp(format, "critical"))
+            shapes = 2;
         else if (!format || (!csv && strcmp(format, "json") != 0))
-            return http_bad_query(c, r, "format", "must be json, csv, spanwise or bmodes");
+            return http_bad_query(c, r, "format",
+                                  "must be json, csv, spanwise, bmodes or critical");
     }
     rc = http_job_read(r->h, r->id, csv ? STORE_WITH_CSV : STORE_WITH_RESULT, &jb);
     if (rc != JOBS_OK) {

@@ -226,6 +226,23 @@ def scenario(exe, cli, ref, client_dir, tmp):
         rc, out, err = client("solve", "--bmodes", req_path)
         check(rc == 0 and out == table_cli, "client solve --bmodes = CLI export (%d)" % rc)
 
+        # critical speeds from the stored result (?format=critical) = the CLI's --critical-csv
+        crit_req = {"blade": {"length": 31.623, "elements": 24,
+                              "section": {"EA": 1e10, "EI_flap": 1e8, "EI_edge": 4e8, "GJ": 1e8,
+                                          "mass_per_length": 100}},
+                    "analysis": {"omega": {"from": 0, "to": 12, "steps": 12}, "modes": 4,
+                                 "mode_shapes": False, "engine_orders": [1, 2]}}
+        c_path = os.path.join(tmp, "critical.json")
+        with open(c_path, "w", encoding="utf-8") as f:
+            json.dump(crit_req, f)
+        rc, crit_cli, err = run([cli, "solve", "--critical-csv", c_path])
+        st = solve(d, crit_req)
+        r = d.get("/v1/analyses/%s/result?format=critical" % st.get("id"))
+        check(rc == 0 and crit_cli.count("\n") >= 2 and r.status == 200 and
+              r.ctype().startswith("text/csv") and r.body.decode() == crit_cli,
+              "daemon ?format=critical = CLI --critical-csv, byte for byte (%d rows)"
+              % (crit_cli.count("\n") - 1))
+
         # 5. planar: no span-wise shapes
         planar = {"structure": {"joints": {"a": [0, 0], "b": [1, 0]},
                                 "sections": {"s": {"E": 7e10, "A": 1e-4, "I": 1e-9,
