@@ -162,6 +162,14 @@ async function shot(page, name) {
   console.log(`# screenshot ${file}`);
 }
 
+/** Screenshot of one element (a close look at a chart). */
+async function shotEl(page, sel, name) {
+  fs.mkdirSync(SHOTS, {recursive: true});
+  const file = path.join(SHOTS, name);
+  await page.locator(sel).screenshot({path: file});
+  console.log(`# screenshot ${file}`);
+}
+
 /** Poll fn in the page until it is true; false after budgetMs(timeout). */
 async function waitFor(page, fn, arg, what, timeout = 15000) {
   const limit = budgetMs(timeout);
@@ -631,6 +639,7 @@ async function trust(page, base) {
     null, 'the crossing tooltip'), 'hovering the crossing marker names the two lines',
   await page.getAttribute('#campbell', 'data-tip'));
   await shot(page, '30-tracked-crossing.png');
+  await shotEl(page, 'figure.chart', '30-tracked-crossing-chart.png');
   await page.mouse.move(b.x - 20, b.y - 20);
 
   // labels in the table
@@ -714,6 +723,7 @@ async function trust(page, base) {
     await page.isVisible('#errbar-note'), 'the Campbell diagram has error bars (drawn where longer than their point)',
   `${eb.list.length} bars, ${eb.drawn} drawn, ${eb.hidden} too small; ${await page.textContent('#errbar-note')}`);
   await shot(page, '32-error-bars.png');
+  await shotEl(page, 'figure.chart', '32-error-bars-chart.png');
   await page.uncheck('#error-estimate');
   await page.uncheck('#critical');
   an = await page.evaluate(() => window.__spinmodal.doc.analysis);
