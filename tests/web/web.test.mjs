@@ -641,6 +641,11 @@ async function trust(page, base) {
   await shot(page, '30-tracked-crossing.png');
   await shotEl(page, 'figure.chart', '30-tracked-crossing-chart.png');
   await page.mouse.move(b.x - 20, b.y - 20);
+  const svgX = await downloadText(page, '#campbell-svg');
+  ok(['1st flap', '1st edge', 'critical speeds', 'modes cross'].every((t) => svgX.text.includes(t)) &&
+    (svgX.text.match(/r="2\.5" fill="#111111"/g) || []).length === 1 + 3,
+  'the Campbell SVG names the lines by label and draws the 3 critical speeds and the crossing (legend too)',
+  `${svgX.text.length} bytes`);
 
   // labels in the table
   const labCells = await page.locator('#freq-table tbody tr').first().locator('td.mlabel').allTextContents();

@@ -137,14 +137,20 @@ export function campbellSvg(u, last, title) {
     const stroke = typeof s.stroke === 'function' ? s.stroke(u, i) : s.stroke || '#333';
     const dash = s.dash ? ` stroke-dasharray="${s.dash.join(' ')}"` : '';
     if (kind === 'critical' || kind === 'tracking') { // drawn below from last, with their shapes
-      legend.push({label: s.label, stroke, marker: kind});
+      const list = kind === 'critical' ? last.crit || [] : last.marks || [];
+      // in the legend only when there are some; the shape is the legend's marker, the label without it
+      if (list.length) {
+        legend.push({label: kind === 'critical' ? 'critical speeds' : list.some((m) => m.kind === 'veering')
+          ? (list.some((m) => m.kind === 'crossing') ? 'modes cross / veer' : 'modes veer') : 'modes cross',
+        stroke, marker: kind === 'tracking' && !list.some((m) => m.kind === 'crossing') ? 'veering' : kind});
+      }
       return;
     }
     if (kind === 'crossings') {
       for (let j = 0; j < xv.length; j++) {
         if (typeof yv[j] === 'number') out.push(`<circle cx="${r2(X(xv[j]))}" cy="${r2(Y(yv[j]))}" r="4.5" fill="#fff" stroke="${stroke}" stroke-width="2"/>`);
       }
-      legend.push({label: s.label, stroke, marker: 'ring'});
+      if (yv.some((v) => typeof v === 'number')) legend.push({label: 'kP crossings', stroke, marker: 'ring'});
       return;
     }
     let d = '', pen = false;
@@ -185,8 +191,8 @@ export function campbellSvg(u, last, title) {
   let ly = T + 6;
   const lx = L + pw + 14;
   for (const e of legend) {
-    if (e.marker === 'critical' || e.marker === 'tracking') {
-      out.push(shape(e.marker === 'critical' ? 'critical' : 'crossing', lx + 10, ly));
+    if (e.marker === 'critical' || e.marker === 'tracking' || e.marker === 'veering') {
+      out.push(shape(e.marker === 'tracking' ? 'crossing' : e.marker, lx + 10, ly));
     } else if (e.marker === 'ring') out.push(`<circle cx="${lx + 10}" cy="${ly}" r="4" fill="#fff" stroke="${e.stroke}" stroke-width="2"/>`);
     else out.push(`<line x1="${lx}" y1="${ly}" x2="${lx + 20}" y2="${ly}" stroke="${e.stroke}" stroke-width="${e.width || 1}"${e.dash ? ` stroke-dasharray="${e.dash.join(' ')}"` : ''}/>`);
     out.push(`<text x="${lx + 26}" y="${ly + 4}" fill="#1b1f24">${esc(e.label)}</text>`);
