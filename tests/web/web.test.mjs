@@ -162,6 +162,14 @@ async function shot(page, name) {
   console.log(`# screenshot ${file}`);
 }
 
+/** Screenshot of one element (a close look at a chart). */
+async function shotEl(page, sel, name) {
+  fs.mkdirSync(SHOTS, {recursive: true});
+  const file = path.join(SHOTS, name);
+  await page.locator(sel).screenshot({path: file});
+  console.log(`# screenshot ${file}`);
+}
+
 /** Poll fn in the page until it is true; false after budgetMs(timeout). */
 async function waitFor(page, fn, arg, what, timeout = 15000) {
   const limit = budgetMs(timeout);
@@ -199,6 +207,12 @@ async function drag(page, sel, dx, dy) {
   await page.mouse.down();
   await page.mouse.move(x + dx, y + dy, {steps: 8});
   await page.mouse.up();
+}
+
+/** The plotted Campbell line holding mode k (sorted index) of case c: the series of its tracked_index. */
+function lineSeries(p, c, k = 0) {
+  const t = c.modes[k].tracked_index;
+  return p.series.find((s) => s.kind === 'mode' && s.line === t);
 }
 
 /** Points "x y" of an SVG path ("M x y L x y …"). */
@@ -420,7 +434,7 @@ async function unitsAndCampbell(page, result) {
   ok(Math.abs(p.x[p.x.length - 1] - rpm20) <= 1e-9 * rpm20 && /rpm/.test(p.axisLabels[0]),
     'rpm: the Campbell x axis is in rpm (last speed = 20·60/2π)', `${p.x[p.x.length - 1]} vs ${rpm20}; ${p.axisLabels[0]}`);
   const xi = p.x.length - 1;
-  const m1 = p.series.find((s) => /^mode 1/.test(s.label));
+  const m1 = lineSeries(p, c20);
   ok(Math.abs(m1.values[xi] - c20.modes[0].frequency_rad_s) <= 1e-12 * c20.modes[0].frequency_rad_s,
     'rpm: mode 1 is still plotted in rad/s at that speed', String(m1.values[xi]));
   const eo1 = p.series.find((s) => s.label === '1P');
@@ -432,7 +446,7 @@ async function unitsAndCampbell(page, result) {
     `${head.slice(0, 40)} | ${last}`);
   await page.selectOption('#freq-unit', 'hz');
   p = await page.evaluate(() => window.__spinmodal.campbell());
-  const hz = p.series.find((s) => /^mode 1/.test(s.label)).values[xi];
+  const hz = lineSeries(p, c20).values[xi];
   ok(Math.abs(hz - c20.modes[0].frequency_hz) <= 1e-12 * hz && /Hz/.test(p.axisLabels[1]),
     'Hz: the Campbell y axis is the result\'s frequency_hz', `${hz} vs ${c20.modes[0].frequency_hz}`);
   ok(Math.abs(p.series.find((s) => s.label === '2P').values[xi] - 2 * 20 / TWO_PI) < 1e-9,
@@ -452,7 +466,7 @@ async function unitsAndCampbell(page, result) {
   `${lines[0]} | ${lines[lines.length - 1]}`);
   await page.selectOption('#freq-unit', 'rev');
   p = await page.evaluate(() => window.__spinmodal.campbell());
-  const pr = p.series.find((s) => /^mode 1/.test(s.label)).values[xi];
+  const pr = lineSeries(p, c20).values[xi];
   ok(Math.abs(pr - c20.modes[0].per_rev) <= 1e-12 && p.series.find((s) => s.label === '3P').values.every((v) => v === 3),
     'per rev: mode 1 is the result\'s per_rev and the 3P line is the constant 3', `${pr} vs ${c20.modes[0].per_rev}`);
   await shot(page, '10-units-rpm-per-rev.png');
@@ -487,17 +501,21 @@ async function unitsAndCampbell(page, result) {
     return items.map((e) => [e.querySelector('.u-label') ? e.querySelector('.u-label').textContent : '',
       getComputedStyle(e.querySelector('.u-marker')).borderColor]);
   });
-  const modeCols = colours.filter(([l]) => /^mode /.test(l)).map(([, c]) => c);
-  const crossCol = (colours.find(([l]) => l === 'crossings') || [])[1];
-  ok(modeCols.length === 3 && new Set(modeCols).size === 3 && !modeCols.includes(crossCol),
-    'mode colours differ from each other and from the crossings', JSON.stringify(colours));
+  const pl = await page.evaluate(() => window.__spinmodal.campbell());
+  const names = new Set(pl.series.filter((s) => s.kind === 'mode').map((s) => s.label));
+  const modeCols = colours.filter(([l]) => names.has(l)).map(([, c]) => c);
+  const markNames = pl.series.filter((s) => ['crossings', 'critical', 'tracking'].includes(s.kind)).map((s) => s.label);
+  const markCols = colours.filter(([l]) => markNames.includes(l)).map(([, c]) => c);
+  ok(modeCols.length === 3 && new Set(modeCols).size === 3 && markCols.length === 3 &&
+    !modeCols.some((c) => markCols.includes(c)),
+  'mode colours differ from each other and from the crossing markers', JSON.stringify(colours));
 }
 
 /** SVG and PNG of the Campbell diagram and the mode shape; a second design overlaid on the first. */
 async function exportsAndCompare(page, result) {
   const svg = await downloadText(page, '#campbell-svg');
   ok(/\.svg$/.test(svg.name) && /^<\?xml/.test(svg.text) && /<svg[^>]+xmlns="http:\/\/www.w3.org\/2000\/svg"/.test(svg.text) &&
-    svg.text.includes('mode 1') && svg.text.includes('1P') && (svg.text.match(/<path /g) || []).length >= 3 + 4,
+    svg.text.includes('1st bending') && svg.text.includes('1P') && (svg.text.match(/<path /g) || []).length >= 3 + 4,
   'Campbell as SVG: vector paths of the modes and engine orders, with the legend', `${svg.name} ${svg.text.length} bytes`);
   const png = await downloadText(page, '#campbell-png', null);
   ok(/\.png$/.test(png.name) && png.buf.subarray(1, 4).toString() === 'PNG' && png.buf.length > 5000,
@@ -522,20 +540,199 @@ async function exportsAndCompare(page, result) {
   await page.fill('#json', text);
   await page.click('#submit');
   await waitFor(page, () => document.body.dataset.jobState === 'done', null, 'the second design', 180000);
-  ok(await waitFor(page, () => (window.__spinmodal.campbell().series || []).some((s) => s.label === 'ref mode 1'), null,
-    'the overlay'), 'compare: the reference result is overlaid');
+  const r20 = result.cases.find((c) => c.omega === 20);
+  ok(await waitFor(page, (t) => (window.__spinmodal.campbell().series || []).some((s) => s.kind === 'ref' && s.line === t),
+    r20.modes[0].tracked_index, 'the overlay'), 'compare: the reference result is overlaid');
   const p = await page.evaluate(() => window.__spinmodal.campbell());
   const xi = p.x.indexOf(20);
-  const ref1 = p.series.find((s) => s.label === 'ref mode 1').values[xi];
-  const cur1 = p.series.find((s) => /^mode 1/.test(s.label)).values[xi];
-  const want = result.cases.find((c) => c.omega === 20).modes[0].frequency_rad_s;
+  const refS = p.series.find((s) => s.kind === 'ref' && s.line === r20.modes[0].tracked_index);
+  const ref1 = refS.values[xi];
+  const now = await page.evaluate(() => window.__spinmodal.result);
+  const cur1 = lineSeries(p, now.cases.find((c) => c.omega === 20)).values[xi];
+  const want = r20.modes[0].frequency_rad_s;
+  ok(refS.label === `ref ${r20.modes[0].label}`, 'compare: the reference line is named by its label', refS.label);
   ok(ref1 === want && cur1 < want, 'compare: ref mode 1 at 20 rad/s is the first design\'s, the heavier beam\'s is lower',
     `${ref1} vs ${want}; now ${cur1}`);
   await shot(page, '12-compare-designs.png');
   await page.click('#clear-ref');
   ok(!(await page.evaluate(() => window.__spinmodal.campbell())).series.some((s) => /^ref /.test(s.label)),
     'Stop comparing removes the overlay');
+  ok(!(await page.evaluate(() => window.__spinmodal.campbell())).series.some((s) => s.kind === 'ref'),
+    'Stop comparing: no reference series left');
   await page.fill('#json', text.replace('"mass_per_length": 2.4', '"mass_per_length": 1.2'));
+}
+
+/** Solve what the editor holds; the API result of the job, or null. */
+async function solveHere(page, base, what, budget = 180000) {
+  await page.click('#submit');
+  const done = await waitFor(page, () => ['done', 'failed', 'canceled', 'rejected'].includes(document.body.dataset.jobState) &&
+    window.__spinmodal.job && window.__spinmodal.job.state === document.body.dataset.jobState && window.__spinmodal.result &&
+    document.getElementById('result-stale').hidden, null, what, budget);
+  const state = await page.evaluate(() => document.body.dataset.jobState);
+  if (!ok(done && state === 'done', `${what}: the job runs to done`, `${state}: ${await page.textContent('#job-status')}`)) return null;
+  const id = await page.evaluate(() => window.__spinmodal.job.id);
+  return {id, result: await (await fetch(`${base}/v1/analyses/${id}/result`)).json()};
+}
+
+const CROSS_BLADE = {blade: {length: 31.623, elements: 24, section: {EA: 1e10, EI_flap: 1e8, EI_edge: 4e8, GJ: 1e8,
+  mass_per_length: 100}}, analysis: {omega: {from: 0, to: 12, steps: 12}, modes: 4}};
+
+/**
+ * Trust (issue 13, DESIGN.md 9.1 and 9.4) on the page: the straight blade with
+ * EI_edge = 4·EI_flap swept 0…12 rad/s, whose first flap and first edge modes
+ * cross.  The Campbell lines follow tracked_index through the swap, the
+ * crossing flag is a marker, the legend and table carry the labels; "find
+ * critical speeds" sends the engine orders and the daemon's critical speeds
+ * are tabled (rad/s and rpm), marked and downloadable byte for byte; "error
+ * estimate" sends error_estimate and the table's ± are the API's.
+ */
+async function trust(page, base) {
+  await page.fill('#json', JSON.stringify(CROSS_BLADE, null, 2));
+  await page.fill('#eo-orders', '1, 2');
+  let an = await page.evaluate(() => window.__spinmodal.doc.analysis);
+  ok(!('engine_orders' in an) && !('error_estimate' in an) && await page.inputValue('#eo-list') === '1, 2',
+    'orders typed without "find critical speeds": no engine_orders key (job ids unchanged); the Campbell orders follow',
+    JSON.stringify(an));
+  await page.check('#critical');
+  an = await page.evaluate(() => window.__spinmodal.doc.analysis);
+  ok(JSON.stringify(an.engine_orders) === '[1,2]' && !('error_estimate' in an),
+    '"find critical speeds" sends analysis.engine_orders [1, 2], and no error_estimate key', JSON.stringify(an));
+  const got = await solveHere(page, base, 'the crossing blade');
+  if (!got) return;
+  const {id, result} = got;
+  const cases = result.cases.slice().sort((a, b) => a.omega - b.omega);
+  const at0 = cases[0], at12 = cases[cases.length - 1];
+  const edge = at0.modes.find((m) => m.label === '1st edge'), flap = at0.modes.find((m) => m.label === '1st flap');
+  ok(edge && flap && at0.modes.indexOf(edge) === 1 && at12.modes[0].tracked_index === edge.tracked_index,
+    'API: the 1st edge mode is sorted 2nd at rest and 1st at 12 rad/s (the sorted indices swap)',
+    JSON.stringify(cases.map((c) => c.modes.map((m) => m.tracked_index))));
+  const p = await page.evaluate(() => window.__spinmodal.campbell());
+  const line = p.series.find((s) => s.kind === 'mode' && s.label === '1st edge');
+  let worst = 0, n = 0;
+  for (const c of cases) {
+    const m = c.modes.find((x) => x.tracked_index === line.line);
+    const v = line.values[p.x.indexOf(c.omega)];
+    worst = Math.max(worst, Math.abs(v - m.frequency_rad_s) / m.frequency_rad_s);
+    n++;
+  }
+  ok(line && line.line === edge.tracked_index && n === 13 && worst === 0,
+    'the plotted line "1st edge" holds, at each of the 13 speeds, the frequency of the mode with its tracked_index',
+    `line ${line && line.line}, worst relative difference ${worst}`);
+  const flaggedAt = cases.filter((c) => c.modes.some((m) => m.tracking_flag === 'crossing'));
+  const mk = p.marks.filter((m) => m.kind === 'crossing');
+  ok(flaggedAt.length === 1 && flaggedAt[0].omega === 7 && mk.length === 1 && mk[0].at === 7 &&
+    JSON.stringify(mk[0].lines) === JSON.stringify([flap.tracked_index, edge.tracked_index].sort()) &&
+    mk[0].omega > 6 && mk[0].omega < 7 && JSON.stringify(mk[0].names.slice().sort()) === '["1st edge","1st flap"]',
+  'one crossing marker, for the flag at 7 rad/s, where the two lines meet between 6 and 7 rad/s',
+  JSON.stringify(mk));
+  const legend = await page.$$eval('#campbell .u-legend .u-series .u-label', (ls) => ls.map((l) => l.textContent));
+  ok(['1st flap', '1st edge', '2nd flap', '2nd edge'].every((l) => legend.includes(l)), 'the legend names the lines by their labels',
+    JSON.stringify(legend));
+  // pointing at the crossing marker tells which lines
+  const over = page.locator('#campbell .u-over');
+  await over.scrollIntoViewIfNeeded();
+  const b = await over.boundingBox();
+  const px = (x, y) => [b.x + (x - p.scales.x[0]) / (p.scales.x[1] - p.scales.x[0]) * b.width,
+    b.y + (1 - (y - p.scales.y[0]) / (p.scales.y[1] - p.scales.y[0])) * b.height];
+  await page.mouse.move(...px(mk[0].x, mk[0].y));
+  ok(await waitFor(page, () => /^Modes cross: 1st (flap|edge) and 1st (flap|edge)/.test(document.getElementById('campbell').dataset.tip || ''),
+    null, 'the crossing tooltip'), 'hovering the crossing marker names the two lines',
+  await page.getAttribute('#campbell', 'data-tip'));
+  await shot(page, '30-tracked-crossing.png');
+  await shotEl(page, 'figure.chart', '30-tracked-crossing-chart.png');
+  await page.mouse.move(b.x - 20, b.y - 20);
+  const svgX = await downloadText(page, '#campbell-svg');
+  ok(['1st flap', '1st edge', 'critical speeds', 'modes cross'].every((t) => svgX.text.includes(t)) &&
+    (svgX.text.match(/r="2\.5" fill="#111111"/g) || []).length === 1 + 3,
+  'the Campbell SVG names the lines by label and draws the 3 critical speeds and the crossing (legend too)',
+  `${svgX.text.length} bytes`);
+
+  // labels in the table
+  const labCells = await page.locator('#freq-table tbody tr').first().locator('td.mlabel').allTextContents();
+  ok(JSON.stringify(labCells) === JSON.stringify(at0.modes.map((m) => m.label)), 'the frequency table has a label column per mode',
+    JSON.stringify(labCells));
+
+  // critical speeds: the daemon's table, in rad/s and rpm, and its CSV byte for byte
+  const cs = result.critical_speeds;
+  const critRows = async () => page.$$eval('#critical-table tbody tr', (trs) => trs.map((tr) =>
+    Array.from(tr.cells).map((td) => td.dataset.value)));
+  let rows = await critRows();
+  const same = (r, c, sp) => r.length === 5 && Number(r[0]) === c.order && r[1] === c.label && Number(r[2]) === sp &&
+    Number(r[3]) === c.frequency_rad_s && r[4] === String(c.refined);
+  ok(cs.length === 3 && rows.length === cs.length && cs.every((c, i) => same(rows[i], c, c.omega)),
+    `the critical-speed table is the API's critical_speeds (${cs.length} rows: order, label, Ω, ω, refined)`,
+    JSON.stringify({rows, cs: cs.map((c) => [c.order, c.label, c.omega, c.refined])}));
+  const e1 = cs.find((c) => c.order === 1 && c.label === '1st edge');
+  ok(e1 && Math.abs(e1.omega - 7.7420) < 1e-3 && e1.refined, '1P meets the 1st edge near 7.742 rad/s, refined',
+    JSON.stringify(e1));
+  ok(p.critical.length === cs.length && p.critical.every((c, i) => c.omega === cs[i].omega && c.y === cs[i].frequency_rad_s),
+    'the critical speeds are marked on the Campbell diagram', JSON.stringify(p.critical.map((c) => [c.x, c.y])));
+  await page.selectOption('#speed-unit', 'rpm');
+  await page.selectOption('#freq-unit', 'hz');
+  rows = await critRows();
+  const rpmOk = cs.every((c, i) => Math.abs(Number(rows[i][2]) - c.omega * 60 / TWO_PI) <= 1e-12 * c.omega * 60 / TWO_PI &&
+    Number(rows[i][3]) === c.frequency_hz);
+  const head = await page.textContent('#critical-table thead');
+  ok(rpmOk && /Ω \(rpm\)/.test(head) && /f \(Hz\)/.test(head), 'in rpm and Hz: Ω·60/2π and the result\'s frequency_hz',
+    JSON.stringify(rows));
+  await shot(page, '31-critical-speeds-rpm.png');
+  await page.selectOption('#speed-unit', 'rad');
+  await page.selectOption('#freq-unit', 'rad');
+  const csv = await downloadText(page, '#dl-critical');
+  const apiCsv = Buffer.from(await (await fetch(`${base}/v1/analyses/${id}/result?format=critical`)).arrayBuffer());
+  ok(csv.buf.equals(apiCsv) && apiCsv.length > 0 && csv.name === `spinmodal-${id.slice(0, 12)}-critical.csv` &&
+    csv.text.trim().split('\n').length === 1 + cs.length, '"Critical speeds (CSV)" is ?format=critical byte for byte',
+  `${csv.name}, ${csv.buf.length} vs ${apiCsv.length} bytes: ${csv.text.split('\n')[0]}`);
+
+  // error estimate: a coarser blade (6 elements) so that the bars are visible
+  await page.fill('#json', JSON.stringify({...CROSS_BLADE, blade: {...CROSS_BLADE.blade, elements: 6},
+    analysis: {...CROSS_BLADE.analysis, engine_orders: [1, 2]}}, null, 2));
+  ok(await page.isChecked('#critical') && !await page.isChecked('#error-estimate'),
+    'a request with engine_orders ticks "find critical speeds"');
+  await page.check('#error-estimate');
+  an = await page.evaluate(() => window.__spinmodal.doc.analysis);
+  ok(an.error_estimate === true, '"error estimate (slower)" sends analysis.error_estimate: true', JSON.stringify(an));
+  const got2 = await solveHere(page, base, 'the blade with error estimates', 300000);
+  if (!got2) return;
+  const r2 = got2.result.cases.slice().sort((a, b) => a.omega - b.omega);
+  const errCells = async () => page.$$eval('#freq-table tbody tr', (trs) => trs.map((tr) =>
+    Array.from(tr.querySelectorAll('td.fq')).map((td) => {
+      const pm = td.querySelector('.pm');
+      return pm && pm.dataset.err !== undefined ? [Number(pm.dataset.err), pm.textContent] : null;
+    })));
+  let cells = await errCells();
+  let bad = [];
+  r2.forEach((c, i) => c.modes.forEach((m, k) => {
+    const cell = cells[i][k];
+    const want = m.error_estimate;
+    if (typeof want !== 'number' ? cell !== null : !cell || cell[0] !== want ||
+      cell[1] !== ` ± ${Number(want.toPrecision(2))}`) bad.push([c.omega, k, cell, want]);
+  }));
+  const nErr = r2.reduce((t, c) => t + c.modes.filter((m) => typeof m.error_estimate === 'number').length, 0);
+  ok(nErr === 13 * 4 && bad.length === 0, `the table shows ± error_estimate of all ${nErr} frequencies (rad/s)`,
+    JSON.stringify(bad.slice(0, 4)));
+  await page.selectOption('#freq-unit', 'hz');
+  cells = await errCells();
+  bad = [];
+  r2.forEach((c, i) => c.modes.forEach((m, k) => {
+    const want = m.error_estimate / TWO_PI;
+    if (!cells[i][k] || Math.abs(cells[i][k][0] - want) > 1e-12 * want) bad.push([c.omega, k, cells[i][k], want]);
+  }));
+  ok(bad.length === 0, 'in Hz the ± are error_estimate/2π', JSON.stringify(bad.slice(0, 4)));
+  const csvU = (await page.evaluate(() => window.__spinmodal.tableCsv())).split('\n');
+  ok(csvU[0].startsWith('speed (rad/s),status,mode 1 (Hz),mode 1 ± (Hz),mode 1 label,'),
+    'CSV (units shown): each mode\'s value, ± and label', csvU[0]);
+  await page.selectOption('#freq-unit', 'rad');
+  const eb = (await page.evaluate(() => window.__spinmodal.campbell())).errbars;
+  ok(eb.list.length === 13 * 4 && eb.drawn > 0 && eb.drawn + eb.hidden <= eb.list.length &&
+    await page.isVisible('#errbar-note'), 'the Campbell diagram has error bars (drawn where longer than their point)',
+  `${eb.list.length} bars, ${eb.drawn} drawn, ${eb.hidden} too small; ${await page.textContent('#errbar-note')}`);
+  await shot(page, '32-error-bars.png');
+  await shotEl(page, 'figure.chart', '32-error-bars-chart.png');
+  await page.uncheck('#error-estimate');
+  await page.uncheck('#critical');
+  an = await page.evaluate(() => window.__spinmodal.doc.analysis);
+  ok(!('error_estimate' in an) && !('engine_orders' in an), 'unticked, both keys are gone from the request', JSON.stringify(an));
 }
 
 /** Speeds with warnings or without equilibrium: hollow grey, not in the lines, never used for crossings. */
@@ -543,9 +740,9 @@ async function flaggedSpeeds(page) {
   const p = await page.evaluate(() => window.__spinmodal.campbell());
   const res = await page.evaluate(() => window.__spinmodal.result);
   const bad = new Set(res.cases.filter((c) => c.status !== 'solved' || (c.warnings || []).length).map((c) => c.omega));
-  const m1 = p.series.find((s) => /^mode 1/.test(s.label));
-  ok(bad.size > 0 && p.flagged.length > 0 && p.flagged.every((f) => bad.has(f.x)) &&
-    p.x.every((x, i) => !bad.has(x) || m1.values[i] === null || m1.values[i] === undefined),
+  const lines = p.series.filter((s) => s.kind === 'mode');
+  ok(bad.size > 0 && p.flagged.length > 0 && p.flagged.every((f) => bad.has(f.x)) && lines.length > 0 &&
+    lines.every((m) => p.x.every((x, i) => !bad.has(x) || m.values[i] === null || m.values[i] === undefined)),
   'flagged speeds are drawn apart (hollow), not on the mode lines', `${p.flagged.length} flagged points at ${[...bad]}`);
   const sorted = res.cases.map((c) => c.omega).sort((a, b) => a - b);
   const okX = p.crossings.every((c) => {
@@ -926,7 +1123,7 @@ async function run() {
     const c20 = result.cases.find((c) => c.omega === 20);
     const plotted = await page.evaluate(() => window.__spinmodal.campbell());
     const xi = plotted.x.indexOf(20);
-    const m1 = plotted.series.find((s) => s.label === 'mode 1' || s.label.startsWith('mode 1 ('));
+    const m1 = lineSeries(plotted, c20);
     const f20 = m1 && xi >= 0 ? m1.values[xi] : NaN;
     const api20 = c20.modes[0].frequency_rad_s;
     console.log(`# Campbell mode 1 at 20 rad/s: plotted ${f20}, API ${api20}`);
@@ -938,7 +1135,7 @@ async function run() {
       eo.map((s) => s.label).join(' '));
     ok(plotted.crossings.length > 0 && plotted.crossings.every((c) => c.omega >= 0 && c.omega <= 20),
       'engine-order crossings marked', JSON.stringify(plotted.crossings.slice(0, 3)));
-    const xing = plotted.crossings.find((c) => c.mode === 1 && c.order === 1);
+    const xing = plotted.crossings.find((c) => c.line === 0 && c.order === 1);
     ok(!xing || Math.abs(xing.freq - xing.omega) < 1e-9, 'a 1× crossing lies on ω = Ω');
     const rows = await page.locator('#freq-table tbody tr').count();
     ok(rows === 11, 'frequency table: one row per speed', String(rows));
@@ -1057,6 +1254,12 @@ async function run() {
     await spatial(page, base);
     await blades(page, base);
     await keepTheDesign(page, base);
+    try {
+      await trust(page, base);
+    } finally { // the next pages open with the stored request: the β = 90° example again
+      await page.selectOption('#example', 'angled-90');
+      await page.click('#load-example');
+    }
 
     // without POST /v1/validate (an older daemon: 404), errors come from the submission
     const page2 = await context.newPage();

@@ -11,7 +11,10 @@
 // A speed whose case is not "solved" or carries warnings (its equilibrium is
 // outside what the model describes) is "flagged": its modes are drawn as
 // hollow grey circles (a draw hook), are not part of the mode lines and are
-// never used for crossings.  Engine-order lines are grey, each with its own
+// never used for crossings.  The lines are the result's tracked modes
+// (tracked_index, DESIGN.md 9.1), named by their labels; the result's
+// crossing / veering flags, the daemon's critical speeds and error bars
+// (error_estimate) are drawn by the hook.  Engine-order lines are grey, each with its own
 // dash, and labelled where they leave the plot.  Drag selects a zoom box (x,
 // y or both); double click resets.  A reference result (another design) can
 // be overlaid: its modes are thin dashed lines.
@@ -34,52 +37,114 @@ export function flaggedCase(c) {
   return c.status !== 'solved' || (Array.isArray(c.warnings) && c.warnings.length > 0);
 }
 
-/** Cases sorted by speed: [{omega, rpm, status, flagged, modes, freqs: [rad/s | null per mode]}], and the mode count. */
+/** A mode's Campbell line: its tracked_index (DESIGN.md 9.1), else its sorted index (a result without tracking). */
+export function lineOf(md, k) {
+  return md && Number.isInteger(md.tracked_index) ? md.tracked_index : k;
+}
+
+/**
+ * Cases sorted by speed and the Campbell lines (tracked modes):
+ * {rows: [{omega, rpm, status, flagged, modes, byLine: Map(line -> mode)}],
+ *  lines: [{id, label, name}], nModes}.  A line is named by the label of its
+ * mode at the first speed where it appears ("1st flap"); a name taken twice
+ * gets " (2)"; a line without labels is "mode k".
+ */
 export function campbellData(result) {
   const cases = (result && Array.isArray(result.cases) ? result.cases : [])
     .filter((c) => typeof c.omega === 'number')
     .slice()
     .sort((a, b) => a.omega - b.omega);
   const nModes = cases.reduce((m, c) => Math.max(m, Array.isArray(c.modes) ? c.modes.length : 0), 0);
-  const rows = cases.map((c) => ({
-    omega: c.omega,
-    rpm: typeof c.rpm === 'number' ? c.rpm : c.omega * 60 / TWO_PI,
-    status: c.status,
-    flagged: flaggedCase(c),
-    modes: Array.isArray(c.modes) ? c.modes : [],
-    freqs: Array.from({length: nModes}, (_, k) => {
-      const md = Array.isArray(c.modes) ? c.modes[k] : null;
-      return md && typeof md.frequency_rad_s === 'number' ? md.frequency_rad_s : null;
-    }),
-  }));
-  return {rows, nModes};
+  const first = new Map(); // line -> label at its first speed
+  const rows = cases.map((c) => {
+    const modes = Array.isArray(c.modes) ? c.modes : [];
+    const byLine = new Map();
+    modes.forEach((md, k) => {
+      if (!md || typeof md.frequency_rad_s !== 'number') return;
+      const l = lineOf(md, k);
+      byLine.set(l, md);
+      if (!first.has(l)) first.set(l, typeof md.label === 'string' ? md.label : null);
+    });
+    return {omega: c.omega, rpm: typeof c.rpm === 'number' ? c.rpm : c.omega * 60 / TWO_PI, status: c.status,
+      flagged: flaggedCase(c), modes, byLine};
+  });
+  const used = new Map();
+  const lines = Array.from(first.keys()).sort((a, b) => a - b).map((id) => {
+    const label = first.get(id);
+    const base = label || `mode ${id + 1}`;
+    const n = (used.get(base) || 0) + 1;
+    used.set(base, n);
+    return {id, label, name: n === 1 ? base : `${base} (${n})`};
+  });
+  return {rows, lines, nModes};
 }
 
 /**
- * Crossings of mode curves with the engine-order lines ω = k·Ω, k in orders:
- * a sign change of ω_m(Ω) − k·Ω between two consecutive speeds that are both
- * unflagged, interpolated linearly (rad/s).  [{mode (1-based), order, omega, freq (rad/s)}].
+ * Crossings of the Campbell lines with the engine-order lines ω = k·Ω, k in
+ * orders: a sign change of ω_line(Ω) − k·Ω between two consecutive speeds that
+ * are both unflagged and both hold the line, interpolated linearly (rad/s).
+ * [{line, name, order, omega, freq (rad/s)}].
  */
-export function crossings(rows, nModes, orders) {
+export function crossings(rows, lines, orders) {
   const out = [];
-  for (let m = 0; m < nModes; m++) {
+  for (const ln of lines) {
     for (const k of orders) {
       for (let i = 0; i + 1 < rows.length; i++) {
         const a = rows[i], b = rows[i + 1];
         if (a.flagged || b.flagged) continue;
-        const fa = a.freqs[m], fb = b.freqs[m];
-        if (fa === null || fb === null) continue;
-        const da = fa - k * a.omega, db = fb - k * b.omega;
-        if (da === 0 && i > 0 && !rows[i - 1].flagged) continue; // counted as the previous interval's end
+        const ma = a.byLine.get(ln.id), mb = b.byLine.get(ln.id);
+        if (!ma || !mb) continue;
+        const da = ma.frequency_rad_s - k * a.omega, db = mb.frequency_rad_s - k * b.omega;
+        if (da === 0 && i > 0 && !rows[i - 1].flagged && rows[i - 1].byLine.has(ln.id)) continue; // the previous interval's end
         if (da === 0 || db === 0 || (da < 0) !== (db < 0)) {
           const t = da === db ? 0 : da / (da - db);
           const om = a.omega + t * (b.omega - a.omega);
-          out.push({mode: m + 1, order: k, omega: om, freq: k * om});
+          out.push({line: ln.id, name: ln.name, order: k, omega: om, freq: k * om});
         }
       }
     }
   }
-  return out.sort((p, q) => p.omega - q.omega || p.mode - q.mode);
+  return out.sort((p, q) => p.omega - q.omega || p.line - q.line);
+}
+
+/**
+ * The result's tracking flags as markers: one per flagged pair of lines at a
+ * speed (DESIGN.md 9.1).  When the pair swapped order since the previous
+ * speed holding both, the marker is where their straight segments meet;
+ * otherwise (a veering at its closest approach) at the flagged speed, midway.
+ * Flagged speeds (warnings, unsolved) give none.  [{kind, lines: [a, b], names, omega, freq}].
+ */
+export function trackingMarks(rows, lines) {
+  const name = new Map(lines.map((l) => [l.id, l.name]));
+  const out = [];
+  const seen = new Set();
+  rows.forEach((r, i) => {
+    if (r.flagged) return;
+    for (const [a, md] of r.byLine) {
+      const b = md.tracking_partner;
+      if ((md.tracking_flag !== 'crossing' && md.tracking_flag !== 'veering') || !Number.isInteger(b) || !r.byLine.has(b)) continue;
+      const key = `${i}:${Math.min(a, b)}:${Math.max(a, b)}`;
+      if (seen.has(key)) continue;
+      seen.add(key);
+      const fa = md.frequency_rad_s, fb = r.byLine.get(b).frequency_rad_s;
+      let omega = r.omega, freq = (fa + fb) / 2;
+      let j = i - 1;
+      while (j >= 0 && !(rows[j].byLine.has(a) && rows[j].byLine.has(b))) j--;
+      if (j >= 0) {
+        const p = rows[j];
+        const da = p.byLine.get(a).frequency_rad_s - p.byLine.get(b).frequency_rad_s, db = fa - fb;
+        if ((da < 0) !== (db < 0) && da !== db) {
+          const t = da / (da - db);
+          omega = p.omega + t * (r.omega - p.omega);
+          freq = p.byLine.get(a).frequency_rad_s + t * (fa - p.byLine.get(a).frequency_rad_s);
+        }
+      }
+      const pair = [Math.min(a, b), Math.max(a, b)];
+      out.push({kind: md.tracking_flag, lines: pair, names: pair.map((l) => name.get(l) || `mode ${l + 1}`),
+        omega, freq, at: r.omega});
+    }
+  });
+  return out;
 }
 
 /** A mode's frequency in unit fu at a case (the result's own per_rev / Hz when it has them). */
@@ -90,59 +155,97 @@ export function freqIn(fu, md, omega) {
   return FREQ_UNITS[fu].of(md.frequency_rad_s, omega);
 }
 
+/** A mode's error_estimate (rad/s) in unit fu at speed omega, or null (none, or per rev at rest). */
+export function errIn(fu, md, omega) {
+  if (!md || typeof md.error_estimate !== 'number') return null;
+  return FREQ_UNITS[fu].of(md.error_estimate, omega);
+}
+
 /** A case's speed in unit su (the result's own rpm when it has it). */
 export function speedIn(su, row) {
   return su === 'rpm' ? row.rpm : row.omega;
 }
 
 /**
- * The aligned uPlot data for rows, orders, units {speed, freq}, and an
- * optional reference {rows, nModes}: [x, modes…, orders…, crossings, ref modes…].
+ * The aligned uPlot data for rows, lines, orders, units {speed, freq}, the
+ * daemon's critical speeds {orders (covered), points} and an optional
+ * reference {rows, lines}: [x, lines…, orders…, crossings, critical, tracking
+ * marks, ref lines…], with meta[i] = {kind, line?} for each column.
  */
-export function plotData(rows, nModes, orders, units, ref = null) {
+export function plotData(rows, lines, orders, units, ref = null, critical = null) {
   const su = units.speed, fu = units.freq;
-  const cross = crossings(rows, nModes, orders);
+  const covered = new Set(critical ? critical.orders : []);
+  const cross = crossings(rows, lines, orders.filter((k) => !covered.has(k)));
+  const crit = (critical ? critical.points : []).filter((c) => orders.includes(c.order));
+  const marks = trackingMarks(rows, lines);
   const xOf = (omega) => SPEED_UNITS[su].of(omega);
+  const yOf = (w, omega, order) => (fu === 'rev' && order !== undefined ? order : FREQ_UNITS[fu].of(w, omega));
   const pts = new Map(); // x -> omega (rad/s)
   for (const r of rows) pts.set(speedIn(su, r), r.omega);
   for (const c of cross) pts.set(xOf(c.omega), c.omega);
+  for (const c of crit) pts.set(su === 'rpm' && typeof c.rpm === 'number' ? c.rpm : xOf(c.omega), c.omega);
+  for (const m of marks) pts.set(xOf(m.omega), m.omega);
   const refRows = ref ? ref.rows : [];
   for (const r of refRows) pts.set(speedIn(su, r), r.omega);
   const xs = Array.from(pts.keys()).sort((a, b) => a - b);
   const at = new Map(rows.map((r) => [speedIn(su, r), r]));
   const data = [xs];
-  for (let m = 0; m < nModes; m++) {
+  const meta = [{kind: 'x'}];
+  const errbars = [];
+  for (const ln of lines) {
     data.push(xs.map((x) => {
       const r = at.get(x);
       if (!r) return undefined;
-      return r.flagged ? null : freqIn(fu, r.modes[m], r.omega);
+      if (r.flagged) return null;
+      const md = r.byLine.get(ln.id);
+      if (!md) return null; // the line is not in the window here: a gap
+      const y = freqIn(fu, md, r.omega);
+      const e = errIn(fu, md, r.omega);
+      if (y !== null && e !== null) errbars.push({x, y, e, line: ln.id, name: ln.name});
+      return y;
     }));
+    meta.push({kind: 'mode', line: ln.id, name: ln.name});
   }
   for (const k of orders) {
     data.push(xs.map((x) => (fu === 'rev' ? k : FREQ_UNITS[fu].of(k * pts.get(x), pts.get(x)))));
+    meta.push({kind: 'eo', order: k});
   }
-  const cx = new Map(cross.map((c) => [xOf(c.omega), fu === 'rev' ? c.order : FREQ_UNITS[fu].of(c.freq, c.omega)]));
-  data.push(xs.map((x) => (cx.has(x) ? cx.get(x) : undefined)));
+  const column = (items, xf, yf) => {
+    const m = new Map(items.map((c) => [xf(c), yf(c)]));
+    return xs.map((x) => (m.has(x) ? m.get(x) : undefined));
+  };
+  data.push(column(cross, (c) => xOf(c.omega), (c) => yOf(c.freq, c.omega, c.order)));
+  meta.push({kind: 'crossings'});
+  const critX = (c) => (su === 'rpm' && typeof c.rpm === 'number' ? c.rpm : xOf(c.omega));
+  data.push(column(crit, critX, (c) => yOf(c.freq, c.omega, c.order)));
+  meta.push({kind: 'critical'});
+  data.push(column(marks, (m) => xOf(m.omega), (m) => yOf(m.freq, m.omega)));
+  meta.push({kind: 'tracking'});
   if (ref) {
     const rat = new Map(refRows.map((r) => [speedIn(su, r), r]));
-    for (let m = 0; m < ref.nModes; m++) {
+    for (const ln of ref.lines) {
       data.push(xs.map((x) => {
         const r = rat.get(x);
         if (!r) return undefined;
-        return r.flagged ? null : freqIn(fu, r.modes[m], r.omega);
+        if (r.flagged) return null;
+        return freqIn(fu, r.byLine.get(ln.id), r.omega);
       }));
+      meta.push({kind: 'ref', line: ln.id, name: ln.name});
     }
   }
   // the flagged speeds' modes, drawn hollow by the hook
   const flagged = [];
   for (const r of rows) {
     if (!r.flagged) continue;
-    for (let m = 0; m < nModes; m++) {
-      const v = freqIn(fu, r.modes[m], r.omega);
-      if (v !== null) flagged.push({x: speedIn(su, r), y: v, mode: m + 1, status: r.status});
+    for (const [l, md] of r.byLine) {
+      const v = freqIn(fu, md, r.omega);
+      if (v !== null) flagged.push({x: speedIn(su, r), y: v, line: l, status: r.status});
     }
   }
-  return {data, cross, flagged};
+  const critPts = crit.map((c) => ({...c, x: critX(c), y: yOf(c.freq, c.omega, c.order)}));
+  const markPts = marks.map((m) => ({...m, x: xOf(m.omega), y: yOf(m.freq, m.omega)}));
+  const crossPts = cross.map((c) => ({...c, x: xOf(c.omega), y: yOf(c.freq, c.omega, c.order)}));
+  return {data, meta, cross: crossPts, crit: critPts, marks: markPts, flagged, errbars};
 }
 
 /** "1, 2, 4-6" -> [1, 2, 4, 5, 6] (whole orders 1…50, sorted, unique); anything else is ignored. */
@@ -157,31 +260,89 @@ export function parseOrders(text) {
   return Array.from(out).sort((a, b) => a - b);
 }
 
-function seriesFor(nModes, orders, units, ref, labels) {
+/** The marker series' legend names (their shapes are drawn by the hook; black, apart from the mode colours). */
+export const MARK_NAMES = {crossings: '○ kP crossings', critical: '◉ critical speeds', tracking: '✕ modes cross / ◇ veer'};
+
+function seriesFor(last, units) {
+  const {lines, orders, ref, meta} = last;
   const fu = FREQ_UNITS[units.freq].label, su = SPEED_UNITS[units.speed].label;
   const fmt = (v) => (v === null || v === undefined ? '–' : Number(v.toPrecision(6)) + ' ' + fu);
+  // a marker's legend value under the cursor: which lines (and orders) it joins
+  const markAt = (list, idx, text) => {
+    const x = last.data[0][idx];
+    const hit = list.filter((m) => m.x === x);
+    return hit.length ? hit.map(text).join('; ') : '–';
+  };
   const s = [{label: `Ω (${su})`, value: (self, v) => (v === null || v === undefined ? '–' : Number(v.toPrecision(6)))}];
-  for (let m = 0; m < nModes; m++) {
-    s.push({label: `mode ${m + 1}` + (labels[m] ? ` (${labels[m]})` : ''), stroke: COLORS[m % COLORS.length], width: 2,
-      value: (self, v) => fmt(v), points: {show: true, size: 5}});
-  }
+  lines.forEach((ln) => {
+    s.push({label: ln.name, stroke: COLORS[ln.id % COLORS.length], width: 2, value: (self, v) => fmt(v),
+      points: {show: true, size: 5}});
+  });
   orders.forEach((k, i) => {
     s.push({label: `${k}P`, stroke: '#6b7280', width: 1, dash: EO_DASH[i % EO_DASH.length], value: (self, v) => fmt(v),
       points: {show: false}});
   });
-  s.push({label: 'crossings', stroke: CROSS_STROKE, fill: CROSS_STROKE, width: 0, paths: () => null,
-    value: (self, v) => fmt(v), points: {show: true, size: 10, stroke: CROSS_STROKE, fill: '#ffffff', width: 2}});
+  s.push({label: MARK_NAMES.crossings, stroke: CROSS_STROKE, fill: '#ffffff', width: 0, paths: () => null,
+    value: (self, v, si, idx) => (v === undefined || v === null ? '–' : markAt(last.cross, idx, (c) => `${c.name} × ${c.order}P`)),
+    points: {show: true, size: 10, stroke: CROSS_STROKE, fill: '#ffffff', width: 2}});
+  s.push({label: MARK_NAMES.critical, stroke: CROSS_STROKE, fill: CROSS_STROKE, width: 0, paths: () => null,
+    value: (self, v, si, idx) => (v === undefined || v === null ? '–'
+      : markAt(last.crit, idx, (c) => `${c.label || 'line ' + c.line} × ${c.order}P${c.refined ? '' : ' (not refined)'}`)),
+    points: {show: false}});
+  s.push({label: MARK_NAMES.tracking, stroke: CROSS_STROKE, fill: '#ffffff', width: 0, paths: () => null,
+    value: (self, v, si, idx) => (v === undefined || v === null ? '–'
+      : markAt(last.marks, idx, (m) => `${m.names.join(m.kind === 'crossing' ? ' ✕ ' : ' ◇ ')} (${m.kind})`)),
+    points: {show: false}});
   if (ref) {
-    for (let m = 0; m < ref.nModes; m++) {
-      s.push({label: `ref mode ${m + 1}`, stroke: COLORS[m % COLORS.length] + '99', width: 1.5, dash: [3, 3],
+    ref.lines.forEach((ln) => {
+      s.push({label: `ref ${ln.name}`, stroke: COLORS[ln.id % COLORS.length] + '99', width: 1.5, dash: [3, 3],
         value: (self, v) => fmt(v), points: {show: false}});
-    }
+    });
   }
+  if (s.length !== meta.length) throw new Error('campbell: series and data columns differ');
   return s;
 }
 
-/** The draw hook: the flagged speeds' modes as hollow grey circles, and the engine-order labels. */
-function decorations(getLast) {
+/** Smallest half-length (CSS px) of an error bar worth drawing: it must reach past the point marker (radius 2.5 px). */
+export const ERRBAR_MIN_PX = 3;
+
+/** The marker shapes: ◉ critical speed (○ when not refined), ✕ crossing, ◇ veering; r in px. */
+function markShape(ctx, kind, x, y, r) {
+  ctx.beginPath();
+  if (kind === 'crossing') {
+    ctx.moveTo(x - r, y - r);
+    ctx.lineTo(x + r, y + r);
+    ctx.moveTo(x + r, y - r);
+    ctx.lineTo(x - r, y + r);
+    ctx.stroke();
+  } else if (kind === 'veering') {
+    ctx.moveTo(x, y - r * 1.3);
+    ctx.lineTo(x + r, y);
+    ctx.lineTo(x, y + r * 1.3);
+    ctx.lineTo(x - r, y);
+    ctx.closePath();
+    ctx.fill();
+    ctx.stroke();
+  } else {
+    ctx.arc(x, y, r, 0, 2 * Math.PI);
+    ctx.fill();
+    ctx.stroke();
+    if (kind === 'critical') {
+      ctx.beginPath();
+      ctx.fillStyle = CROSS_STROKE;
+      ctx.arc(x, y, r * 0.45, 0, 2 * Math.PI);
+      ctx.fill();
+      ctx.fillStyle = '#ffffff';
+    }
+  }
+}
+
+/**
+ * The draw hook: error bars (where longer than the point marker), the flagged
+ * speeds' modes as hollow grey circles, the tracking and critical-speed
+ * markers, and the engine-order labels.  Reports what it drew to onDraw.
+ */
+function decorations(getLast, onDraw) {
   return (u) => {
     const L = getLast();
     if (!L) return;
@@ -191,6 +352,30 @@ function decorations(getLast) {
     ctx.beginPath();
     ctx.rect(left, top, width, height);
     ctx.clip();
+    // error bars: vertical segments y ± e in the line's colour, with caps
+    let drawn = 0, hidden = 0, emax = 0;
+    const xMin = u.scales.x.min, xMax = u.scales.x.max;
+    ctx.lineWidth = 1.25 * px;
+    for (const b of L.errbars) {
+      emax = Math.max(emax, b.e);
+      if (b.x < xMin || b.x > xMax) continue;
+      const y0 = u.valToPos(b.y, 'y'), half = Math.abs(u.valToPos(b.y + b.e, 'y') - y0);
+      if (half < ERRBAR_MIN_PX) {
+        hidden++;
+        continue;
+      }
+      drawn++;
+      const X = u.valToPos(b.x, 'x', true), Y0 = u.valToPos(b.y - b.e, 'y', true), Y1 = u.valToPos(b.y + b.e, 'y', true);
+      ctx.strokeStyle = COLORS[b.line % COLORS.length];
+      ctx.beginPath();
+      ctx.moveTo(X, Y0);
+      ctx.lineTo(X, Y1);
+      ctx.moveTo(X - 3 * px, Y0);
+      ctx.lineTo(X + 3 * px, Y0);
+      ctx.moveTo(X - 3 * px, Y1);
+      ctx.lineTo(X + 3 * px, Y1);
+      ctx.stroke();
+    }
     ctx.lineWidth = 1.5 * px;
     ctx.strokeStyle = FLAG_STROKE;
     ctx.fillStyle = '#ffffff';
@@ -201,12 +386,20 @@ function decorations(getLast) {
       ctx.fill();
       ctx.stroke();
     }
+    // the daemon's critical speeds and the tracking flags: black shapes
+    ctx.strokeStyle = CROSS_STROKE;
+    ctx.fillStyle = '#ffffff';
+    ctx.lineWidth = 2 * px;
+    for (const c of L.crit) {
+      markShape(ctx, c.refined ? 'critical' : 'ring', u.valToPos(c.x, 'x', true), u.valToPos(c.y, 'y', true), 5.5 * px);
+    }
+    for (const m of L.marks) markShape(ctx, m.kind, u.valToPos(m.x, 'x', true), u.valToPos(m.y, 'y', true), 5 * px);
     // engine-order labels where each line leaves the plot (top or right edge)
     ctx.font = `${Math.round(11 * px)}px system-ui, sans-serif`;
     ctx.fillStyle = '#374151';
     ctx.textBaseline = 'middle';
-    const xMax = u.scales.x.max, yMax = u.scales.y.max, yMin = u.scales.y.min;
-    const base = 1 + L.nModes;
+    const yMax = u.scales.y.max, yMin = u.scales.y.min;
+    const base = 1 + L.lines.length;
     L.orders.forEach((k, i) => {
       const ys = u.data[base + i], xs = u.data[0];
       // the last point of the line inside the y range
@@ -230,40 +423,86 @@ function decorations(getLast) {
       ctx.fillText(text, X, Y);
     });
     ctx.restore();
+    L.errDrawn = {drawn, hidden, max: emax, total: L.errbars.length};
+    if (onDraw) onDraw(L);
   };
 }
 
-/** A Campbell chart in container; update({result, orders, units, ref, labels}); destroy(). */
-export function campbellChart(container) {
+/** What lies under the cursor (CSS px in the plot area): the nearest marker or point within 8 px, as text. */
+function hoverText(u, L, cx, cy) {
+  const fu = FREQ_UNITS[L.units.freq].label, su = SPEED_UNITS[L.units.speed].label;
+  const n = (v) => String(Number(v.toPrecision(5)));
+  let best = null;
+  const consider = (x, y, pri, text) => {
+    const d = Math.hypot(u.valToPos(x, 'x') - cx, u.valToPos(y, 'y') - cy) - pri;
+    if (d <= 8 && (!best || d < best.d)) best = {d, text};
+  };
+  for (const m of L.marks) {
+    consider(m.x, m.y, 3, `${m.kind === 'crossing' ? 'Modes cross' : 'Veering'}: ${m.names.join(' and ')} ` +
+      `(flagged at Ω = ${n(SPEED_UNITS[L.units.speed].of(m.at))} ${su})`);
+  }
+  for (const c of L.crit) {
+    consider(c.x, c.y, 3, `Critical speed: ${c.label || 'line ' + c.line} meets ${c.order}P at Ω = ${n(c.x)} ${su}, ` +
+      `${n(c.y)} ${fu}${c.refined ? ' (refined by the daemon)' : ' (interpolated, not refined)'}`);
+  }
+  for (const c of L.cross) {
+    consider(c.x, c.y, 2, `${c.name} meets ${c.order}P at Ω = ${n(c.x)} ${su}, ${n(c.y)} ${fu} (interpolated between ` +
+      'the speeds solved; tick "find critical speeds" and solve again to have it refined)');
+  }
+  const eb = new Map(L.errbars.map((b) => [`${b.line}:${b.x}`, b]));
+  L.meta.forEach((m, i) => {
+    if (m.kind !== 'mode') return;
+    const col = L.data[i];
+    for (let j = 0; j < col.length; j++) {
+      if (typeof col[j] !== 'number') continue;
+      const b = eb.get(`${m.line}:${L.data[0][j]}`);
+      let t = `${m.name}: ${n(col[j])}`;
+      if (b) {
+        const half = Math.abs(u.valToPos(b.y + b.e, 'y') - u.valToPos(b.y, 'y'));
+        t += ` ± ${n(b.e)}`;
+        if (half < ERRBAR_MIN_PX) t += ' (error bar too small to see at this scale)';
+      }
+      consider(L.data[0][j], col[j], 0, `${t} ${fu} at Ω = ${n(L.data[0][j])} ${su}`);
+    }
+  });
+  return best ? best.text : '';
+}
+
+/** A Campbell chart in container; update({result, orders, units, ref, critical}); destroy(). onDraw(last) after each draw. */
+export function campbellChart(container, onDraw = null) {
   let plot = null;
   let last = null;
+  const tip = document.createElement('div');
+  tip.className = 'campbell-tip';
+  tip.setAttribute('role', 'tooltip');
+  tip.hidden = true;
 
   function width() {
     return Math.max(280, Math.floor(container.clientWidth || 560));
   }
 
-  function update({result, orders, units, ref = null, labels = []}) {
-    const {rows, nModes} = campbellData(result);
+  function update({result, orders, units, ref = null, critical = null}) {
+    const {rows, lines, nModes} = campbellData(result);
     const refData = ref ? campbellData(ref) : null;
-    const {data, cross, flagged} = plotData(rows, nModes, orders, units, refData);
-    last = {rows, nModes, orders, units, cross, data, flagged, ref: refData};
+    const pd = plotData(rows, lines, orders, units, refData, critical);
+    const {data, meta, flagged} = pd;
+    last = {rows, lines, nModes, orders, units, ref: refData, ...pd};
     if (plot) plot.destroy();
     const fu = FREQ_UNITS[units.freq], su = SPEED_UNITS[units.speed];
     const yl = `frequency ${fu.sym} (${fu.label})`;
     let ymax = 0;
-    const refFrom = 1 + nModes + orders.length + 1; // the reference's modes follow the crossings
-    for (let i = 1; i < data.length; i++) {
-      if (i > nModes && i < refFrom) continue;
+    meta.forEach((m, i) => {
+      if (m.kind !== 'mode' && m.kind !== 'ref') return;
       for (const v of data[i]) if (typeof v === 'number') ymax = Math.max(ymax, v);
-    }
+    });
     for (const p of flagged) ymax = Math.max(ymax, p.y);
     if (units.freq === 'rev') {
       // per rev explodes towards Ω = 0: show the band of the engine orders and the modes at the top
       // speed (the lower speeds' values stay in the table; zoom works inside this range)
-      const top = data[1 + 0] ? data.slice(1, 1 + nModes).map((col) => {
+      const top = meta.map((m, i) => [m, data[i]]).filter(([m]) => m.kind === 'mode').map(([, col]) => {
         for (let j = col.length - 1; j >= 0; j--) if (typeof col[j] === 'number') return col[j];
         return 0;
-      }) : [];
+      });
       ymax = Math.min(ymax, Math.max(1.5 * (orders.length ? orders[orders.length - 1] : 1), ...top));
     }
     plot = new uPlot({
@@ -281,21 +520,38 @@ export function campbellChart(container) {
       legend: {live: true},
       // drag a box to zoom in x and y (a mostly horizontal or vertical drag zooms that axis only); double click resets
       cursor: {drag: {x: true, y: true, uni: 25}},
-      hooks: {draw: [decorations(() => last)]},
-      series: seriesFor(nModes, orders, units, refData, labels),
+      hooks: {
+        draw: [decorations(() => last, onDraw)],
+        setCursor: [(u) => {
+          const {left, top} = u.cursor;
+          const t = left >= 0 && top >= 0 && last ? hoverText(u, last, left, top) : '';
+          tip.hidden = !t;
+          tip.textContent = t;
+          container.dataset.tip = t;
+          if (t) {
+            tip.style.left = `${Math.min(left + 12, u.bbox.width / (uPlot.pxRatio || 1) - 200)}px`;
+            tip.style.top = `${Math.max(0, top - 34)}px`;
+          }
+        }],
+      },
+      series: seriesFor(last, units),
     }, data, container);
+    plot.over.append(tip);
+    tip.hidden = true;
     const cv = plot.root.querySelector('canvas');
     if (cv) {
       cv.setAttribute('role', 'img');
       cv.setAttribute('aria-label', rows.length
-        ? `Campbell diagram: ${nModes} modes at ${rows.length} speeds from ${sig(speedIn(units.speed, rows[0]))} to ` +
+        ? `Campbell diagram: ${lines.length} tracked modes (${lines.map((l) => l.name).join(', ')}) at ${rows.length} ` +
+          `speeds from ${sig(speedIn(units.speed, rows[0]))} to ` +
           `${sig(speedIn(units.speed, rows[rows.length - 1]))} ${su.label}, frequencies in ${fu.label}, engine orders ` +
-          `${orders.join(', ') || 'none'}, ${cross.length} crossings (listed below)` +
+          `${orders.join(', ') || 'none'}, ${pd.cross.length + pd.crit.length} crossings with them (listed below)` +
+          (pd.marks.length ? `, ${pd.marks.length} mode crossings or veerings` : '') +
           (flagged.length ? `, ${new Set(flagged.map((p) => p.x)).size} speeds flagged (hollow grey)` : '')
         : 'Campbell diagram: no speeds');
     }
     container.dataset.cases = String(rows.length);
-    container.dataset.crossings = String(cross.length);
+    container.dataset.crossings = String(pd.cross.length);
     return last;
   }
 
@@ -314,8 +570,13 @@ export function campbellChart(container) {
         units: {...last.units},
         unit: last.units.freq,
         x: Array.from(plot.data[0]),
-        series: labels.slice(1).map((label, i) => ({label, values: Array.from(plot.data[i + 1])})),
+        series: labels.slice(1).map((label, i) => ({label, kind: last.meta[i + 1].kind, line: last.meta[i + 1].line,
+          values: Array.from(plot.data[i + 1])})),
+        lines: last.lines.map((l) => ({...l})),
         crossings: last.cross.map((c) => ({...c})),
+        critical: last.crit.map((c) => ({...c})),
+        marks: last.marks.map((m) => ({...m})),
+        errbars: {list: last.errbars.map((b) => ({...b})), ...(last.errDrawn || {})},
         flagged: last.flagged.map((p) => ({...p})),
         scales: {x: [plot.scales.x.min, plot.scales.x.max], y: [plot.scales.y.min, plot.scales.y.max]},
         axisLabels: plot.axes.map((a) => a.label),

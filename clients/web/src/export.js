@@ -121,16 +121,36 @@ export function campbellSvg(u, last, title) {
   out.push(`<clipPath id="plot"><rect x="${L}" y="${T}" width="${pw}" height="${ph}"/></clipPath><g clip-path="url(#plot)">`);
   const xv = u.data[0];
   const legend = [];
+  const meta = last.meta || [];
+  // error bars first (under the lines), where they reach beyond their point as on the screen
+  for (const b of last.errbars || []) {
+    const h = Math.abs(Y(b.y + b.e) - Y(b.y));
+    if (h < 3 || b.x < xs.min || b.x > xs.max) continue;
+    const x = r2(X(b.x)), y0 = r2(Y(b.y - b.e)), y1 = r2(Y(b.y + b.e));
+    const col = (u.series[1 + (last.lines || []).findIndex((l) => l.id === b.line)] || {}).stroke || '#333';
+    out.push(`<path d="M${x} ${y0}V${y1}M${x - 3} ${y0}h6M${x - 3} ${y1}h6" stroke="${col}" stroke-width="1.25" fill="none"/>`);
+  }
   u.series.forEach((s, i) => {
     if (i === 0) return;
+    const kind = (meta[i] || {}).kind;
     const yv = u.data[i];
     const stroke = typeof s.stroke === 'function' ? s.stroke(u, i) : s.stroke || '#333';
     const dash = s.dash ? ` stroke-dasharray="${s.dash.join(' ')}"` : '';
-    if (s.label === 'crossings') {
+    if (kind === 'critical' || kind === 'tracking') { // drawn below from last, with their shapes
+      const list = kind === 'critical' ? last.crit || [] : last.marks || [];
+      // in the legend only when there are some; the shape is the legend's marker, the label without it
+      if (list.length) {
+        legend.push({label: kind === 'critical' ? 'critical speeds' : list.some((m) => m.kind === 'veering')
+          ? (list.some((m) => m.kind === 'crossing') ? 'modes cross / veer' : 'modes veer') : 'modes cross',
+        stroke, marker: kind === 'tracking' && !list.some((m) => m.kind === 'crossing') ? 'veering' : kind});
+      }
+      return;
+    }
+    if (kind === 'crossings') {
       for (let j = 0; j < xv.length; j++) {
         if (typeof yv[j] === 'number') out.push(`<circle cx="${r2(X(xv[j]))}" cy="${r2(Y(yv[j]))}" r="4.5" fill="#fff" stroke="${stroke}" stroke-width="2"/>`);
       }
-      legend.push({label: s.label, stroke, marker: 'ring'});
+      if (yv.some((v) => typeof v === 'number')) legend.push({label: 'kP crossings', stroke, marker: 'ring'});
       return;
     }
     let d = '', pen = false;
@@ -153,7 +173,7 @@ export function campbellSvg(u, last, title) {
         out.push(`<text x="${r2(lx)}" y="${r2(ly)}" fill="#374151" font-size="11">${esc(s.label)}</text>`);
       }
     }
-    if (/^mode /.test(s.label)) {
+    if (kind === 'mode') {
       for (let j = 0; j < xv.length; j++) {
         if (typeof yv[j] === 'number') out.push(`<circle cx="${r2(X(xv[j]))}" cy="${r2(Y(yv[j]))}" r="2.2" fill="${stroke}"/>`);
       }
@@ -163,13 +183,17 @@ export function campbellSvg(u, last, title) {
   for (const p of last.flagged || []) {
     out.push(`<circle cx="${r2(X(p.x))}" cy="${r2(Y(p.y))}" r="4" fill="#fff" stroke="#9ca3af" stroke-width="1.5"/>`);
   }
+  for (const c of last.crit || []) out.push(shape(c.refined ? 'critical' : 'ring', X(c.x), Y(c.y)));
+  for (const m of last.marks || []) out.push(shape(m.kind, X(m.x), Y(m.y)));
   out.push('</g>');
   if ((last.flagged || []).length) legend.push({label: 'flagged speeds', stroke: '#9ca3af', marker: 'ring'});
   // legend
   let ly = T + 6;
   const lx = L + pw + 14;
   for (const e of legend) {
-    if (e.marker === 'ring') out.push(`<circle cx="${lx + 10}" cy="${ly}" r="4" fill="#fff" stroke="${e.stroke}" stroke-width="2"/>`);
+    if (e.marker === 'critical' || e.marker === 'tracking' || e.marker === 'veering') {
+      out.push(shape(e.marker === 'tracking' ? 'crossing' : e.marker, lx + 10, ly));
+    } else if (e.marker === 'ring') out.push(`<circle cx="${lx + 10}" cy="${ly}" r="4" fill="#fff" stroke="${e.stroke}" stroke-width="2"/>`);
     else out.push(`<line x1="${lx}" y1="${ly}" x2="${lx + 20}" y2="${ly}" stroke="${e.stroke}" stroke-width="${e.width || 1}"${e.dash ? ` stroke-dasharray="${e.dash.join(' ')}"` : ''}/>`);
     out.push(`<text x="${lx + 26}" y="${ly + 4}" fill="#1b1f24">${esc(e.label)}</text>`);
     ly += 17;
@@ -177,6 +201,16 @@ export function campbellSvg(u, last, title) {
   }
   out.push('</svg>');
   return '<?xml version="1.0" encoding="UTF-8"?>\n' + out.join('\n') + '\n';
+}
+
+/** A black marker: ◉ critical speed, ○ ring, ✕ crossing, ◇ veering, at (x, y) px. */
+function shape(kind, x, y) {
+  const a = (v) => Math.round(v * 100) / 100;
+  const st = 'stroke="#111111" stroke-width="2"';
+  if (kind === 'crossing') return `<path d="M${a(x - 5)} ${a(y - 5)}L${a(x + 5)} ${a(y + 5)}M${a(x + 5)} ${a(y - 5)}L${a(x - 5)} ${a(y + 5)}" ${st}/>`;
+  if (kind === 'veering') return `<path d="M${a(x)} ${a(y - 6.5)}L${a(x + 5)} ${a(y)}L${a(x)} ${a(y + 6.5)}L${a(x - 5)} ${a(y)}Z" fill="#fff" ${st}/>`;
+  return `<circle cx="${a(x)}" cy="${a(y)}" r="5.5" fill="#fff" ${st}/>` +
+    (kind === 'critical' ? `<circle cx="${a(x)}" cy="${a(y)}" r="2.5" fill="#111111"/>` : '');
 }
 
 /** Offer a blob as a download named name. */

@@ -13,7 +13,7 @@ import {DEFAULTS, prettyJSON, structureToRows, rowsToStructure, speedsForm, spee
 import {buildMesh} from './mesh.js';
 import {drawStructure, modeView} from './drawing.js';
 import {drawStructure3d, modeView3d, attachOrbit, homeCamera, PRESETS} from './view3d.js';
-import {campbellChart, parseOrders, freqIn, flaggedCase} from './campbell.js';
+import {campbellChart, parseOrders, freqIn, errIn, flaggedCase, campbellData, COLORS} from './campbell.js';
 import {exportSvg, svgToPng, campbellSvg, saveBlob} from './export.js';
 import {StructureEditor} from './editor.js';
 import {EXAMPLES} from './examples.js';
@@ -246,6 +246,15 @@ function renderOptions() {
   $('coriolis').checked = optValue('coriolis') === true;
   $('stiffening').checked = optValue('geometric_stiffening') === true;
   $('mode-shapes').checked = optValue('mode_shapes') === true;
+  // critical speeds: the orders of the request are the ones shown (both order fields)
+  $('critical').checked = Array.isArray(a.engine_orders);
+  if (Array.isArray(a.engine_orders)) setOrdersText(a.engine_orders.join(', '));
+  $('error-estimate').checked = a.error_estimate === true;
+}
+
+/** The engine orders typed (Analysis and the Campbell diagram show the same text). */
+function setOrdersText(t) {
+  for (const id of ['eo-orders', 'eo-list']) if ($(id).value !== t) $(id).value = t;
 }
 
 function showSpeedMode() {
@@ -349,6 +358,29 @@ bindOpt('modes-per-frame', 'modes_per_frame', (e) => (e.value.trim() === '' || e
 bindOpt('coriolis', 'coriolis', (e) => e.checked);
 bindOpt('stiffening', 'geometric_stiffening', (e) => e.checked);
 bindOpt('mode-shapes', 'mode_shapes', (e) => e.checked);
+// only when ticked: without it the key is absent and the job id is that of before (DESIGN.md 9.4)
+bindOpt('error-estimate', 'error_estimate', (e) => (e.checked ? true : undefined));
+
+/**
+ * "find critical speeds": the engine orders typed go to analysis.engine_orders
+ * (unticked: the key is absent, so the job id does not change).  The orders
+ * fields of the Analysis panel and of the Campbell diagram are one list.
+ */
+function ordersChanged(from) {
+  setOrdersText($(from).value);
+  if ($('critical').checked) {
+    an().engine_orders = parseOrders($('eo-orders').value);
+    docChanged('options');
+  }
+  updateChart();
+}
+$('critical').addEventListener('change', () => {
+  if ($('critical').checked) an().engine_orders = parseOrders($('eo-orders').value);
+  else delete an().engine_orders;
+  docChanged('options');
+});
+$('eo-orders').addEventListener('input', () => ordersChanged('eo-orders'));
+$('eo-list').addEventListener('input', () => ordersChanged('eo-list'));
 
 // --------------------------------------------------------------- errors
 
@@ -776,7 +808,7 @@ $('cancel').addEventListener('click', async () => {
 
 // ---------------------------------------------------------------- results
 
-const chart = campbellChart($('campbell'));
+const chart = campbellChart($('campbell'), (last) => errbarNote(last));
 
 function selectedCase() {
   const R = S.result;
@@ -836,6 +868,7 @@ function showResult(id, request, result) {
     JSON.stringify({request, result}, null, 1));
   dlMsg('');
   spanwiseControls();
+  criticalControls();
   const rw = api.warningsOf(result);
   if (rw.length && JSON.stringify(request) === JSON.stringify(S.doc)) {
     const have = new Set(S.warnings.map((w) => w.pointer + '\n' + w.message));
@@ -919,20 +952,33 @@ function tableRows(result) {
   const u = units();
   const cases = (result.cases || []).slice().sort((a, b) => a.omega - b.omega);
   const n = cases.reduce((m, c) => Math.max(m, (c.modes || []).length), 0);
+  const hasLabel = cases.some((c) => (c.modes || []).some((m) => m && typeof m.label === 'string'));
+  const hasErr = cases.some((c) => (c.modes || []).some((m) => m && 'error_estimate' in m));
+  const fl = FREQ_UNITS[u.freq].label;
   const head = [`speed (${SPEED_UNITS[u.speed].label})`, 'status'];
-  for (let k = 1; k <= n; k++) head.push(`mode ${k} (${FREQ_UNITS[u.freq].label})`);
+  for (let k = 1; k <= n; k++) {
+    head.push(`mode ${k} (${fl})`);
+    if (hasErr) head.push(`mode ${k} ± (${fl})`);
+    if (hasLabel) head.push(`mode ${k} label`);
+  }
   const rows = cases.map((c) => {
     const sp = u.speed === 'rpm' ? (typeof c.rpm === 'number' ? c.rpm : c.omega * 60 / (2 * Math.PI)) : c.omega;
     const r = [sp, c.status];
-    for (let k = 0; k < n; k++) r.push(freqIn(u.freq, (c.modes || [])[k], c.omega));
+    for (let k = 0; k < n; k++) {
+      const m = (c.modes || [])[k];
+      r.push(freqIn(u.freq, m, c.omega));
+      if (hasErr) r.push(errIn(u.freq, m, c.omega));
+      if (hasLabel) r.push(m && typeof m.label === 'string' ? m.label : null);
+    }
     return r;
   });
-  return {head, rows, cases, n};
+  return {head, rows, cases, n, hasLabel, hasErr};
 }
 
 function freqTable(result) {
   const u = units();
-  const {rows, cases, n} = tableRows(result);
+  const {rows, cases, n, hasLabel, hasErr} = tableRows(result);
+  const per = 1 + (hasErr ? 1 : 0) + (hasLabel ? 1 : 0); // values per mode in a row
   const thead = $('freq-table').tHead, tbody = $('freq-table').tBodies[0];
   thead.textContent = '';
   tbody.textContent = '';
@@ -946,8 +992,13 @@ function freqTable(result) {
   hr.append(th(`Ω (${SPEED_UNITS[u.speed].label})`), th('status'));
   const fsym = u.freq === 'hz' ? 'f' : u.freq === 'rev' ? 'ω/Ω' : 'ω';
   for (let k = 1; k <= n; k++) {
-    const lab = cases.map((c) => (c.modes || [])[k - 1]).find((m) => m && typeof m.label === 'string');
-    hr.append(th(`${fsym}<sub>${k}</sub> (${FREQ_UNITS[u.freq].label})` + (lab ? `<br><span class="mlabel">${lab.label}</span>` : '')));
+    hr.append(th(`${fsym}<sub>${k}</sub> (${FREQ_UNITS[u.freq].label})` + (hasErr ? ' ± error' : '')));
+    if (hasLabel) {
+      const e = th(`label<sub>${k}</sub>`);
+      e.className = 'mlabel';
+      e.title = 'The mode\'s kind by its strain energy (flap, edge, torsion, axial, bending; coupled when no part exceeds 60 %), numbered by frequency at that speed';
+      hr.append(e);
+    }
   }
   rows.forEach((r, i) => {
     const c = cases[i];
@@ -964,7 +1015,29 @@ function freqTable(result) {
       st.className = 'warned';
     }
     if (c.status !== 'solved') st.className = 'bad';
-    for (let k = 0; k < n; k++) tr.insertCell().textContent = r[2 + k] === null ? '–' : sig(r[2 + k]);
+    for (let k = 0; k < n; k++) {
+      const v = r[2 + per * k];
+      const td = tr.insertCell();
+      td.className = 'fq';
+      td.textContent = v === null ? '–' : sig(v);
+      if (hasErr) {
+        const e = r[3 + per * k];
+        const sp = document.createElement('span');
+        sp.className = 'pm';
+        sp.textContent = e === null ? '' : ` ± ${sig(e, 2)}`;
+        if (e !== null) sp.dataset.err = String(e);
+        td.title = e === null ? 'no error estimate for this mode (not matched in the refined meshes)'
+          : `estimated distance to the converged beam model: ${sig(e, 3)} ${FREQ_UNITS[u.freq].label}`;
+        td.append(sp);
+      }
+      if (hasLabel) {
+        const m = (c.modes || [])[k];
+        const lt = tr.insertCell();
+        lt.className = 'mlabel';
+        lt.textContent = m && typeof m.label === 'string' ? m.label : '';
+        if (m && typeof m.label_confidence === 'number') lt.title = `confidence ${sig(m.label_confidence, 3)} (dominant strain-energy fraction)`;
+      }
+    }
   });
 }
 
@@ -999,16 +1072,11 @@ function updateChart() {
   if (!S.result) return;
   const orders = parseOrders($('eo-list').value);
   const u = units();
-  const labels = [];
-  for (const c of S.result.result.cases || []) {
-    (c.modes || []).forEach((m, k) => {
-      if (!labels[k] && m && typeof m.label === 'string') labels[k] = m.label;
-    });
-  }
   const ref = S.ref && S.ref.id !== S.result.id ? S.ref.result : null;
   $('ref-note').hidden = !ref;
   $('ref-note').textContent = ref ? `Dashed thin lines: the reference result ${S.ref.label}.` : '';
-  const d = chart.update({result: S.result.result, orders, units: u, ref, labels});
+  const critical = criticalOf(S.result);
+  const d = chart.update({result: S.result.result, orders, units: u, ref, critical});
   const tb = $('crossings').tBodies[0];
   $('cross-speed-h').textContent = `Ω (${SPEED_UNITS[u.speed].label})`;
   $('cross-freq-h').textContent = `${FREQ_UNITS[u.freq].sym} (${FREQ_UNITS[u.freq].label})`;
@@ -1017,15 +1085,91 @@ function updateChart() {
     const tr = tb.insertRow();
     const sp = SPEED_UNITS[u.speed].of(c.omega);
     const f = u.freq === 'rev' ? c.order : FREQ_UNITS[u.freq].of(c.freq, c.omega);
-    for (const v of [`mode ${c.mode}`, `${c.order}P`, sig(sp, 5), sig(f, 5)]) tr.insertCell().textContent = v;
+    for (const v of [c.name, `${c.order}P`, sig(sp, 5), sig(f, 5)]) tr.insertCell().textContent = v;
   }
+  // the orders the daemon covered are in the critical-speed table; the others (if any) here
+  const left = orders.filter((k) => !(critical && critical.orders.includes(k)));
+  $('crossings').hidden = !left.length;
   if (!d.cross.length) {
     const td = tb.insertRow().insertCell();
     td.colSpan = 4;
     td.textContent = d.rows.length > 1 ? 'none in the speed range' : 'a sweep is needed';
   }
+  $('critical-hint').hidden = !!critical || d.rows.length < 2 || !orders.length;
+  criticalTable(critical);
 }
-$('eo-list').addEventListener('input', updateChart);
+
+/**
+ * The result's critical speeds (DESIGN.md 9.1) for the chart: {orders (the
+ * request's engine_orders, else those listed), points}, or null without them.
+ */
+function criticalOf(R) {
+  const cs = R && R.result && Array.isArray(R.result.critical_speeds) ? R.result.critical_speeds : null;
+  if (!cs) return null;
+  const req = R.request && R.request.analysis && Array.isArray(R.request.analysis.engine_orders)
+    ? R.request.analysis.engine_orders : null;
+  return {
+    orders: (req || cs.map((c) => c.order)).map(Number),
+    points: cs.map((c) => ({order: c.order, line: c.tracked_index, label: c.label, omega: c.omega, rpm: c.rpm,
+      freq: c.frequency_rad_s, refined: c.refined === true})),
+  };
+}
+
+/** The daemon's critical speeds in the units shown: order, mode label, speed, frequency, refined. */
+function criticalTable(critical) {
+  const R = S.result;
+  const cs = R && Array.isArray(R.result.critical_speeds) ? R.result.critical_speeds : null;
+  const t = $('critical-table');
+  t.hidden = !critical;
+  const tb = t.tBodies[0];
+  tb.textContent = '';
+  if (!cs) return;
+  const u = units();
+  $('crit-speed-h').textContent = `Ω (${SPEED_UNITS[u.speed].label})`;
+  $('crit-freq-h').textContent = `${FREQ_UNITS[u.freq].sym} (${FREQ_UNITS[u.freq].label})`;
+  for (const c of cs) {
+    const tr = tb.insertRow();
+    const sp = u.speed === 'rpm' ? (typeof c.rpm === 'number' ? c.rpm : c.omega * 60 / (2 * Math.PI)) : c.omega;
+    const f = u.freq === 'hz' ? (typeof c.frequency_hz === 'number' ? c.frequency_hz : c.frequency_rad_s / (2 * Math.PI))
+      : u.freq === 'rev' ? c.order : c.frequency_rad_s;
+    const cells = [[`${c.order}P`, c.order], [c.label || `line ${c.tracked_index}`, c.label], [sig(sp, 6), sp], [sig(f, 6), f],
+      [c.refined ? 'yes' : 'no', c.refined]];
+    for (const [text, v] of cells) {
+      const td = tr.insertCell();
+      td.textContent = text;
+      td.dataset.value = String(v);
+    }
+    const sw = tr.cells[1];
+    sw.style.borderLeft = `4px solid ${COLORS[c.tracked_index % COLORS.length]}`;
+    if (!c.refined) tr.cells[4].title = 'interpolated between the speeds of the sweep; the refining solve found no equilibrium or lost the mode';
+    else tr.cells[4].title = `refined by ${c.refine_solves} solve(s) at single speeds, |ω − kΩ|/kΩ = ${sig(c.residual, 2)}`;
+  }
+  if (!cs.length) {
+    const td = tb.insertRow().insertCell();
+    td.colSpan = 5;
+    td.textContent = 'none in the speed range';
+  }
+}
+
+/** Say how the error bars are shown: drawn where longer than the point, else only in the tooltip. */
+function errbarNote(last) {
+  const n = $('errbar-note');
+  const e = last && last.errDrawn;
+  if (!e || !e.total) {
+    n.hidden = true;
+    return;
+  }
+  n.hidden = false;
+  const fu = FREQ_UNITS[last.units.freq].label;
+  n.textContent = e.hidden && !e.drawn
+    ? `Error bars (± up to ${sig(e.max, 2)} ${fu}) are too small to see at this scale: point at a mode to read its ±, or zoom in.`
+    : `Error bars: ± the estimated error of each frequency (up to ${sig(e.max, 2)} ${fu})` +
+      (e.hidden ? `; ${e.hidden} too small to see at this scale (point at a mode to read its ±).` : '.');
+  n.title = 'error_estimate of each frequency: refined meshes (2×, 4× the elements) and Richardson extrapolation; ' +
+    `a bar is drawn where it reaches beyond its point marker (${e.drawn} drawn, ${e.hidden} smaller).`;
+  n.dataset.drawn = String(e.drawn);
+  n.dataset.hidden = String(e.hidden);
+}
 $('freq-unit').addEventListener('change', showUnits);
 $('speed-unit').addEventListener('change', showUnits);
 $('zoom-reset').addEventListener('click', updateChart);
@@ -1068,7 +1212,10 @@ function startMode() {
     const fu = units().freq;
     const other = fu === 'hz' ? `${sig(m.frequency_rad_s)} rad/s` : `${sig(m.frequency_hz)} Hz`;
     desc.textContent = `mode ${k + 1}${typeof m.label === 'string' ? ` (${m.label})` : ''} at Ω = ${speedText(c)}: ` +
-      `${FREQ_UNITS[fu].sym} = ${freqText(m, c)} (${other})` +
+      `${FREQ_UNITS[fu].sym} = ${freqText(m, c)}` +
+      (errIn(fu, m, c.omega) !== null ? ` ± ${sig(errIn(fu, m, c.omega), 2)}` : '') + ` (${other})` +
+      (Number.isInteger(m.tracked_index) && m.tracking_flag ? `, ${m.tracking_flag} with ` +
+        `${lineName(m.tracking_partner)}` : '') +
       (m.shape.im ? ', complex (gyroscopic): u(t) = Re((re + i·im)·e^{iωt})' : '') +
       '. Grey: undeformed; blue line: steady shape; animated: the mode, one cycle every 2 s' +
       (modeIn3d() ? '; faint: its shadow on the hub plane. Drag to turn the view.' : '.');
@@ -1076,6 +1223,12 @@ function startMode() {
   svg.dataset.mode = String(k);
   svg.dataset.case = $('mode-speed').value;
   showSpanwisePlot();
+}
+
+/** The Campbell name of a tracked line of the result shown. */
+function lineName(id) {
+  const l = S.result ? campbellData(S.result.result).lines.find((x) => x.id === id) : null;
+  return l ? l.name : `line ${id}`;
 }
 
 /** (Re)build the mode view of the selected case and mode, in the plane or in 3D, at the current phase. */
@@ -1385,6 +1538,45 @@ async function downloadShapes(format) {
   dlMsg(`saved ${name} (your downloads)`, 'ok');
 }
 $('dl-spanwise').addEventListener('click', () => downloadShapes('spanwise'));
+
+/** "Critical speeds (CSV)": the daemon's ?format=critical of a job whose result has critical_speeds. */
+function criticalControls() {
+  const R = S.result;
+  const has = R && Array.isArray(R.result.critical_speeds);
+  const job = R && !/^file/.test(R.id);
+  const why = !R ? 'no result' : !has ? 'this result has no critical speeds: tick "find critical speeds" (Analysis) and solve'
+    : !job ? 'a result opened from a file: the daemon has no job to serve the CSV from' : '';
+  const b = $('dl-critical');
+  b.disabled = !!why || b.dataset.busy === '1';
+  b.title = why || 'The critical speeds as CSV (order, tracked mode, label, Ω in rad/s and rpm, frequency, refined …): ' +
+    'GET …/result?format=critical';
+  $('critical-dl').title = why;
+  $('critical-dl').hidden = !has;
+}
+$('dl-critical').addEventListener('click', async () => {
+  const R = S.result;
+  if (!R) return;
+  const b = $('dl-critical');
+  b.dataset.busy = '1';
+  b.disabled = true;
+  dlMsg('fetching the critical speeds…');
+  let r;
+  try {
+    r = await api.getResultFile(R.id, 'critical');
+  } catch (e) {
+    r = {ok: false, message: `cannot reach the daemon: ${e.message}`};
+  }
+  delete b.dataset.busy;
+  criticalControls();
+  if (!r.ok) {
+    dlMsg(`critical speeds: ${r.status ? r.status + ' ' : ''}${r.message}`, 'bad');
+    return;
+  }
+  const name = `spinmodal-${R.id.slice(0, 12)}-critical.csv`;
+  S.lastExport = {name, type: r.blob.type, size: r.blob.size};
+  saveBlob(r.blob, name);
+  dlMsg(`saved ${name} (your downloads)`, 'ok');
+});
 $('dl-bmodes').addEventListener('click', () => downloadShapes('bmodes'));
 
 let spanSeq = 0;
