@@ -12,7 +12,10 @@
  * With K_red positive definite (K_red = L L') the gyroscopic problem is the
  * Hermitian eigenproblem of size 2r of  -i H,  H = [[0, B], [-B', -G]],
  * B = L' U11^-1, G = U11^-T C_yy U11^-1 (skew): exactly real frequencies.
- * Otherwise the companion form goes to dgeev.
+ * It is solved in the inverse form i H^-1 (eigenvalues 1/w), which resolves
+ * the lowest frequencies relative to themselves, as the undamped path does
+ * with L^-1 M L^-T; modes far above the lowest (w^2 > w_1 w_max) come from
+ * -i H itself.  Otherwise the companion form goes to dgeev.
  */
 #include "internal.h"
 
@@ -82,6 +85,9 @@ static int eig_definite(int n, const double *A, double *L, int *chol, int *neg)
     memcpy(L, A, (size_t)n * n * sizeof(double));
     return eig_inertia(n, L, neg);
 }
+
+/* Directions added to the k requested in the Rayleigh-Ritz basis of the gyroscopic solve. */
+#define EIG_GUARD 4
 
 typedef struct eig_split {
     int r, z;        /* range and null dimensions */
@@ -335,7 +341,7 @@ done:
 
 /* y = S x for S = [[0, B], [-B', -G]] (2r x 2r, real skew) and the real
  * 2r x m block x (leading dimension 2r). */
-static void eig_skew_apply(int r, const double *B, const double *G, int m, const double *x, double *y)
+static void eig_dir_apply(int r, const double *B, const double *G, int m, const double *x, double *y)
 {
     int N2 = 2 * r;
     /* top = B x2;  bottom = -B' x1 - G x2 */
@@ -345,6 +351,7 @@ static void eig_skew_apply(int r, const double *B, const double *G, int m, const
 }
 
 /*
+ * The direct form (the route of the frequencies far above the lowest, eig_gyro_hermitian).
  * The k lowest positive eigenpairs of the Hermitian matrix -i S, S real
  * skew (above), without complex arithmetic on the 2r-sized problem:
  * S'S = -S^2 = [[B B', B G], [-G B', B'B + G'G]] is real symmetric with the
@@ -356,7 +363,7 @@ static void eig_skew_apply(int r, const double *B, const double *G, int m, const
  * quarter of the floating-point work of zheevr on -i S.  Returns SM_OK, or
  * SM_LAPACK_FAILED when the caller should fall back to zheevr.
  */
-static int eig_skew_lowest(int r, const double *B, const double *G, int k, double *w, double complex *Y)
+static int eig_dir_lowest(int r, const double *B, const double *G, int k, double *w, double complex *Y)
 {
     int N2 = 2 * r, m2 = 2 * k < N2 ? 2 * k : N2, found = 0, acc = 0, rc = SM_NOMEM;
     double *A = dm_vec((size_t)N2 * N2), *ev = dm_vec((size_t)N2), *V = dm_vec((size_t)N2 * m2);
@@ -381,7 +388,7 @@ static int eig_skew_lowest(int r, const double *B, const double *G, int k, doubl
     rc = SM_LAPACK_FAILED; /* from here on: the caller falls back to zheevr */
     if (found != m2)
         goto done;
-    eig_skew_apply(r, B, G, m2, V, SV);
+    eig_dir_apply(r, B, G, m2, V, SV);
     /* candidates y = v - i S v / w, orthonormalised (twice) against the accepted ones */
     for (int j = 0; j < m2 && acc < k; j++) {
         if (!(ev[j] > 1e-14 * ev[m2 - 1]))
@@ -421,8 +428,8 @@ static int eig_skew_lowest(int r, const double *B, const double *G, int k, doubl
     if (acc < k)
         goto done;
     /* Rayleigh-Ritz: T = Y* (-i S) Y, Y <- Y Q */
-    eig_skew_apply(r, B, G, k, Yr, SYr);
-    eig_skew_apply(r, B, G, k, Yi, SYi);
+    eig_dir_apply(r, B, G, k, Yr, SYr);
+    eig_dir_apply(r, B, G, k, Yi, SYi);
     for (size_t i = 0; i < (size_t)N2 * k; i++) {
         Q[i] = Yr[i] + I * Yi[i];
         SY[i] = -I * (SYr[i] + I * SYi[i]);
@@ -455,7 +462,7 @@ done:
 }
 
 /* The k lowest positive eigenpairs of -i S by zheevr (the fallback). */
-static int eig_skew_zheevr(int r, const double *B, const double *G, int k, double *w, double complex *Y)
+static int eig_dir_zheevr(int r, const double *B, const double *G, int k, double *w, double complex *Y)
 {
     int N2 = 2 * r, found = 0, rc = SM_NOMEM;
     double complex *H = calloc((size_t)N2 * N2, sizeof(double complex));
@@ -486,15 +493,238 @@ done:
     return rc;
 }
 
-/* Gyroscopic problem with K_red = L L' positive definite: Hermitian form. */
-static int eig_gyro_hermitian(int n, const eig_split *sp, const double *L, const double *Cy, int k,
-                              sm_eig_out *o)
+/*
+ * The gyroscopic problem is solved in the inverse of the real skew form of the header,
+ *   S = [[0, B], [-B', -G]],  B = L' U^-1,  G = U^-T C_yy U^-1:
+ *   E = S^-1 = [[-F, -D'], [D, 0]],  D = B^-1 = U L^-T,  F = D' G D = L^-1 C_yy L^-T (skew).
+ * S y = i w y  <=>  i E y = (1/w) y: the lowest frequencies are the largest eigenvalues of the
+ * Hermitian i E and are resolved relative to themselves, as in eig_undamped_inverse (at rest,
+ * F = 0 and E'E = diag(D'D, D D'), D'D = L^-1 M_yy L^-T: that very matrix).  The form S
+ * resolves w^2 only to eps w_max^2: a near-inextensible blade (EA = 1e14, w_max^2 ~ 1e16 at 64
+ * elements) lost its first frequency to 6e-3 (DESIGN.md 9.4).
+ */
+
+/* y = E x for E = [[-F, -D'], [D, 0]] (2r x 2r, real skew) and the real 2r x m block x
+ * (leading dimension 2r). */
+static void eig_inv_apply(int r, const double *D, const double *F, int m, const double *x, double *y)
 {
-    int r = sp->r, N2 = 2 * r, rc = SM_NOMEM;
-    double *B = dm_vec((size_t)r * r), *G = dm_vec((size_t)r * r), *w = dm_vec((size_t)k);
-    double *ar = dm_vec((size_t)r), *ai = dm_vec((size_t)r);
-    double complex *Y = calloc((size_t)N2 * k, sizeof(double complex));
-    if (!B || !G || !w || !ar || !ai || !Y || eig_alloc_out(o, n, k))
+    int N2 = 2 * r;
+    /* top = -F x1 - D' x2;  bottom = D x1 */
+    cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, r, m, r, -1.0, F, r, x, N2, 0.0, y, N2);
+    cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, r, m, r, -1.0, D, r, x + r, N2, 1.0, y, N2);
+    cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, r, m, r, 1.0, D, r, x, N2, 0.0, y + r, N2);
+}
+
+/* The first k columns of Q (ld 2r, kk columns) T (kk x kk) in reverse order into Y (ld 2r):
+ * ascending 1/w from zheev become ascending w. */
+static void eig_inv_reverse(int N2, int kk, int k, const double complex *Q, const double complex *T,
+                            double complex *Y)
+{
+    for (int j = 0; j < k; j++) {
+        const double complex *t = T + (size_t)(kk - 1 - j) * kk;
+        double complex *y = Y + (size_t)j * N2;
+        for (int i = 0; i < N2; i++)
+            y[i] = 0;
+        for (int p = 0; p < kk; p++)
+            for (int i = 0; i < N2; i++)
+                y[i] += Q[(size_t)p * N2 + i] * t[p];
+    }
+}
+
+/* Lower triangle of E'E = -E^2 = [[F'F + D'D, -F D'], [D F, D D']] into A (ld 2r); real
+ * symmetric with the eigenvalues 1/w^2, each twice. */
+static void eig_inv_square(int r, const double *D, const double *F, double *A)
+{
+    int N2 = 2 * r;
+    cblas_dsyrk(CblasColMajor, CblasLower, CblasTrans, r, r, 1.0, F, r, 0.0, A, N2);
+    cblas_dsyrk(CblasColMajor, CblasLower, CblasTrans, r, r, 1.0, D, r, 1.0, A, N2);
+    cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, r, r, r, 1.0, D, r, F, r, 0.0, A + r, N2);
+    cblas_dsyrk(CblasColMajor, CblasLower, CblasNoTrans, r, r, 1.0, D, r, 0.0, A + (size_t)r * N2 + r, N2);
+}
+
+/*
+ * The k lowest frequencies w (ascending) and the vectors y (S y = i w y) of the Hermitian
+ * i E = (-i S)^-1, without complex arithmetic on the 2r-sized problem: dsyevr gives the 2k
+ * largest eigenvalues 1/w^2 of E'E; each real eigenvector v yields y = v + i w E v with
+ * i E y = y / w; the candidates are orthonormalised (a pair gives one direction) and a
+ * Rayleigh-Ritz step on i E restores full accuracy (the squared problem alone loses digits of a
+ * frequency to the lowest one) and separates close frequencies.  About a quarter of the
+ * floating-point work of zheevr on i E.  Returns SM_OK, or SM_LAPACK_FAILED when the caller
+ * should fall back to zheevr.
+ */
+static int eig_skew_lowest(int r, const double *D, const double *F, int k, double *w, double complex *Y)
+{
+    /* kk = k + EIG_GUARD directions: a frequency just above the k-th (a close pair at the end
+     * of the request) is then separated by the Rayleigh-Ritz step, not left out of the basis */
+    int kk = k + EIG_GUARD < r ? k + EIG_GUARD : r, N2 = 2 * r, m2 = 2 * kk, found = 0, acc = 0, rc = SM_NOMEM;
+    double *A = dm_vec((size_t)N2 * N2), *ev = dm_vec((size_t)N2), *V = dm_vec((size_t)N2 * m2);
+    double *EV = dm_vec((size_t)N2 * m2), *Yr = dm_vec((size_t)N2 * kk), *Yi = dm_vec((size_t)N2 * kk);
+    double *EYr = dm_vec((size_t)N2 * kk), *EYi = dm_vec((size_t)N2 * kk), *th = dm_vec((size_t)kk);
+    double complex *T = calloc((size_t)kk * kk, sizeof(double complex));
+    double complex *EY = calloc((size_t)N2 * kk, sizeof(double complex));
+    double complex *Q = calloc((size_t)N2 * kk, sizeof(double complex));
+    int *sup = malloc(2 * (size_t)m2 * sizeof(int));
+    if (!A || !ev || !V || !EV || !Yr || !Yi || !EYr || !EYi || !th || !T || !EY || !Q || !sup)
+        goto done;
+    eig_inv_square(r, D, F, A);
+    rc = dm_lapack_status(LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', N2, A, N2, 0, 0, N2 - m2 + 1, N2, 0.0,
+                                         &found, ev, V, N2, sup),
+                          SM_LAPACK_FAILED);
+    if (rc < 0)
+        goto done;
+    rc = SM_LAPACK_FAILED; /* from here on: the caller falls back to zheevr */
+    if (found != m2)
+        goto done;
+    eig_inv_apply(r, D, F, m2, V, EV);
+    /* candidates y = v + i E v / mu (mu = 1/w), largest mu first, orthonormalised (twice)
+     * against the accepted ones */
+    for (int j = m2 - 1; j >= 0 && acc < kk; j--) {
+        if (!(ev[j] > 1e-14 * ev[m2 - 1]))
+            goto done;
+        double mu = sqrt(ev[j]), *yr = Yr + (size_t)acc * N2, *yi = Yi + (size_t)acc * N2, nrm = 0;
+        for (int i = 0; i < N2; i++) {
+            yr[i] = V[(size_t)j * N2 + i];
+            yi[i] = EV[(size_t)j * N2 + i] / mu;
+            nrm += yr[i] * yr[i] + yi[i] * yi[i];
+        }
+        double nrm0 = sqrt(nrm);
+        for (int pass = 0; pass < 2; pass++)
+            for (int a = 0; a < acc; a++) {
+                const double *ur = Yr + (size_t)a * N2, *ui = Yi + (size_t)a * N2;
+                double cr = 0, ci = 0; /* c = u* y */
+                for (int i = 0; i < N2; i++) {
+                    cr += ur[i] * yr[i] + ui[i] * yi[i];
+                    ci += ur[i] * yi[i] - ui[i] * yr[i];
+                }
+                for (int i = 0; i < N2; i++) {
+                    yr[i] -= cr * ur[i] - ci * ui[i];
+                    yi[i] -= cr * ui[i] + ci * ur[i];
+                }
+            }
+        nrm = 0;
+        for (int i = 0; i < N2; i++)
+            nrm += yr[i] * yr[i] + yi[i] * yi[i];
+        nrm = sqrt(nrm);
+        if (nrm < 0.25 * nrm0)
+            continue; /* the other half of an accepted pair */
+        for (int i = 0; i < N2; i++) {
+            yr[i] /= nrm;
+            yi[i] /= nrm;
+        }
+        acc++;
+    }
+    if (acc < kk)
+        goto done;
+    /* Rayleigh-Ritz: T = Y* (i E) Y, Y <- Y Q */
+    eig_inv_apply(r, D, F, kk, Yr, EYr);
+    eig_inv_apply(r, D, F, kk, Yi, EYi);
+    for (size_t i = 0; i < (size_t)N2 * kk; i++) {
+        Q[i] = Yr[i] + I * Yi[i];
+        EY[i] = I * (EYr[i] + I * EYi[i]);
+    }
+    const double complex one = 1, zero = 0;
+    cblas_zgemm(CblasColMajor, CblasConjTrans, CblasNoTrans, kk, kk, N2, &one, Q, N2, EY, N2, &zero, T, kk);
+    rc = dm_lapack_status(LAPACKE_zheev(LAPACK_COL_MAJOR, 'V', 'L', kk, T, kk, th), SM_LAPACK_FAILED);
+    if (rc == SM_OK && !(th[0] > 0))
+        rc = SM_LAPACK_FAILED;
+    if (rc < 0)
+        goto done;
+    eig_inv_reverse(N2, kk, k, Q, T, Y);
+    for (int j = 0; j < k; j++)
+        w[j] = 1.0 / th[kk - 1 - j];
+    rc = SM_OK;
+done:
+    free(A);
+    free(ev);
+    free(V);
+    free(EV);
+    free(Yr);
+    free(Yi);
+    free(EYr);
+    free(EYi);
+    free(th);
+    free(T);
+    free(EY);
+    free(Q);
+    free(sup);
+    return rc;
+}
+
+/* The k lowest frequencies and vectors of i E by zheevr (the fallback). */
+static int eig_skew_zheevr(int r, const double *D, const double *F, int k, double *w, double complex *Y)
+{
+    int N2 = 2 * r, found = 0, rc = SM_NOMEM;
+    double complex *H = calloc((size_t)N2 * N2, sizeof(double complex));
+    double complex *Z = calloc((size_t)N2 * k, sizeof(double complex));
+    double *wall = dm_vec((size_t)N2);
+    int *sup = malloc(2 * (size_t)k * sizeof(int));
+    if (!H || !Z || !wall || !sup)
+        goto done;
+    /* i E, lower triangle: [[-i F, .], [i D, 0]] */
+    for (int j = 0; j < r; j++)
+        for (int i = 0; i < r; i++) {
+            H[(size_t)j * N2 + (r + i)] = I * D[(size_t)j * r + i]; /* (r+i, j) = i D(i,j) */
+            if (i >= j)
+                H[(size_t)j * N2 + i] = -I * F[(size_t)j * r + i];  /* (i, j) = -i F(i,j) */
+        }
+    rc = dm_lapack_status(LAPACKE_zheevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', N2, H, N2, 0, 0, N2 - k + 1, N2, 0.0,
+                                         &found, wall, Z, N2, sup),
+                          SM_LAPACK_FAILED);
+    if (rc == SM_OK && (found != k || !(wall[0] > 0)))
+        rc = SM_LAPACK_FAILED;
+    if (rc < 0)
+        goto done;
+    for (int j = 0; j < k; j++) { /* ascending 1/w: descending w */
+        w[j] = 1.0 / wall[k - 1 - j];
+        memcpy(Y + (size_t)j * N2, Z + (size_t)(k - 1 - j) * N2, (size_t)N2 * sizeof(double complex));
+    }
+    rc = SM_OK;
+done:
+    free(H);
+    free(Z);
+    free(wall);
+    free(sup);
+    return rc;
+}
+
+/* sqrt(max_i Kr_ii / M_ii): a lower estimate of the highest frequency of the condensed problem
+ * (M_yy = U'U). */
+static double eig_wmax_estimate(const eig_split *sp)
+{
+    int r = sp->r;
+    double w2 = 0;
+    for (int i = 0; i < r; i++) {
+        double m = 0;
+        for (int p = 0; p <= i; p++)
+            m += sp->U[(size_t)i * r + p] * sp->U[(size_t)i * r + p];
+        w2 = fmax(w2, sp->Kr[(size_t)i * r + i] / m);
+    }
+    return sqrt(w2);
+}
+
+/*
+ * Frequencies from i E carry a relative rounding error ~eps w_j / w_1 (their vectors likewise),
+ * those of the direct form -i S ~eps w_max / w_j: from the first j0 with w_j^2 > w_1 w_max on
+ * (only a request that reaches near the top of the spectrum, or a nearly free coordinate with
+ * w_1 ~ 0) the modes are taken from the direct form, solved for the k lowest as well.  j0 is
+ * moved past a cluster (a pair of nearly equal frequencies comes from one form).  A failure of
+ * the direct form keeps the inverse one's modes.  Returns SM_OK or SM_NOMEM.
+ */
+static int eig_gyro_direct(const eig_split *sp, const double *L, const double *Cy, int k, double *w,
+                           double complex *Y)
+{
+    int r = sp->r, N2 = 2 * r, j0 = 0, rc = SM_OK;
+    double wmax = eig_wmax_estimate(sp);
+    while (j0 < k && !(w[j0] * w[j0] > w[0] * wmax))
+        j0++;
+    while (j0 > 0 && j0 < k && w[j0] - w[j0 - 1] < 1e-6 * w[j0])
+        j0++;
+    if (j0 >= k)
+        return SM_OK;
+    double *B = dm_vec((size_t)r * r), *G = dm_vec((size_t)r * r), *wd = dm_vec((size_t)k);
+    double complex *Yd = calloc((size_t)N2 * k, sizeof(double complex));
+    rc = SM_NOMEM;
+    if (!B || !G || !wd || !Yd)
         goto done;
     /* B = L' U^-1 */
     for (int j = 0; j < r; j++)
@@ -505,10 +735,47 @@ static int eig_gyro_hermitian(int n, const eig_split *sp, const double *L, const
     memcpy(G, Cy, (size_t)r * r * sizeof(double));
     cblas_dtrsm(CblasColMajor, CblasLeft, CblasUpper, CblasTrans, CblasNonUnit, r, r, 1.0, sp->U, r, G, r);
     cblas_dtrsm(CblasColMajor, CblasRight, CblasUpper, CblasNoTrans, CblasNonUnit, r, r, 1.0, sp->U, r, G, r);
-    rc = eig_skew_lowest(r, B, G, k, w, Y);
+    rc = eig_dir_lowest(r, B, G, k, wd, Yd);
     if (rc == SM_LAPACK_FAILED)
-        rc = eig_skew_zheevr(r, B, G, k, w, Y);
+        rc = eig_dir_zheevr(r, B, G, k, wd, Yd);
+    if (rc == SM_OK) {
+        memcpy(w + j0, wd + j0, (size_t)(k - j0) * sizeof(double));
+        memcpy(Y + (size_t)j0 * N2, Yd + (size_t)j0 * N2, (size_t)(k - j0) * N2 * sizeof(double complex));
+    }
+    rc = rc == SM_NOMEM ? SM_NOMEM : SM_OK;
+done:
+    free(B);
+    free(G);
+    free(wd);
+    free(Yd);
+    return rc;
+}
+
+/* Gyroscopic problem with K_red = L L' positive definite: Hermitian form. */
+static int eig_gyro_hermitian(int n, const eig_split *sp, const double *L, const double *Cy, int k,
+                              sm_eig_out *o)
+{
+    int r = sp->r, N2 = 2 * r, rc = SM_NOMEM;
+    double *D = dm_vec((size_t)r * r), *F = dm_vec((size_t)r * r), *w = dm_vec((size_t)k);
+    double *ar = dm_vec((size_t)r), *ai = dm_vec((size_t)r);
+    double complex *Y = calloc((size_t)N2 * k, sizeof(double complex));
+    if (!D || !F || !w || !ar || !ai || !Y || eig_alloc_out(o, n, k))
+        goto done;
+    /* D = U L^-T */
+    for (int j = 0; j < r; j++)
+        for (int i = 0; i <= j; i++)
+            D[(size_t)j * r + i] = sp->U[(size_t)j * r + i];
+    cblas_dtrsm(CblasColMajor, CblasRight, CblasLower, CblasTrans, CblasNonUnit, r, r, 1.0, L, r, D, r);
+    /* F = L^-1 C L^-T */
+    memcpy(F, Cy, (size_t)r * r * sizeof(double));
+    cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasNoTrans, CblasNonUnit, r, r, 1.0, L, r, F, r);
+    cblas_dtrsm(CblasColMajor, CblasRight, CblasLower, CblasTrans, CblasNonUnit, r, r, 1.0, L, r, F, r);
+    rc = eig_skew_lowest(r, D, F, k, w, Y);
+    if (rc == SM_LAPACK_FAILED)
+        rc = eig_skew_zheevr(r, D, F, k, w, Y);
     if (rc < 0)
+        goto done;
+    if ((rc = eig_gyro_direct(sp, L, Cy, k, w, Y)) < 0)
         goto done;
     o->max_re = 0;
     for (int j = 0; j < k; j++) {
@@ -526,8 +793,8 @@ static int eig_gyro_hermitian(int n, const eig_split *sp, const double *L, const
     }
     rc = SM_OK;
 done:
-    free(B);
-    free(G);
+    free(D);
+    free(F);
     free(w);
     free(ar);
     free(ai);
