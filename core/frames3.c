@@ -39,6 +39,13 @@ void sp_kin_free(sp_kin *k)
     free(k->cA);
     free(k->cF);
     free(k->cg);
+    free(k->lw);
+    free(k->lpsi);
+    free(k->lL);
+    free(k->lT);
+    free(k->bR);
+    free(k->bA);
+    free(k->mark);
     free(k->pt_ptr);
     free(k->pt_idx);
     free(k->ch_ptr);
@@ -106,7 +113,16 @@ int sp_kin_alloc(const sm_model *m, sp_kin *k, int jac)
     k->cA = calloc(9 * (size_t)S, sizeof(sp_cx));
     k->cF = calloc(6 * (size_t)S, sizeof(sp_cx));
     k->cg = calloc((size_t)n, sizeof(sp_cx));
+    k->lw = calloc(3 * (size_t)P + 1, sizeof(sp_cx));
+    k->lpsi = calloc(3 * (size_t)P + 1, sizeof(sp_cx));
+    k->lL = calloc(9 * (size_t)P + 1, sizeof(sp_cx));
+    k->lT = calloc(9 * (size_t)P + 1, sizeof(sp_cx));
+    k->bR = calloc(3 * (size_t)S + 1, sizeof(sp_cx));
+    k->bA = calloc(9 * (size_t)S + 1, sizeof(sp_cx));
+    k->mark = calloc((size_t)S + 1, sizeof(int));
+    k->pert = -1;
     if (!k->R || !k->A || !k->r || !k->psi || !k->AT || !k->dh || !k->cq || !k->cR || !k->cA || !k->cF || !k->cg ||
+        !k->lw || !k->lpsi || !k->lL || !k->lT || !k->bR || !k->bA || !k->mark ||
         sp_lists(m, k) || (jac && (dm_alloc(&k->JRT, n, 6 * S) || dm_alloc(&k->JW, n, 6 * P)))) {
         sp_kin_free(k);
         return SM_NOMEM;
@@ -132,30 +148,61 @@ static void sp_local(const sm_model *m, const sp_point *p, const sp_cx *q, sp_cx
     }
 }
 
+/*
+ * Local state of point pi at the complex q: w = ub + N^u q_s, psi = N^psi q_s, L = Lambda(psi),
+ * T = its tangent.  When k->lw holds the local state at the real base point of a complex-step
+ * Jacobian (sp_centrifugal_jacobian), only the points of the perturbed substructure k->pert
+ * are recomputed; the others are copied (the same operations on the same values: bitwise equal).
+ */
+static void sp_point_state(const sm_model *m, sp_kin *k, int pi, const sp_cx *q, int want_L, sp_cx w[3],
+                           sp_cx psi[3], sp_cx L[9], sp_cx T[9])
+{
+    const sp_point *p = &m->pt[pi];
+    if (k->cached && p->sub != k->pert) {
+        memcpy(w, k->lw + 3 * pi, 3 * sizeof(sp_cx));
+        memcpy(psi, k->lpsi + 3 * pi, 3 * sizeof(sp_cx));
+        if (want_L) {
+            memcpy(L, k->lL + 9 * pi, 9 * sizeof(sp_cx));
+            memcpy(T, k->lT + 9 * pi, 9 * sizeof(sp_cx));
+        }
+        return;
+    }
+    sp_local(m, p, q, w, psi);
+    if (want_L)
+        rot3_exp(psi, L, T);
+}
+
+/* Pose of frame s (not a root frame) at the complex q from its parent's pose in k->cR, k->cA. */
+static void sp_pose(const sm_model *m, sp_kin *k, int s, const sp_cx *q)
+{
+    const sm_sub *b = &m->subs[s];
+    sp_cx *R = k->cR + 3 * s, *A = k->cA + 9 * s;
+    const sp_cx *Rp = k->cR + 3 * b->parent, *Ap = k->cA + 9 * b->parent;
+    sp_cx w[3], psi[3], aw[3], L[9], T[9], AL[9], Ar[9];
+    sp_point_state(m, k, b->root, q, 1, w, psi, L, T);
+    rot3_mv(Ap, w, aw);
+    for (int i = 0; i < 3; i++)
+        R[i] = Rp[i] + aw[i]; /* R_c = R_s + A_s w_e */
+    rot3_mul(Ap, L, AL);
+    for (int i = 0; i < 9; i++)
+        Ar[i] = b->Arel[i];
+    rot3_mul(AL, Ar, A); /* A_c = A_s Lambda(psi_e) Arel_c */
+}
+
 /* Frame poses at the complex q into k->cR, k->cA (parents first). */
 static void sp_poses(const sm_model *m, const sp_cx *q, sp_kin *k)
 {
     for (int s = 0; s < m->n_subs; s++) {
         const sm_sub *b = &m->subs[s];
-        sp_cx *R = k->cR + 3 * s, *A = k->cA + 9 * s;
-        if (b->parent < 0) {
-            const sm_node *r = &m->nodes[b->root];
-            R[0] = r->x, R[1] = r->y, R[2] = r->z;
-            for (int i = 0; i < 9; i++)
-                A[i] = b->Arel[i];
+        if (b->parent >= 0) {
+            sp_pose(m, k, s, q);
             continue;
         }
-        const sp_cx *Rp = k->cR + 3 * b->parent, *Ap = k->cA + 9 * b->parent;
-        sp_cx w[3], psi[3], aw[3], L[9], AL[9], Ar[9];
-        sp_local(m, &m->pt[b->root], q, w, psi);
-        rot3_mv(Ap, w, aw);
-        for (int i = 0; i < 3; i++)
-            R[i] = Rp[i] + aw[i]; /* R_c = R_s + A_s w_e */
-        rot3_exp(psi, L, NULL);
-        rot3_mul(Ap, L, AL);
+        const sm_node *r = &m->nodes[b->root];
+        sp_cx *R = k->cR + 3 * s, *A = k->cA + 9 * s;
+        R[0] = r->x, R[1] = r->y, R[2] = r->z;
         for (int i = 0; i < 9; i++)
-            Ar[i] = b->Arel[i];
-        rot3_mul(AL, Ar, A); /* A_c = A_s Lambda(psi_e) Arel_c */
+            A[i] = b->Arel[i];
     }
 }
 
@@ -184,64 +231,77 @@ static void sp_apply(const sm_sub *b, const sp_point *p, const sp_cx A[9], const
     }
 }
 
+/* Force and moment (hub frame) of the centrifugal potential on point p of frame s at its local
+ * state (w, L), aw = A_s w: F = m P r (r = R + A w, + A Lambda c for an offset mass), Mo = the
+ * moment of F about the node at the offset plus (X e) x e, X e = A Lambda I Lambda' A' e. */
+static void sp_point_wrench(const sp_point *p, const sp_cx R[3], const sp_cx A[9], const sp_cx aw[3],
+                            const sp_cx L[9], sp_cx F[3], sp_cx Mo[3])
+{
+    static const sp_cx ez[3] = {0, 0, 1};
+    if (p->mass != 0) {
+        sp_cx dh[3] = {0, 0, 0};
+        if (p->has_c) {
+            sp_cx cc[3] = {p->c[0], p->c[1], p->c[2]}, lc[3];
+            rot3_mv(L, cc, lc);
+            rot3_mv(A, lc, dh);
+        }
+        F[0] = p->mass * (R[0] + aw[0] + dh[0]);
+        F[1] = p->mass * (R[1] + aw[1] + dh[1]);
+        if (p->has_c) /* F acts at the offset: its moment about the node, F.dr = (dh x F).dtheta */
+            rot3_cross(dh, F, Mo);
+    }
+    if (p->has_I) {
+        sp_cx v[3], u[3], Ic[9], y[3], z[3], mr[3];
+        for (int i = 0; i < 9; i++)
+            Ic[i] = p->I[i];
+        rot3_tmv(A, ez, v);
+        rot3_tmv(L, v, u);
+        rot3_mv(Ic, u, y);
+        rot3_mv(L, y, z);
+        rot3_mv(A, z, y);
+        rot3_cross(y, ez, mr);
+        for (int i = 0; i < 3; i++)
+            Mo[i] += mr[i];
+    }
+}
+
+/* The wrench recursion step of frame s at q (its pose and its children's wrenches in k): g_s and
+ * the subtree wrench (F, M about R_s) of s. */
+static void sp_frame_wrench(const sm_model *m, sp_kin *k, int s, const sp_cx *q)
+{
+    const sm_sub *b = &m->subs[s];
+    const sp_cx *A = k->cA + 9 * s;
+    sp_cx *Fs = k->cF + 6 * s, *Ms = Fs + 3, *gs = k->cg + b->q0;
+    for (int i = 0; i < 6; i++)
+        Fs[i] = 0;
+    for (int t = k->pt_ptr[s]; t < k->pt_ptr[s + 1]; t++) {
+        int pi = k->pt_idx[t];
+        const sp_point *p = &m->pt[pi];
+        int rot = p->has_I || p->has_c;
+        sp_cx w[3], psi[3], aw[3], F[3] = {0, 0, 0}, Mo[3] = {0, 0, 0}, L[9], T[9];
+        sp_point_state(m, k, pi, q, rot, w, psi, L, T);
+        rot3_mv(A, w, aw);
+        sp_point_wrench(p, k->cR + 3 * s, A, aw, L, F, Mo);
+        sp_apply(b, p, A, rot ? T : NULL, aw, F, Mo, gs, Fs, Ms);
+    }
+    for (int t = k->ch_ptr[s]; t < k->ch_ptr[s + 1]; t++) { /* the subtree wrench of each child */
+        int ch = k->ch_idx[t], pi = m->subs[ch].root;
+        const sp_cx *Fc = k->cF + 6 * ch, *Mc = Fc + 3;
+        sp_cx w[3], psi[3], aw[3], L[9], T[9];
+        sp_point_state(m, k, pi, q, 1, w, psi, L, T);
+        rot3_mv(A, w, aw);
+        sp_apply(b, &m->pt[pi], A, T, aw, Fc, Mc, gs, Fs, Ms);
+    }
+}
+
 /* g = dT0~/dq at the complex q (k->cq) into k->cg: poses, then the wrench recursion. */
 static void sp_centrifugal_c(const sm_model *m, sp_kin *k)
 {
-    static const sp_cx ez[3] = {0, 0, 1};
     const sp_cx *q = k->cq;
     sp_poses(m, q, k);
     memset(k->cg, 0, (size_t)m->n * sizeof(sp_cx));
-    for (int s = m->n_subs - 1; s >= 0; s--) { /* children first */
-        const sm_sub *b = &m->subs[s];
-        const sp_cx *A = k->cA + 9 * s;
-        sp_cx *Fs = k->cF + 6 * s, *Ms = Fs + 3, *gs = k->cg + b->q0;
-        for (int i = 0; i < 6; i++)
-            Fs[i] = 0;
-        for (int t = k->pt_ptr[s]; t < k->pt_ptr[s + 1]; t++) {
-            const sp_point *p = &m->pt[k->pt_idx[t]];
-            sp_cx w[3], psi[3], aw[3], F[3] = {0, 0, 0}, Mo[3] = {0, 0, 0}, L[9], T[9];
-            sp_local(m, p, q, w, psi);
-            rot3_mv(A, w, aw);
-            if (p->has_I || p->has_c)
-                rot3_exp(psi, L, T);
-            if (p->mass != 0) { /* F = m P r, r = R + A w (+ dh = A Lambda c for an offset mass) */
-                sp_cx dh[3] = {0, 0, 0};
-                if (p->has_c) {
-                    sp_cx cc[3] = {p->c[0], p->c[1], p->c[2]}, lc[3];
-                    rot3_mv(L, cc, lc);
-                    rot3_mv(A, lc, dh);
-                }
-                F[0] = p->mass * (k->cR[3 * s] + aw[0] + dh[0]);
-                F[1] = p->mass * (k->cR[3 * s + 1] + aw[1] + dh[1]);
-                if (p->has_c) /* F acts at the offset: its moment about the node, F.dr = (dh x F).dtheta */
-                    rot3_cross(dh, F, Mo);
-            }
-            if (p->has_I) { /* M += (X e) x e, X e = A Lambda I Lambda' A' e */
-                sp_cx v[3], u[3], Ic[9], y[3], z[3], mr[3];
-                for (int i = 0; i < 9; i++)
-                    Ic[i] = p->I[i];
-                rot3_tmv(A, ez, v);
-                rot3_tmv(L, v, u);
-                rot3_mv(Ic, u, y);
-                rot3_mv(L, y, z);
-                rot3_mv(A, z, y);
-                rot3_cross(y, ez, mr);
-                for (int i = 0; i < 3; i++)
-                    Mo[i] += mr[i];
-            }
-            sp_apply(b, p, A, p->has_I || p->has_c ? T : NULL, aw, F, Mo, gs, Fs, Ms);
-        }
-        for (int t = k->ch_ptr[s]; t < k->ch_ptr[s + 1]; t++) { /* the subtree wrench of each child */
-            int ch = k->ch_idx[t];
-            const sp_point *p = &m->pt[m->subs[ch].root];
-            const sp_cx *Fc = k->cF + 6 * ch, *Mc = Fc + 3;
-            sp_cx w[3], psi[3], aw[3], L[9], T[9];
-            sp_local(m, p, q, w, psi);
-            rot3_mv(A, w, aw);
-            rot3_exp(psi, L, T);
-            sp_apply(b, p, A, T, aw, Fc, Mc, gs, Fs, Ms);
-        }
-    }
+    for (int s = m->n_subs - 1; s >= 0; s--) /* children first */
+        sp_frame_wrench(m, k, s, q);
 }
 
 void sp_centrifugal(const sm_model *m, const double *q, sp_kin *k, double *g)
@@ -253,19 +313,82 @@ void sp_centrifugal(const sm_model *m, const double *q, sp_kin *k, double *g)
         g[i] = creal(k->cg[i]);
 }
 
+/* The local state of every point and the poses at the real q (k->cq): the base of the complex
+ * steps, saved in k->lw.., k->bR, k->bA. */
+static void sp_base(const sm_model *m, sp_kin *k)
+{
+    k->cached = 0;
+    sp_poses(m, k->cq, k);
+    memcpy(k->bR, k->cR, 3 * (size_t)m->n_subs * sizeof(sp_cx));
+    memcpy(k->bA, k->cA, 9 * (size_t)m->n_subs * sizeof(sp_cx));
+    for (int pi = 0; pi < m->n_pt; pi++)
+        if (m->pt[pi].sub >= 0)
+            sp_point_state(m, k, pi, k->cq, 1, k->lw + 3 * pi, k->lpsi + 3 * pi, k->lL + 9 * pi, k->lT + 9 * pi);
+    k->cached = 1;
+}
+
+/*
+ * One complex step in coordinate j of substructure s (k->cq[j] already imaginary): Im g into
+ * k->cg.  Only the subtree of s moves: its poses and wrenches are recomputed (the points of s
+ * from q, the others from the base state); above s the imaginary part of the wrench is carried
+ * to the root through the child on the path alone (the ancestors' own points and other children
+ * are real and unchanged, their imaginary contributions exactly zero).  Equal, bit for bit, to
+ * the whole recursion sp_centrifugal_c.
+ */
+static void sp_step(const sm_model *m, sp_kin *k, int s)
+{
+    const sp_cx *q = k->cq;
+    int S = m->n_subs;
+    k->pert = s;
+    memset(k->cg, 0, (size_t)m->n * sizeof(sp_cx));
+    k->mark[s] = 1;
+    for (int t = s + 1; t < S; t++) { /* the subtree of s: parents come first */
+        k->mark[t] = m->subs[t].parent >= 0 && k->mark[m->subs[t].parent];
+        if (k->mark[t])
+            sp_pose(m, k, t, q);
+    }
+    for (int t = S - 1; t >= s; t--)
+        if (k->mark[t])
+            sp_frame_wrench(m, k, t, q);
+    for (int c = s, a = m->subs[s].parent; a >= 0; c = a, a = m->subs[a].parent) {
+        const sm_sub *b = &m->subs[a];
+        int pi = m->subs[c].root;
+        sp_cx *Fs = k->cF + 6 * a;
+        for (int i = 0; i < 6; i++)
+            Fs[i] = 0;
+        sp_cx aw[3];
+        rot3_mv(k->cA + 9 * a, k->lw + 3 * pi, aw);
+        sp_apply(b, &m->pt[pi], k->cA + 9 * a, k->lT + 9 * pi, aw, k->cF + 6 * c, k->cF + 6 * c + 3,
+                 k->cg + b->q0, Fs, Fs + 3);
+    }
+    for (int t = s + 1; t < S; t++) /* back to the base poses */
+        if (k->mark[t]) {
+            memcpy(k->cR + 3 * t, k->bR + 3 * t, 3 * sizeof(sp_cx));
+            memcpy(k->cA + 9 * t, k->bA + 9 * t, 9 * sizeof(sp_cx));
+            k->mark[t] = 0;
+        }
+    k->mark[s] = 0;
+    k->pert = -1;
+}
+
 void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat *H)
 {
     int n = m->n;
     for (int i = 0; i < n; i++)
         k->cq[i] = q[i];
-    for (int j = 0; j < n; j++) {
-        double h = SP_STEP * fmax(1.0, fabs(q[j]));
-        k->cq[j] = q[j] + _Complex_I * h;
-        sp_centrifugal_c(m, k);
-        for (int i = 0; i < n; i++)
-            DM(H, i, j) = cimag(k->cg[i]) / h;
-        k->cq[j] = q[j];
+    sp_base(m, k);
+    for (int s = 0; s < m->n_subs; s++) {
+        const sm_sub *b = &m->subs[s];
+        for (int j = b->q0; j < b->q0 + b->m; j++) {
+            double h = SP_STEP * fmax(1.0, fabs(q[j]));
+            k->cq[j] = q[j] + _Complex_I * h;
+            sp_step(m, k, s);
+            for (int i = 0; i < n; i++)
+                DM(H, i, j) = cimag(k->cg[i]) / h;
+            k->cq[j] = q[j];
+        }
     }
+    k->cached = 0;
 }
 
 /*
