@@ -125,6 +125,10 @@ typedef struct sp_kin {
     sp_cx *lw, *lpsi, *lL, *lT; /* 3P, 3P, 9P, 9P: w, psi, Lambda(psi), T(psi) of every point */
     sp_cx *bR, *bA;     /* 3S, 9S: the poses at the base point */
     int *mark;          /* S: 1 for the frames of the subtree being stepped */
+    sp_cx *bF;          /* 6S: subtree wrenches at the base point */
+    double *Psi;        /* 36S: d wrench_c / d pose_c under a rigid motion of c's subtree (6x6 each) */
+    double *Gown;       /* n x 6: d g_c / d pose_c, rows of c, under that rigid motion */
+    double *v;          /* 6S: pose change of each frame below a stepped coordinate */
     int cached;         /* 1 while lw.. hold the base state */
     int pert;           /* the substructure stepped (-1: none) */
 } sp_kin;
@@ -139,7 +143,9 @@ void sp_eval(const sm_model *m, const double *q, sp_kin *k);
  *  the centrifugal force is Omega^2 g.  Uses the complex scratch of k. */
 void sp_centrifugal(const sm_model *m, const double *q, sp_kin *k, double *g);
 /** H (n x n) = dg/dq at q, column by column by complex step (exact to round-off); a step in a
- *  coordinate of frame s recomputes only the subtree of s and carries its wrench up the path. */
+ *  coordinate of frame s goes through the points of s only: below s the subtrees move rigidly
+ *  (their 6-column responses are computed once per Jacobian, leaves first), above s the wrench
+ *  is carried up the path. */
 void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat *H);
 
 /* ------------------------------------------------------------- lin3.c */
