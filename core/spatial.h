@@ -121,6 +121,16 @@ typedef struct sp_kin {
     int *ch_ptr, *ch_idx; /* child frames of s, likewise */
     /* complex scratch of the centrifugal recursion */
     sp_cx *cq, *cR, *cA, *cF, *cg; /* n, 3S, 9S, 6S (subtree wrench), n */
+    /* base state of the complex steps of sp_centrifugal_jacobian (frames3.c) */
+    sp_cx *lw, *lpsi, *lL, *lT; /* 3P, 3P, 9P, 9P: w, psi, Lambda(psi), T(psi) of every point */
+    sp_cx *bR, *bA;     /* 3S, 9S: the poses at the base point */
+    int *mark;          /* S: 1 for the frames of the subtree being stepped */
+    sp_cx *bF;          /* 6S: subtree wrenches at the base point */
+    double *Psi;        /* 36S: d wrench_c / d pose_c under a rigid motion of c's subtree (6x6 each) */
+    double *Gown;       /* n x 6: d g_c / d pose_c, rows of c, under that rigid motion */
+    double *v;          /* 6S: pose change of each frame below a stepped coordinate */
+    int cached;         /* 1 while lw.. hold the base state */
+    int pert;           /* the substructure stepped (-1: none) */
 } sp_kin;
 
 /** Allocate k for m; jac: also the dense Jacobians JRT, JW (O(n (S + P))).  SM_OK or SM_NOMEM. */
@@ -132,7 +142,10 @@ void sp_eval(const sm_model *m, const double *q, sp_kin *k);
 /** g (n) = d T0~/dq, T0~ = sum_p 1/2 m_p |P r_p|^2 + 1/2 e_z' A_p I_p A_p' e_z (DESIGN.md 7.3):
  *  the centrifugal force is Omega^2 g.  Uses the complex scratch of k. */
 void sp_centrifugal(const sm_model *m, const double *q, sp_kin *k, double *g);
-/** H (n x n) = dg/dq at q, column by column by complex step (exact to round-off). */
+/** H (n x n) = dg/dq at q, column by column by complex step (exact to round-off); a step in a
+ *  coordinate of frame s goes through the points of s only: below s the subtrees move rigidly
+ *  (their 6-column responses are computed once per Jacobian, leaves first), above s the wrench
+ *  is carried up the path. */
 void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat *H);
 
 /* ------------------------------------------------------------- lin3.c */
