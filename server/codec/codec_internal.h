@@ -32,6 +32,7 @@
 
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdio.h>
 
 #include <jansson.h>
 
@@ -379,5 +380,12 @@ int req_error(const codec_request *r, codec_errors *errs, const char *ptr, const
  */
 int req_parse_codec_only(codec_request **out, const char *text, size_t len,
                          const codec_limits *lim, codec_errors *errs);
+
+/*
+ * Close an open_memstream f (buffer *buf, size *n) and hand its text to *out (NUL-terminated,
+ * malloc'd) and *len (may be NULL).  SM_OK, or SM_NOMEM (a write or the close failed; the
+ * buffer is freed).  csv.c; used by every text writer of the codec.
+ */
+int codec_memstream_done(FILE *f, char **buf, size_t *n, char **out, size_t *len);
 
 #endif /* SPINMODAL_CODEC_INTERNAL_H */

@@ -21,6 +21,21 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+int codec_memstream_done(FILE *f, char **buf, size_t *n, char **out, size_t *len)
+{
+    int bad = ferror(f);
+
+    if (fclose(f) || bad) { /* fclose also writes *buf and *n */
+        free(*buf);
+        *buf = NULL;
+        return SM_NOMEM;
+    }
+    *out = *buf;
+    if (len)
+        *len = *n;
+    return SM_OK;
+}
+
 /* A CSV number: full precision, empty when not finite. */
 static void csv_num(FILE *f, double x)
 {
@@ -123,19 +138,7 @@ int codec_result_csv(char **out, size_t *len, const codec_request *r, const sm_r
             csv_est(f, est, c->error_estimate ? c->error_estimate[k] : NAN);
         }
     }
-    if (ferror(f)) {
-        fclose(f);
-        free(buf);
-        return SM_NOMEM;
-    }
-    if (fclose(f)) {
-        free(buf);
-        return SM_NOMEM;
-    }
-    *out = buf;
-    if (len)
-        *len = n;
-    return SM_OK;
+    return codec_memstream_done(f, &buf, &n, out, len);
 }
 
 /* A number of a JSON object o[key] for the CSV, empty when absent or null. */
@@ -177,17 +180,5 @@ int codec_critical_speeds_csv(char **out, size_t *len, const json_t *result)
         csv_json_num(f, c, "omega_interpolated");
         fputc('\n', f);
     }
-    if (ferror(f)) {
-        fclose(f);
-        free(buf);
-        return SM_NOMEM;
-    }
-    if (fclose(f)) {
-        free(buf);
-        return SM_NOMEM;
-    }
-    *out = buf;
-    if (len)
-        *len = n;
-    return SM_OK;
+    return codec_memstream_done(f, &buf, &n, out, len);
 }

@@ -287,12 +287,5 @@ int codec_result_spanwise(char **out, size_t *len, const json_t *result, int bmo
         }
     }
     json_decref(members);
-    if (ferror(f) | fclose(f)) {
-        free(buf);
-        return SM_NOMEM;
-    }
-    *out = buf;
-    if (len)
-        *len = n;
-    return SM_OK;
+    return codec_memstream_done(f, &buf, &n, out, len);
 }
