@@ -77,6 +77,14 @@ static int eq_ws_alloc(const sm_model *m, eq_ws *w)
     w->ipiv = malloc((size_t)n * sizeof(int));
     w->P = dm_vec((size_t)m->n_elems);
     w->tree = tree_use(m);
+    if (m->spatial && w->tree) {
+        if (!w->P || !w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp || !w->work ||
+            sp_kin_alloc(m, &w->sk, 0) || tree_alloc(m, &w->t)) {
+            eq_ws_free(w);
+            return SM_NOMEM;
+        }
+        return SM_OK;
+    }
     if (m->spatial) {
         if (!w->P || !w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp || !w->work || !w->ipiv ||
             sp_kin_alloc(m, &w->sk, 0) || dm_alloc(&w->Kt, n, n) || dm_alloc(&w->H, n, n)) {
@@ -137,7 +145,10 @@ static int eq_tangent(const sm_model *m, const double *q, double s, eq_ws *w)
 {
     int n = m->n;
     if (w->tree) {
-        tree_assemble(m, q, &w->kin, s, 0, 0, &w->t);
+        if (m->spatial)
+            tree3_assemble(m, q, &w->sk, s, 0, 0, 0, &w->t);
+        else
+            tree_assemble(m, q, &w->kin, s, 0, 0, &w->t);
         return tree_factor(m, &w->t, 0);
     }
     if (m->spatial)

@@ -418,13 +418,13 @@ static void sp_base(const sm_model *m, sp_kin *k)
  * imaginary part of the wrench on the path to the root is nonzero; it is carried up through the
  * child on the path alone.  Rows of the frames off the path and outside the subtree are zero.
  */
-static void sp_step(const sm_model *m, sp_kin *k, int s, double h, double *col)
+/* The step of sp_step within frame s: its children take their pose changes (k->v), and g_s and
+ * the wrench of s are recomputed at the complex q (k->cg rows of s, k->cF of s). */
+static void sp_step_own(const sm_model *m, sp_kin *k, int s, double h)
 {
     const sp_cx *q = k->cq;
     const sm_sub *bs = &m->subs[s];
-    int S = m->n_subs, n = m->n;
     k->pert = s;
-    memset(col, 0, (size_t)n * sizeof(double));
     for (int t = k->ch_ptr[s]; t < k->ch_ptr[s + 1]; t++) {
         int c = k->ch_idx[t];
         const sp_cx *Ac = k->cA + 9 * c;
@@ -446,6 +446,14 @@ static void sp_step(const sm_model *m, sp_kin *k, int s, double h, double *col)
     }
     memset(k->cg + bs->q0, 0, (size_t)bs->m * sizeof(sp_cx));
     sp_frame_wrench(m, k, s, q);
+}
+
+static void sp_step(const sm_model *m, sp_kin *k, int s, double h, double *col)
+{
+    const sm_sub *bs = &m->subs[s];
+    int S = m->n_subs, n = m->n;
+    memset(col, 0, (size_t)n * sizeof(double));
+    sp_step_own(m, k, s, h);
     for (int i = 0; i < bs->m; i++)
         col[bs->q0 + i] = cimag(k->cg[bs->q0 + i]) / h;
     k->mark[s] = 1;
@@ -481,6 +489,34 @@ static void sp_step(const sm_model *m, sp_kin *k, int s, double h, double *col)
     for (int t = s; t < S; t++)
         k->mark[t] = 0;
     k->pert = -1;
+}
+
+void sp_hessian_base(const sm_model *m, const double *q, sp_kin *k)
+{
+    for (int i = 0; i < m->n; i++)
+        k->cq[i] = q[i];
+    sp_base(m, k);
+}
+
+void sp_hessian_own(const sm_model *m, sp_kin *k, int s, int j, double *col)
+{
+    const sm_sub *b = &m->subs[s];
+    double qj = creal(k->cq[j]), h = SP_STEP * fmax(1.0, fabs(qj));
+    k->cq[j] = qj + _Complex_I * h;
+    sp_step_own(m, k, s, h);
+    for (int i = 0; i < b->m; i++)
+        col[i] = cimag(k->cg[b->q0 + i]) / h;
+    k->cq[j] = qj;
+    memcpy(k->cF + 6 * s, k->bF + 6 * s, 6 * sizeof(sp_cx));
+    for (int t = k->ch_ptr[s]; t < k->ch_ptr[s + 1]; t++)
+        memcpy(k->cF + 6 * k->ch_idx[t], k->bF + 6 * k->ch_idx[t], 6 * sizeof(sp_cx));
+    k->pert = -1;
+}
+
+void sp_hessian_end(const sm_model *m, sp_kin *k)
+{
+    memcpy(k->cF, k->bF, 6 * (size_t)m->n_subs * sizeof(sp_cx));
+    k->cached = 0;
 }
 
 void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat *H)

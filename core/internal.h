@@ -277,21 +277,25 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to,
  * products and solves. */
 typedef struct tree_ws {
     int S, n;           /* substructures, coordinates */
+    int d;              /* frame-pose coordinates: 3 planar (x, y, theta), 6 spatial (dR, dtheta) */
     int max_m;          /* largest m_s */
     int *mp_ptr;        /* S+1: mass points of s are mp_idx[mp_ptr[s] .. mp_ptr[s+1]) */
     int *mp_idx;        /* n_mp mass point indices grouped by substructure */
-    size_t *loc_off;    /* S+1: offset of the (3+m_s)^2 local blocks of s in Kl, Ml, Cl */
-    size_t *fr_off;     /* S+1: offset of the (m_s+6)^2 front of s in F */
-    size_t *v_off;      /* S+1: offset of the m_s+6 vector of s in z and ipiv (x3 in X) */
-    double *Kl;         /* local K* (or Newton tangent) blocks, order (theta frame pose 3, q_s) */
+    size_t *loc_off;    /* S+1: offset of the (d+m_s)^2 local blocks of s in Kl, Ml, Cl */
+    size_t *fr_off;     /* S+1: offset of the (m_s+2d)^2 front of s in F */
+    size_t *v_off;      /* S+1: offset of the m_s+2d vector of s in z and ipiv (xd in X) */
+    double *Kl;         /* local K* (or Newton tangent) blocks, order (frame pose d, q_s) */
     double *Ml;         /* local M* blocks */
     double *Cl;         /* local C* blocks without the factor 2 Omega */
     double *F;          /* fronts: factors after tree_factor */
-    double *X;          /* (m_s+6) x 3 per s: F_s^-1 E_w */
+    double *X;          /* (m_s+2d) x d per s: F_s^-1 E_w */
     int *ipiv;          /* pivots of the fronts */
-    double *lk;         /* 4 per s: cos, sin of the parent's angle and A' w_e (the link T_s) */
-    double *z;          /* sum (m_s+6): solve vector */
-    double *u, *v;      /* 3 S each: forward / adjoint recursion vectors */
+    double *lk;         /* 4 per s: cos, sin of the parent's angle and A' w_e (the link T_s);
+                           spatial: 3 per s, a = R_s - R_parent (T_s = [I -skew(a); 0 I]) */
+    double *D;          /* spatial: 6 x m_parent per s (ld 6), the link D_s = [A N^u_e; A T N^psi_e] */
+    size_t *d_off;      /* spatial: S+1 offsets of D_s */
+    double *z;          /* sum (m_s+2d): solve vector */
+    double *u, *v;      /* d S each: forward / adjoint recursion vectors */
     double *work;       /* small scratch */
     double omega;       /* Omega of the last tree_assemble (C* = 2 Omega Cl) */
     int sym;            /* fronts factored by dsytrf (1) or dgetrf (0) */
@@ -327,6 +331,9 @@ int tree_factor(const sm_model *m, tree_ws *t, int sym);
 int tree_solve(const sm_model *m, tree_ws *t, double *x);
 /** y = A x for A = K (TREE_K), M* (TREE_M) or C* (TREE_C) of the last tree_assemble; x, y: n. */
 void tree_apply(const sm_model *m, tree_ws *t, int which, const double *x, double *y);
+/** u (d S) = the frame pose increments dy/dq x (forward recursion along the tree, links of the
+ *  last assembly). */
+void tree_forward(const sm_model *m, const tree_ws *t, const double *x, double *u);
 /** d (3 n_nodes) = nodal (dx, dy, dphi) = J_k x in the hub frame at the kinematics k. */
 void tree_nodal(const sm_model *m, const sm_kin *k, tree_ws *t, const double *x, double *d);
 

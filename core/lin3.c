@@ -58,56 +58,63 @@ void lin3_geometric_force(const sm_model *m, const double *q, double *f)
     }
 }
 
-void lin3_geometric_tangent(const sm_model *m, const double *q, int frozen, dmat *Kt, double *work)
+void lin3_geometric_tangent_sub(const sm_model *m, int s, const double *q, int frozen, double *Kt, int ld,
+                                double *work)
 {
     double G[144], tq[12], gt[12];
-    for (int s = 0; s < m->n_subs; s++) {
-        const sm_sub *b = &m->subs[s];
-        const double *qs = q + b->q0;
-        int mm = b->m;
-        double *GT = work; /* 12 x m: G T_e */
-        for (int j = 0; j < b->nel; j++) {
-            fe3_geometric(&m->elems[b->elems[j]], G);
-            double P = lin3_axial(b, j, qs);
-            for (int c = 0; c < mm; c++)
-                for (int r = 0; r < 12; r++) {
-                    double s2 = 0;
-                    for (int t = 0; t < 12; t++)
-                        s2 += G[r + 12 * t] * DM(&b->T, 12 * j + t, c);
-                    GT[r + 12 * c] = s2;
-                }
-            /* Kt_ss += P T' G T */
-            for (int c = 0; c < mm; c++)
-                for (int a = 0; a < mm; a++) {
-                    double s2 = 0;
-                    for (int r = 0; r < 12; r++)
-                        s2 += DM(&b->T, 12 * j + r, a) * GT[r + 12 * c];
-                    DM(Kt, b->q0 + a, b->q0 + c) += P * s2;
-                }
-            if (frozen)
-                continue;
-            /* + (T' G T q) d': the derivative of P */
-            lin3_tq(b, j, qs, tq);
+    const sm_sub *b = &m->subs[s];
+    const double *qs = q + b->q0;
+    int mm = b->m;
+    double *GT = work; /* 12 x m: G T_e */
+    for (int j = 0; j < b->nel; j++) {
+        fe3_geometric(&m->elems[b->elems[j]], G);
+        double P = lin3_axial(b, j, qs);
+        for (int c = 0; c < mm; c++)
             for (int r = 0; r < 12; r++) {
                 double s2 = 0;
                 for (int t = 0; t < 12; t++)
-                    s2 += G[r + 12 * t] * tq[t];
-                gt[r] = s2;
+                    s2 += G[r + 12 * t] * DM(&b->T, 12 * j + t, c);
+                GT[r + 12 * c] = s2;
             }
-            const double *d = b->d + (size_t)j * mm;
+        /* Kt_ss += P T' G T */
+        for (int c = 0; c < mm; c++)
             for (int a = 0; a < mm; a++) {
-                double v = 0;
+                double s2 = 0;
                 for (int r = 0; r < 12; r++)
-                    v += DM(&b->T, 12 * j + r, a) * gt[r];
-                for (int c = 0; c < mm; c++)
-                    DM(Kt, b->q0 + a, b->q0 + c) += v * d[c];
+                    s2 += DM(&b->T, 12 * j + r, a) * GT[r + 12 * c];
+                Kt[a + (size_t)ld * c] += P * s2;
             }
+        if (frozen)
+            continue;
+        /* + (T' G T q) d': the derivative of P */
+        lin3_tq(b, j, qs, tq);
+        for (int r = 0; r < 12; r++) {
+            double s2 = 0;
+            for (int t = 0; t < 12; t++)
+                s2 += G[r + 12 * t] * tq[t];
+            gt[r] = s2;
+        }
+        const double *d = b->d + (size_t)j * mm;
+        for (int a = 0; a < mm; a++) {
+            double v = 0;
+            for (int r = 0; r < 12; r++)
+                v += DM(&b->T, 12 * j + r, a) * gt[r];
+            for (int c = 0; c < mm; c++)
+                Kt[a + (size_t)ld * c] += v * d[c];
         }
     }
 }
 
+void lin3_geometric_tangent(const sm_model *m, const double *q, int frozen, dmat *Kt, double *work)
+{
+    for (int s = 0; s < m->n_subs; s++) {
+        const sm_sub *b = &m->subs[s];
+        lin3_geometric_tangent_sub(m, s, q, frozen, &DM(Kt, b->q0, b->q0), Kt->rows, work);
+    }
+}
+
 /* X = A_s Lambda(psi_p) I_p Lambda' A_s': the hub inertia of point p at k. */
-static void lin3_hub_inertia(const sm_model *m, const sp_kin *k, int pi, double X[9])
+void lin3_hub_inertia(const sm_model *m, const sp_kin *k, int pi, double X[9])
 {
     const sp_point *p = &m->pt[pi];
     sp_cx psi[3] = {k->psi[3 * pi], k->psi[3 * pi + 1], k->psi[3 * pi + 2]}, L[9], AL[9], Ic[9], t[9], u[9];
@@ -184,21 +191,26 @@ void lin3_gyro(const sm_model *m, const sp_kin *k, double omega, dmat *C, dmat *
         if (!p->has_I)
             continue;
         lin3_hub_inertia(m, k, pi, X);
-        /* Y_p = -skew(X e) + X S + S X, X e = third column of X */
-        double xe[3] = {X[6], X[7], X[8]};
-        double Sk[9] = {0, xe[2], -xe[1], -xe[2], 0, xe[0], xe[1], -xe[0], 0};
-        double XS[9] = {X[3], X[4], X[5], -X[0], -X[1], -X[2], 0, 0, 0}; /* X S: columns (X e2, -X e1, 0) */
-        double SX[9];
-        for (int j = 0; j < 3; j++) { /* S X: rows (-X row 2, X row 1, 0) */
-            SX[0 + 3 * j] = -X[1 + 3 * j];
-            SX[1 + 3 * j] = X[0 + 3 * j];
-            SX[2 + 3 * j] = 0;
-        }
-        for (int i = 0; i < 9; i++)
-            Yp[i] = -Sk[i] + XS[i] + SX[i];
+        lin3_gyro_rotary(X, Yp);
         lin3_times(n, J + 3 * (size_t)n, Yp, &DM(Y, 0, 6 * pi + 3));
     }
     lin3_product(m, k, Y, omega, -1, C);
+}
+
+void lin3_gyro_rotary(const double X[9], double Yp[9])
+{
+    /* Y_p = -skew(X e) + X S + S X, X e = third column of X */
+    double xe[3] = {X[6], X[7], X[8]};
+    double Sk[9] = {0, xe[2], -xe[1], -xe[2], 0, xe[0], xe[1], -xe[0], 0};
+    double XS[9] = {X[3], X[4], X[5], -X[0], -X[1], -X[2], 0, 0, 0}; /* X S: columns (X e2, -X e1, 0) */
+    double SX[9];
+    for (int j = 0; j < 3; j++) { /* S X: rows (-X row 2, X row 1, 0) */
+        SX[0 + 3 * j] = -X[1 + 3 * j];
+        SX[1 + 3 * j] = X[0 + 3 * j];
+        SX[2 + 3 * j] = 0;
+    }
+    for (int i = 0; i < 9; i++)
+        Yp[i] = -Sk[i] + XS[i] + SX[i];
 }
 
 void lin3_tangent(const sm_model *m, const double *q, sp_kin *k, double s, int frozen, dmat *Kt, dmat *H,

@@ -148,11 +148,27 @@ void sp_centrifugal(const sm_model *m, const double *q, sp_kin *k, double *g);
  *  is carried up the path. */
 void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat *H);
 
+/** The complex-step base of the block Hessian (tree3.c): local state, poses, subtree wrenches and
+ *  the rigid-motion responses Gown (rows of each frame, n x 6) and Psi at q. */
+void sp_hessian_base(const sm_model *m, const double *q, sp_kin *k);
+/** col (m_s) = rows of frame s of H e_j for coordinate j of frame s (after sp_hessian_base): the
+ *  points of s take the step, its children the pose change, their subtrees move rigidly (Psi). */
+void sp_hessian_own(const sm_model *m, sp_kin *k, int s, int j, double *col);
+/** End of the block Hessian: the complex scratch back to the base. */
+void sp_hessian_end(const sm_model *m, sp_kin *k);
+
 /* ------------------------------------------------------------- lin3.c */
 /** f += f_g(q) = sum_e P_e T_e' G_e T_e q_s (the 3D G of fe3_geometric). */
 void lin3_geometric_force(const sm_model *m, const double *q, double *f);
 /** Kt += d f_g / dq; frozen: P_e held at P_e(q). work: >= 12 max m_s doubles. */
 void lin3_geometric_tangent(const sm_model *m, const double *q, int frozen, dmat *Kt, double *work);
+/** Kt (m_s x m_s block of frame s, leading dimension ld) += d f_g,s / dq_s, as lin3_geometric_tangent. */
+void lin3_geometric_tangent_sub(const sm_model *m, int s, const double *q, int frozen, double *Kt, int ld,
+                                double *work);
+/** X = A_s Lambda(psi_p) I_p Lambda' A_s': the hub inertia of point pi at k. */
+void lin3_hub_inertia(const sm_model *m, const sp_kin *k, int pi, double X[9]);
+/** Yp = -skew(X e_z) + X S + S X: the rotary gyroscopic matrix of a hub inertia X (lin3_gyro). */
+void lin3_gyro_rotary(const double X[9], double Yp[9]);
 /** M = M* = sum_p m_p J_p' J_p + W_p' X_p W_p at k (jac), X_p the hub inertia. Y: n x 6P scratch. */
 void lin3_mass(const sm_model *m, const sp_kin *k, dmat *M, dmat *Y);
 /** C = C* = Omega sum_p (2 m_p J_p' S J_p + W_p' Y_p W_p), S = skew(e_z),
@@ -167,5 +183,15 @@ void lin3_tangent(const sm_model *m, const double *q, sp_kin *k, double s, int f
 double lin3_nodes(const sm_model *m, const sp_kin *k, double *nodes, int *at);
 /** y (6 n_nodes) = (J_k x, W_k x) per node at k (jac). */
 void lin3_nodal(const sm_model *m, const sp_kin *k, const double *x, double *y);
+
+/* ------------------------------------------------------------ tree3.c */
+/** The local blocks of tree.c for a spatial model at q (pose coordinates dR, dtheta of each frame):
+ *  Kl of the Newton tangent (frozen 0) or of K* (frozen 1) from the block Hessian
+ *  [0 Gown'; Gown Hd] of frames3.c; Ml and Cl when lin (Cl only with gyro).  k: kinematics
+ *  without Jacobians, evaluated here.  Returns 1 when all are finite. */
+int tree3_assemble(const sm_model *m, const double *q, sp_kin *k, double s2, int frozen, int lin, int gyro,
+                   tree_ws *t);
+/** y (6 n_nodes) = (J_k x, W_k x) per node at the kinematics of the last tree3_assemble. */
+void tree3_nodal(const sm_model *m, const sp_kin *k, tree_ws *t, const double *x, double *y);
 
 #endif

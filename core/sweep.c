@@ -83,6 +83,13 @@ static int sweep_lin_alloc(const sm_model *m, sweep_lin *L, int tree)
     for (int s = 0; s < m->n_subs; s++)
         mx = m->subs[s].m > mx ? m->subs[s].m : mx;
     L->work = dm_vec((size_t)(12 * mx + n));
+    if (m->spatial && tree) {
+        if (!L->work || sp_kin_alloc(m, &L->sk, 0) || tree_alloc(m, &L->t)) {
+            sweep_lin_free(L);
+            return SM_NOMEM;
+        }
+        return SM_OK;
+    }
     if (m->spatial) {
         if (!L->work || sp_kin_alloc(m, &L->sk, 1) || dm_alloc(&L->M, n, n) || dm_alloc(&L->C, n, n) ||
             dm_alloc(&L->K, n, n) || dm_alloc(&L->H, n, n) || dm_alloc(&L->W, n, 6 * m->n_pt)) {
@@ -113,6 +120,8 @@ static int sweep_linearize(const sm_model *m, const double *q, double omega, swe
 {
     int n = m->n;
     double s = omega * omega;
+    if (m->spatial && L->tree) /* K*, P frozen; M*; C* in the local blocks of tree3.c */
+        return tree3_assemble(m, q, &L->sk, s, 1, 1, m->opt.coriolis, &L->t);
     if (m->spatial) { /* K*, P frozen; M*; C* (DESIGN.md 7.3) */
         sp_eval(m, q, &L->sk);
         lin3_tangent(m, q, &L->sk, s, 1, &L->K, &L->H, L->work);
@@ -156,7 +165,10 @@ static void sweep_shapes(const sm_model *m, sweep_lin *L, const sm_eig_out *e, d
     for (int j = 0; j < e->n_modes; j++) {
         const double *xr = e->xre + (size_t)j * n, *xi = e->xim + (size_t)j * n;
         double *yr = sr + (size_t)j * dof * nn, *yi = si + (size_t)j * dof * nn;
-        if (m->spatial) {
+        if (m->spatial && L->tree) {
+            tree3_nodal(m, &L->sk, &L->t, xr, yr);
+            tree3_nodal(m, &L->sk, &L->t, xi, yi);
+        } else if (m->spatial) {
             lin3_nodal(m, &L->sk, xr, yr);
             lin3_nodal(m, &L->sk, xi, yi);
         } else if (L->tree) {

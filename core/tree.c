@@ -85,8 +85,6 @@ int tree_choose(int solver, int n, int max_m, int modes)
 
 int tree_use(const sm_model *m)
 {
-    if (m->spatial)
-        return 0; /* the block form is planar (3 frame-pose coordinates) */
     int mx = 0;
     for (int s = 0; s < m->n_subs; s++)
         mx = m->subs[s].m > mx ? m->subs[s].m : mx;
@@ -107,6 +105,8 @@ void tree_free(tree_ws *t)
     free(t->X);
     free(t->ipiv);
     free(t->lk);
+    free(t->D);
+    free(t->d_off);
     free(t->z);
     free(t->u);
     free(t->v);
@@ -116,23 +116,27 @@ void tree_free(tree_ws *t)
 
 int tree_alloc(const sm_model *m, tree_ws *t)
 {
-    int S = m->n_subs, mx = 1;
+    int S = m->n_subs, mx = 1, d = m->spatial ? 6 : 3;
     memset(t, 0, sizeof *t);
     t->S = S;
     t->n = m->n;
+    t->d = d;
     t->mp_ptr = calloc((size_t)S + 1, sizeof(int));
     t->mp_idx = calloc((size_t)(m->n_mp ? m->n_mp : 1), sizeof(int));
     t->loc_off = calloc((size_t)S + 1, sizeof(size_t));
     t->fr_off = calloc((size_t)S + 1, sizeof(size_t));
     t->v_off = calloc((size_t)S + 1, sizeof(size_t));
-    if (!t->mp_ptr || !t->mp_idx || !t->loc_off || !t->fr_off || !t->v_off)
+    t->d_off = calloc((size_t)S + 1, sizeof(size_t));
+    if (!t->mp_ptr || !t->mp_idx || !t->loc_off || !t->fr_off || !t->v_off || !t->d_off)
         goto fail;
     for (int s = 0; s < S; s++) {
-        size_t l = 3 + (size_t)m->subs[s].m, nb = 6 + (size_t)m->subs[s].m;
+        size_t l = (size_t)d + m->subs[s].m, nb = 2 * (size_t)d + m->subs[s].m;
+        int p = m->subs[s].parent;
         mx = m->subs[s].m > mx ? m->subs[s].m : mx;
         t->loc_off[s + 1] = t->loc_off[s] + l * l;
         t->fr_off[s + 1] = t->fr_off[s] + nb * nb;
         t->v_off[s + 1] = t->v_off[s] + nb;
+        t->d_off[s + 1] = t->d_off[s] + (d == 6 && p >= 0 ? 6 * (size_t)m->subs[p].m : 0);
     }
     /* mass points of each substructure (CSR, in the order of m->mp) */
     for (int p = 0; p < m->n_mp; p++)
@@ -153,15 +157,16 @@ int tree_alloc(const sm_model *m, tree_ws *t)
     t->Ml = dm_vec(L);
     t->Cl = dm_vec(L);
     t->F = dm_vec(Fz);
-    t->X = dm_vec(3 * V);
+    t->X = dm_vec((size_t)d * V);
     t->ipiv = calloc(V ? V : 1, sizeof(int));
     t->lk = dm_vec(4 * (size_t)S);
+    t->D = dm_vec(t->d_off[S] + 1);
     t->z = dm_vec(V);
-    t->u = dm_vec(3 * (size_t)S);
-    t->v = dm_vec(3 * (size_t)S);
-    t->work = dm_vec(4 * (size_t)mx + 2 * (size_t)(mx + 6) * (mx + 6) + 64);
-    if (!t->Kl || !t->Ml || !t->Cl || !t->F || !t->X || !t->ipiv || !t->lk || !t->z || !t->u || !t->v ||
-        !t->work)
+    t->u = dm_vec((size_t)d * S);
+    t->v = dm_vec((size_t)d * S);
+    t->work = dm_vec(4 * (size_t)mx + 2 * (size_t)(mx + 2 * d) * (mx + 2 * d) + 64);
+    if (!t->Kl || !t->Ml || !t->Cl || !t->F || !t->X || !t->ipiv || !t->lk || !t->D || !t->z || !t->u ||
+        !t->v || !t->work)
         goto fail;
     return SM_OK;
 fail:
@@ -190,9 +195,55 @@ static void tree_links(const sm_model *m, const sm_kin *k, tree_ws *t)
     }
 }
 
-/* u (3 S) = dy/dq x: the forward recursion dy_c = T_c dy_p + D_c x_p, dy = 0 at the hub. */
-static void tree_forward(const sm_model *m, const tree_ws *t, const double *x, double *u)
+/* Spatial forward step: u_s = T_s u_p + D_s x_p, T_s u = (dR + dtheta x a, dtheta). */
+static void tree_forward6(const sm_model *m, const tree_ws *t, int s, const double *x, double *u)
 {
+    const sm_sub *b = &m->subs[s], *p = &m->subs[b->parent];
+    const double *up = u + 6 * b->parent, *a = t->lk + 3 * s, *D = t->D + t->d_off[s], *xp = x + p->q0;
+    double *us = u + 6 * s;
+    us[0] = up[0] + up[4] * a[2] - up[5] * a[1];
+    us[1] = up[1] + up[5] * a[0] - up[3] * a[2];
+    us[2] = up[2] + up[3] * a[1] - up[4] * a[0];
+    us[3] = up[3];
+    us[4] = up[4];
+    us[5] = up[5];
+    for (int j = 0; j < p->m; j++)
+        for (int i = 0; i < 6; i++)
+            us[i] += D[6 * j + i] * xp[j];
+}
+
+/* Spatial adjoint step: v_p += T_s' v_s = (v_R, v_theta + a x v_R); y_p += D_s' v_s. */
+static void tree_adjoint6(const sm_model *m, const tree_ws *t, int s, double *v, double *y)
+{
+    const sm_sub *b = &m->subs[s], *p = &m->subs[b->parent];
+    const double *vs = v + 6 * s, *a = t->lk + 3 * s, *D = t->D + t->d_off[s];
+    double *vp = v + 6 * b->parent, *yp = y + p->q0;
+    vp[0] += vs[0];
+    vp[1] += vs[1];
+    vp[2] += vs[2];
+    vp[3] += vs[3] + a[1] * vs[2] - a[2] * vs[1];
+    vp[4] += vs[4] + a[2] * vs[0] - a[0] * vs[2];
+    vp[5] += vs[5] + a[0] * vs[1] - a[1] * vs[0];
+    for (int j = 0; j < p->m; j++) {
+        double acc = 0;
+        for (int i = 0; i < 6; i++)
+            acc += D[6 * j + i] * vs[i];
+        yp[j] += acc;
+    }
+}
+
+/* u (d S) = dy/dq x: the forward recursion dy_c = T_c dy_p + D_c x_p, dy = 0 at the hub. */
+void tree_forward(const sm_model *m, const tree_ws *t, const double *x, double *u)
+{
+    if (t->d == 6) {
+        for (int s = 0; s < m->n_subs; s++) {
+            if (m->subs[s].parent < 0)
+                memset(u + 6 * s, 0, 6 * sizeof(double));
+            else
+                tree_forward6(m, t, s, x, u);
+        }
+        return;
+    }
     for (int s = 0; s < m->n_subs; s++) {
         const sm_sub *b = &m->subs[s];
         double *us = u + 3 * s;
@@ -215,13 +266,17 @@ static void tree_forward(const sm_model *m, const tree_ws *t, const double *x, d
     }
 }
 
-/* y += (dy/dq)' v for v (3 S, destroyed): the adjoint recursion, leaves first. */
+/* y += (dy/dq)' v for v (d S, destroyed): the adjoint recursion, leaves first. */
 static void tree_adjoint(const sm_model *m, const tree_ws *t, double *v, double *y)
 {
     for (int s = m->n_subs - 1; s >= 0; s--) {
         const sm_sub *b = &m->subs[s];
         if (b->parent < 0)
             continue;
+        if (t->d == 6) {
+            tree_adjoint6(m, t, s, v, y);
+            continue;
+        }
         const sm_sub *p = &m->subs[b->parent];
         double *vs = v + 3 * s, *vp = v + 3 * b->parent, *yp = y + p->q0;
         const double *lk = t->lk + 4 * s;
@@ -379,24 +434,45 @@ int tree_assemble(const sm_model *m, const double *q, sm_kin *k, double s2, int 
 /* Front of s before elimination: [Kqq Kqy 0; Kyq Kyy I; 0 I 0] on (x_s, u_s, w_s). */
 static void tree_front_init(const sm_model *m, tree_ws *t, int s)
 {
-    int mm = m->subs[s].m, l = 3 + mm, nb = mm + 6;
+    int d = t->d, mm = m->subs[s].m, l = d + mm, nb = mm + 2 * d;
     double *F = t->F + t->fr_off[s];
     const double *Kl = t->Kl + t->loc_off[s];
     memset(F, 0, (size_t)nb * nb * sizeof(double));
     for (int j = 0; j < l; j++) /* local order (y, q) -> front order (x, u) */
         for (int i = 0; i < l; i++) {
-            int fi = i < 3 ? mm + i : i - 3, fj = j < 3 ? mm + j : j - 3;
+            int fi = i < d ? mm + i : i - d, fj = j < d ? mm + j : j - d;
             F[(size_t)fj * nb + fi] = Kl[(size_t)j * l + i];
         }
-    for (int i = 0; i < 3; i++) {
-        F[(size_t)(mm + 3 + i) * nb + mm + i] = 1.0;
-        F[(size_t)(mm + i) * nb + mm + 3 + i] = 1.0;
+    for (int i = 0; i < d; i++) {
+        F[(size_t)(mm + d + i) * nb + mm + i] = 1.0;
+        F[(size_t)(mm + i) * nb + mm + d + i] = 1.0;
     }
 }
 
-/* C_s = [-D_s, -T_s, 0] (3 x nb_p, column-major ld 3) coupling child s to its parent's front. */
+/* Spatial C_s = [-D_s, -T_s, 0] (6 x nb_p, ld 6). */
+static void tree_coupling6(const sm_model *m, const tree_ws *t, int s, double *C)
+{
+    const sm_sub *b = &m->subs[s], *p = &m->subs[b->parent];
+    const double *a = t->lk + 3 * s, *D = t->D + t->d_off[s];
+    int mp = p->m;
+    memset(C, 0, 6 * (size_t)(mp + 12) * sizeof(double));
+    for (size_t i = 0; i < 6 * (size_t)mp; i++)
+        C[i] = -D[i];
+    double *Ct = C + 6 * (size_t)mp; /* -T = -[I -skew(a); 0 I] */
+    for (int i = 0; i < 6; i++)
+        Ct[6 * i + i] = -1.0;
+    Ct[6 * 3 + 1] = a[2], Ct[6 * 3 + 2] = -a[1];
+    Ct[6 * 4 + 0] = -a[2], Ct[6 * 4 + 2] = a[0];
+    Ct[6 * 5 + 0] = a[1], Ct[6 * 5 + 1] = -a[0];
+}
+
+/* C_s = [-D_s, -T_s, 0] (d x nb_p, column-major ld d) coupling child s to its parent's front. */
 static void tree_coupling(const sm_model *m, const tree_ws *t, int s, double *C)
 {
+    if (t->d == 6) {
+        tree_coupling6(m, t, s, C);
+        return;
+    }
     const sm_sub *b = &m->subs[s], *p = &m->subs[b->parent];
     const double *lk = t->lk + 4 * s;
     int a = b->attach_local, mp = p->m;
@@ -443,14 +519,14 @@ static int tree_front_solve(const tree_ws *t, int s, int nb, int nrhs, double *B
 
 int tree_factor(const sm_model *m, tree_ws *t, int sym)
 {
-    int S = m->n_subs, neg = 0, sign = (3 * S) % 2 ? -1 : 1, rc;
-    double *C = t->work, *W = C + 3 * (size_t)(t->max_m + 6);
+    int S = m->n_subs, d = t->d, neg = 0, sign = (d * S) % 2 ? -1 : 1, rc;
+    double *C = t->work, *W = C + (size_t)d * (t->max_m + 2 * d);
     t->sym = sym;
     for (int s = 0; s < S; s++)
         tree_front_init(m, t, s);
     for (int s = S - 1; s >= 0; s--) {
-        int mm = m->subs[s].m, nb = mm + 6;
-        double *F = t->F + t->fr_off[s], *X = t->X + 3 * t->v_off[s];
+        int mm = m->subs[s].m, nb = mm + 2 * d;
+        double *F = t->F + t->fr_off[s], *X = t->X + (size_t)d * t->v_off[s];
         int *ip = t->ipiv + t->v_off[s];
         if (sym) {
             int lw = nb * 64;
@@ -473,72 +549,84 @@ int tree_factor(const sm_model *m, tree_ws *t, int sym)
             }
         }
         /* X_s = F_s^-1 E_w */
-        memset(X, 0, 3 * (size_t)nb * sizeof(double));
-        for (int i = 0; i < 3; i++)
-            X[(size_t)i * nb + mm + 3 + i] = 1.0;
-        if ((rc = tree_front_solve(t, s, nb, 3, X)) < 0)
+        memset(X, 0, (size_t)d * nb * sizeof(double));
+        for (int i = 0; i < d; i++)
+            X[(size_t)i * nb + mm + d + i] = 1.0;
+        if ((rc = tree_front_solve(t, s, nb, d, X)) < 0)
             return rc;
         const sm_sub *b = &m->subs[s];
         if (b->parent < 0)
             continue;
         /* F_p -= C' Z C,  Z = (F_s^-1)_ww = rows w of X */
-        int mp = m->subs[b->parent].m, nbp = mp + 6, nc = mp + 3;
+        int mp = m->subs[b->parent].m, nbp = mp + 2 * d, nc = mp + d;
         double *Fp = t->F + t->fr_off[b->parent];
         tree_coupling(m, t, s, C);
-        for (int j = 0; j < nc; j++) /* W = Z C (3 x nc) */
-            for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < nc; j++) /* W = Z C (d x nc) */
+            for (int i = 0; i < d; i++) {
                 double acc = 0;
-                for (int r = 0; r < 3; r++)
-                    acc += X[(size_t)r * nb + mm + 3 + i] * C[3 * j + r];
-                W[3 * j + i] = acc;
+                for (int r = 0; r < d; r++)
+                    acc += X[(size_t)r * nb + mm + d + i] * C[d * j + r];
+                W[d * j + i] = acc;
             }
         for (int j = 0; j < nc; j++)
-            for (int i = 0; i < nc; i++)
-                Fp[(size_t)j * nbp + i] -= C[3 * i] * W[3 * j] + C[3 * i + 1] * W[3 * j + 1] + C[3 * i + 2] * W[3 * j + 2];
+            for (int i = 0; i < nc; i++) {
+                double acc = C[d * i] * W[d * j];
+                for (int r = 1; r < d; r++)
+                    acc += C[d * i + r] * W[d * j + r];
+                Fp[(size_t)j * nbp + i] -= acc;
+            }
     }
-    t->neg = neg - 3 * S;
+    t->neg = neg - d * S;
     t->det_sign = sign;
     return SM_OK;
 }
 
 int tree_solve(const sm_model *m, tree_ws *t, double *x)
 {
-    int S = m->n_subs, rc;
+    int S = m->n_subs, d = t->d, rc;
     double *C = t->work;
     for (int s = 0; s < S; s++) { /* right-hand sides [b_s; 0; 0] */
         double *zs = t->z + t->v_off[s];
         int mm = m->subs[s].m;
         memcpy(zs, x + m->subs[s].q0, (size_t)mm * sizeof(double));
-        memset(zs + mm, 0, 6 * sizeof(double));
+        memset(zs + mm, 0, 2 * (size_t)d * sizeof(double));
     }
     for (int s = S - 1; s >= 0; s--) { /* forward: y_s = F_s^-1 r_s; r_p -= C' y_s,w */
         const sm_sub *b = &m->subs[s];
-        int mm = b->m, nb = mm + 6;
+        int mm = b->m, nb = mm + 2 * d;
         double *zs = t->z + t->v_off[s];
         if ((rc = tree_front_solve(t, s, nb, 1, zs)) < 0)
             return rc;
         if (b->parent < 0)
             continue;
-        int nc = m->subs[b->parent].m + 3;
-        double *zp = t->z + t->v_off[b->parent], *yw = zs + mm + 3;
+        int nc = m->subs[b->parent].m + d;
+        double *zp = t->z + t->v_off[b->parent], *yw = zs + mm + d;
         tree_coupling(m, t, s, C);
-        for (int j = 0; j < nc; j++)
-            zp[j] -= C[3 * j] * yw[0] + C[3 * j + 1] * yw[1] + C[3 * j + 2] * yw[2];
+        for (int j = 0; j < nc; j++) {
+            double acc = C[d * j] * yw[0];
+            for (int r = 1; r < d; r++)
+                acc += C[d * j + r] * yw[r];
+            zp[j] -= acc;
+        }
     }
     for (int s = 0; s < S; s++) { /* back: z_s = y_s - X_s (C z_p) */
         const sm_sub *b = &m->subs[s];
-        int mm = b->m, nb = mm + 6;
+        int mm = b->m, nb = mm + 2 * d;
         double *zs = t->z + t->v_off[s];
         if (b->parent >= 0) {
-            int nc = m->subs[b->parent].m + 3;
-            const double *zp = t->z + t->v_off[b->parent], *X = t->X + 3 * t->v_off[s];
-            double cz[3] = {0, 0, 0};
+            int nc = m->subs[b->parent].m + d;
+            const double *zp = t->z + t->v_off[b->parent], *X = t->X + (size_t)d * t->v_off[s];
+            double cz[6] = {0, 0, 0, 0, 0, 0};
             tree_coupling(m, t, s, C);
             for (int j = 0; j < nc; j++)
-                for (int i = 0; i < 3; i++)
-                    cz[i] += C[3 * j + i] * zp[j];
-            for (int r = 0; r < nb; r++)
-                zs[r] -= X[r] * cz[0] + X[(size_t)nb + r] * cz[1] + X[2 * (size_t)nb + r] * cz[2];
+                for (int i = 0; i < d; i++)
+                    cz[i] += C[d * j + i] * zp[j];
+            for (int r = 0; r < nb; r++) {
+                double acc = X[r] * cz[0];
+                for (int i = 1; i < d; i++)
+                    acc += X[(size_t)i * nb + r] * cz[i];
+                zs[r] -= acc;
+            }
         }
         memcpy(x + b->q0, zs, (size_t)mm * sizeof(double));
     }
@@ -549,23 +637,24 @@ void tree_apply(const sm_model *m, tree_ws *t, int which, const double *x, doubl
 {
     const double *L = which == TREE_K ? t->Kl : which == TREE_M ? t->Ml : t->Cl;
     double scale = which == TREE_C ? 2.0 * t->omega : 1.0;
-    double *in = t->work, *out = t->work + 3 + t->max_m;
+    int d = t->d;
+    double *in = t->work, *out = t->work + d + t->max_m;
     tree_forward(m, t, x, t->u);
     for (int s = 0; s < m->n_subs; s++) {
         const sm_sub *b = &m->subs[s];
-        int l = 3 + b->m;
+        int l = d + b->m;
         const double *Ls = L + t->loc_off[s];
-        memcpy(in, t->u + 3 * s, 3 * sizeof(double));
-        memcpy(in + 3, x + b->q0, (size_t)b->m * sizeof(double));
+        memcpy(in, t->u + (size_t)d * s, (size_t)d * sizeof(double));
+        memcpy(in + d, x + b->q0, (size_t)b->m * sizeof(double));
         for (int i = 0; i < l; i++)
             out[i] = 0;
         for (int j = 0; j < l; j++)
             for (int i = 0; i < l; i++)
                 out[i] += Ls[(size_t)j * l + i] * in[j];
-        for (int i = 0; i < 3; i++)
-            t->v[3 * s + i] = scale * out[i];
+        for (int i = 0; i < d; i++)
+            t->v[(size_t)d * s + i] = scale * out[i];
         for (int i = 0; i < b->m; i++)
-            y[b->q0 + i] = scale * out[3 + i];
+            y[b->q0 + i] = scale * out[d + i];
     }
     tree_adjoint(m, t, t->v, y);
 }
