@@ -11,6 +11,8 @@
  *        equilibrium, linearisation and eigen-analysis (sm_case timings).
  * Not a test: ratios are what to read (the machines are shared and noisy).
  * Usage: bench_spatial [seconds per case, default 2]
+ *        bench_spatial --growth ELEMENTS auto|dense|tree   one solve of the blade (W = 10, Coriolis,
+ *        6 modes, no shapes) for tests/bench/growth.sh --spatial: "elements coordinates ms w1 w2 w3"
  */
 #include <math.h>
 #include <stdio.h>
@@ -105,8 +107,49 @@ static void blade(int ne, double *xy, double *z, sm_section *sec, sm_member *mem
     st->n_members = 1, st->members = mem, st->spatial = 1;
 }
 
+/* One solve of the blade with ne elements (growth.sh --spatial: one process per point). */
+static int growth_one(int ne, int solver)
+{
+    double bxy[4], bz[2], w = 10.0;
+    sm_section bs;
+    sm_member bm;
+    sm_structure bst;
+    sm_options o;
+    sm_model *m = NULL;
+    sm_result *r = NULL;
+    sm_diag d;
+    blade(ne, bxy, bz, &bs, &bm, &bst);
+    sm_default_options(&o);
+    o.modes = 6;
+    o.mode_shapes = 0;
+    o.solver = solver;
+    double t0 = now_ms();
+    int rc = sm_model_new(&m, &bst, &o, &d);
+    if (rc == SM_OK)
+        rc = sm_solve(m, &w, 1, NULL, NULL, &r, &d);
+    double ms = now_ms() - t0;
+    if (rc < 0) {
+        fprintf(stderr, "growth %d: %s: %s\n", ne, sm_strerror(rc), d.message);
+    } else {
+        sm_model_info info;
+        sm_model_get_info(m, &info);
+        printf("%d %d %.2f", ne, info.coordinates, ms);
+        for (int i = 0; i < r->cases[0].n_modes && i < 3; i++)
+            printf(" %.12g", r->cases[0].frequency[i]);
+        printf("\n");
+    }
+    sm_result_free(r);
+    sm_model_free(m);
+    return rc < 0 ? 1 : 0;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc == 4 && !strcmp(argv[1], "--growth")) {
+        int solver = !strcmp(argv[3], "dense") ? SM_SOLVER_DENSE : !strcmp(argv[3], "tree") ? SM_SOLVER_TREE
+                                                                                            : SM_SOLVER_AUTO;
+        return growth_one(atoi(argv[2]), solver);
+    }
     double sec_budget = argc > 1 ? atof(argv[1]) : 2.0;
     printf("spinmodal %s bench_spatial (OPENBLAS_NUM_THREADS=%s); time = sm_model_new + sm_solve from rest\n",
            sm_version(), getenv("OPENBLAS_NUM_THREADS") ? getenv("OPENBLAS_NUM_THREADS") : "unset");

@@ -4,7 +4,9 @@
 # (/usr/bin/time -v) of `bench_core --growth E SOLVER`, dense (today's path, forced) beside the
 # automatic choice, measured in one run; ratio = dense / auto.  Release build in build-bench.
 #   bash tests/bench/growth.sh [ELEMENTS...]     (default 48 96 192 384 768 1536)
-# DENSE_MAX (default 768) skips the dense path above that size (1536 dense takes minutes).
+#   bash tests/bench/growth.sh --spatial [ELEMENTS...]   the 3D precone blade of bench_spatial
+#        (R3, W = 10, Coriolis, 6 modes, no shapes; default 48 96 192 400 768)
+# DENSE_MAX (default 768; spatial 400) skips the dense path above that size (it takes minutes).
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 if [ -d build-bench/meson-private ]; then
@@ -12,12 +14,19 @@ if [ -d build-bench/meson-private ]; then
 else
   meson setup build-bench -Dbuildtype=release >/dev/null
 fi
-ninja -C build-bench tests/bench/bench_core >/dev/null
+spatial=0
+if [ "${1:-}" = "--spatial" ]; then spatial=1; shift; fi
+prog=bench_core
+[ "$spatial" = 1 ] && prog=bench_spatial
+ninja -C build-bench "tests/bench/$prog" >/dev/null
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
-bin=build-bench/tests/bench/bench_core
+bin=build-bench/tests/bench/$prog
 sizes=("$@")
-[ "${#sizes[@]}" -gt 0 ] || sizes=(48 96 192 384 768 1536)
+if [ "${#sizes[@]}" -eq 0 ]; then
+  if [ "$spatial" = 1 ]; then sizes=(48 96 192 400 768); else sizes=(48 96 192 384 768 1536); fi
+fi
 dense_max=${DENSE_MAX:-768}
+[ "$spatial" = 1 ] && dense_max=${DENSE_MAX:-400}
 tmp=$(mktemp)
 trap 'rm -f "$tmp"' EXIT
 # run E SOLVER: prints "wall_s peak_MB w1" (best wall of 3 runs for short ones, 1 for long ones)
@@ -42,6 +51,7 @@ printf '%-9s %6s | %9s %8s | %9s %8s | %8s %7s | %s\n' elements coords "dense s"
 for e in "${sizes[@]}"; do
   read -r ta ma wa < <(run "$e" auto)
   coords=$(( 3 * e - 1 ))
+  [ "$spatial" = 1 ] && coords=$(( 6 * e ))
   if [ "$e" -le "$dense_max" ]; then
     read -r td md wd < <(run "$e" dense)
     printf '%-9s %6s | %9.3f %8.1f | %9.3f %8.1f | %8.1f %7.1f | %s / %s\n' "$e" "$coords" "$td" "$md" "$ta" "$ma" \
