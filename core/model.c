@@ -150,8 +150,8 @@ int sm_structure_check(const sm_structure *st, const sm_options *opt, sm_model_i
             if (k > info->max_frame_coordinates)
                 info->max_frame_coordinates = k;
         }
-        info->structured = !m->spatial && tree_choose(m->opt.solver, info->coordinates,
-                                                      info->max_frame_coordinates, m->opt.modes);
+        info->structured =
+            tree_choose(m->opt.solver, info->coordinates, info->max_frame_coordinates, m->opt.modes);
     }
     sm_model_free(m);
     return SM_OK;

@@ -489,6 +489,47 @@ def t_trust(tmp):
         check(rc == 2 and ptr in err, "trust: engine_orders %s is a 422 at %s (exit %d)" % (str(bad)[:20], ptr, rc))
 
 
+def t_reference3d(tmp):
+    """The spinmodal requests of tests/reference/3d/cases.json (CalculiX cases R1, R3), through the
+    CLI as given and with Coriolis off: each of the six tabulated frequencies per speed within 1 %
+    of the nearest of ours (w_coriolis, w_plain), and the steady position of the tabulated joint
+    within 1 % of its displacement from rest (1e-5 m at rest, the table's rounding)."""
+    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "reference", "3d",
+                        "cases.json")
+    with open(path) as f:
+        cases = json.load(f)
+    check(set(cases) >= {"R1", "R3"}, "reference3d: cases.json holds R1 and R3 (%s)" % sorted(cases))
+    for name, case in sorted(cases.items()):
+        rest = case["request"]["structure"]["joints"][case["tip_joint"]]
+        for coriolis in (True, False):
+            req = json.loads(json.dumps(case["request"]))
+            req["analysis"]["coriolis"] = coriolis
+            code, out, err = run(["solve", write_request(tmp, "%s-%d.json" % (name, coriolis), req)])
+            if not check(code == 0, "reference3d %s Coriolis %s: exit 0 (%d: %s)" % (name, coriolis, code,
+                                                                                      err.strip()[:200])):
+                continue
+            doc = parse_json(out, "reference3d %s" % name)
+            by_omega = {c["omega"]: c for c in doc["cases"]}
+            for exp in case["expected"]:
+                c = by_omega.get(exp["omega"])
+                if not check(c is not None and c["status"] == "solved",
+                             "reference3d %s W=%g Coriolis %s: solved" % (name, exp["omega"], coriolis)):
+                    continue
+                ours = [m["frequency_rad_s"] for m in c["modes"]]
+                want = exp["w_coriolis"] if coriolis else exp["w_plain"]
+                worst = max(min(abs(w - o) for o in ours) / w for w in want)
+                check(worst <= 0.01, "reference3d %s W=%g Coriolis %s: %d frequencies within 1 %% of CalculiX "
+                      "(worst %.3f %%; 24 lumped elements per member, per-element frames, stiffening)" %
+                      (name, exp["omega"], coriolis, len(want), 100 * worst))
+                tip = c["equilibrium"]["joints"][case["tip_joint"]][:3]
+                moved = math.dist(exp["tip"], rest)
+                err_m = math.dist(tip, exp["tip"])
+                limit = 0.01 * moved if exp["omega"] > 0 else 1e-5
+                check(err_m <= limit, "reference3d %s W=%g Coriolis %s: steady %s within %.2g m of CalculiX "
+                      "(off by %.2g m, displacement %.4f m)" % (name, exp["omega"], coriolis, case["tip_joint"],
+                                                                limit, err_m, moved))
+
+
 SCENARIOS = {
     "cantilever": t_cantilever,
     "invalid": t_invalid,
@@ -500,6 +541,7 @@ SCENARIOS = {
     "blade": t_blade,
     "error_estimate": t_error_estimate,
     "trust": t_trust,
+    "reference3d": t_reference3d,
 }
 
 
