@@ -184,6 +184,9 @@ typedef enum sm_basis {
 /** Most engine orders one solve looks for (sm_options.engine_orders, DESIGN.md 9.1). */
 #define SM_MAX_ENGINE_ORDERS 16
 
+/** Default of sm_options.max_dense_coordinates (the daemon's --max-coordinates default). */
+#define SM_DENSE_MAX_DEFAULT 4000
+
 /** Analysis options; fill with sm_default_options first. */
 typedef struct sm_options {
     sm_frame_scheme frames;          /* default SM_FRAMES_PER_ELEMENT */
@@ -203,6 +206,11 @@ typedef struct sm_options {
      * round-off): SM_SOLVER_AUTO (default) picks by size; the others force a path (tests,
      * benchmarks). */
     int solver;                      /* sm_solver */
+    /* The tree path hands an unstable steady state (K* not positive definite) or a stalled
+     * iteration to the dense eigen-analysis only up to this many coordinates (its cost is ~n^3
+     * time, ~10 n^2 doubles of memory); beyond, the case ends eigen_failed with the number of
+     * negative eigenvalues of K*.  0: SM_DENSE_MAX_DEFAULT. */
+    int max_dense_coordinates;
     /* DESIGN.md 9.1: engine orders n > 0 (finite, at most SM_MAX_ENGINE_ORDERS) whose critical
      * speeds (w(Omega) = n Omega along each tracked mode) sm_solve finds in a sweep; 0: none */
     int n_engine_orders;

@@ -254,6 +254,8 @@ static int sweep_eigen_failed(sm_case *c, int rc, int finite)
     if (rc == SM_NOMEM)
         return rc;
     c->status = SM_CASE_EIGEN_FAILED;
+    if (rc == SM_LIMIT) /* sweep_eigen wrote the reason */
+        return SM_OK;
     snprintf(c->message, sizeof c->message, "eigen-analysis failed at the converged equilibrium: %s%s",
              sm_strerror(rc),
              finite ? "" : " (K*, M* or C* has non-finite entries: the numbers overflow double precision)");
@@ -283,6 +285,22 @@ static int sweep_eigen(const sm_model *m, const double *q, sweep_lin *L, sweep_l
         c->t_eigen = sweep_ms() - t1;
         if (!fallback)
             return SM_OK;
+        int dmax = m->opt.max_dense_coordinates > 0 ? m->opt.max_dense_coordinates : SM_DENSE_MAX_DEFAULT;
+        if (m->n > dmax) { /* the dense path would take minutes and gigabytes */
+            if (L->t.neg > 0)
+                snprintf(c->message, sizeof c->message,
+                         "the steady state is unstable: K* has %d negative eigenvalues (structured "
+                         "factorisation); the modes of an unstable state are found by the dense "
+                         "eigen-analysis, which is limited to %d coordinates (this model has %d)",
+                         L->t.neg, dmax, m->n);
+            else
+                snprintf(c->message, sizeof c->message,
+                         "the structured eigen-analysis cannot give these modes (K* singular, too few "
+                         "coordinates for the modes asked, or no convergence), and the dense one is "
+                         "limited to %d coordinates (this model has %d)",
+                         dmax, m->n);
+            return SM_LIMIT;
+        }
         if ((rc = sweep_lin_alloc(m, D, 0)) < 0) /* the dense path decides */
             return rc;
         *use = D;

@@ -522,6 +522,7 @@ int tree_factor(const sm_model *m, tree_ws *t, int sym)
     int S = m->n_subs, d = t->d, neg = 0, sign = (d * S) % 2 ? -1 : 1, rc;
     double *C = t->work, *W = C + (size_t)d * (t->max_m + 2 * d);
     t->sym = sym;
+    t->neg = 0;
     for (int s = 0; s < S; s++)
         tree_front_init(m, t, s);
     for (int s = S - 1; s >= 0; s--) {

@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <math.h>
 #include <stdio.h>
+#include <limits.h>
 #include <string.h>
 
 #include <openssl/evp.h>
@@ -336,6 +337,8 @@ static int req_check_model(codec_request *r, const codec_limits *lim, codec_erro
         return codec_diag_error(r, &d, errs) == SM_NOMEM ? SM_NOMEM : SM_INVALID_INPUT;
     if (st != SM_OK)
         return st;
+    /* the tree path's fallback to the dense eigen-analysis is bounded alike (0: no cap) */
+    r->opt.max_dense_coordinates = lim->max_coordinates > 0 ? lim->max_coordinates : INT_MAX;
     dofs = node_dof * r->info.max_frame_nodes;
     if (dofs > lim->max_frame_dofs &&
         codec_errors_add(errs, "/frames",

@@ -157,6 +157,49 @@ int main(void)
     sm_default_options(&o);
     compare("beta 45, 96+96 per-element sweep", &ab.st, &o, sweep, 5, 1e-9);
 
+    /* the tree path's fallback to the dense eigen-analysis is capped by max_dense_coordinates: on
+     * the RF 2 paper basis with more modes than n / 4 (the tree path hands every speed over)
+     * a cap below n ends each converged speed eigen_failed with the reason and the equilibrium
+     * kept; a cap at n gives the dense answers */
+    tu_angled_beam(&ab, 90, 24, 24);
+    for (int cap = 1; cap <= 2; cap++) {
+        sm_default_options(&o);
+        o.frames = SM_FRAMES_PER_MEMBER;
+        o.frames_param = 1;
+        o.basis = SM_BASIS_PAPER;
+        o.coriolis = 0;
+        sm_result *rd = NULL, *rt = NULL;
+        sm_model *md = NULL, *mt = NULL;
+        TU_CHECK(sm_model_new(&md, &ab.st, &o, NULL) == SM_OK, "RF2 model");
+        o.modes = md->n / 4 + 1; /* more than the tree eigen-analysis takes: it hands over */
+        sm_model_free(md);
+        md = NULL;
+        TU_CHECK(sm_model_new(&md, &ab.st, &o, NULL) == SM_OK && sm_solve(md, sweep, 5, NULL, NULL, &rd, NULL) == SM_OK,
+                 "RF2 dense");
+        o.solver = SM_SOLVER_TREE;
+        o.max_dense_coordinates = cap == 1 ? 1 : md->n;
+        TU_CHECK(sm_model_new(&mt, &ab.st, &o, NULL) == SM_OK && sm_solve(mt, sweep, 5, NULL, NULL, &rt, NULL) == SM_OK,
+                 "RF2 tree, dense fallback capped at %d", o.max_dense_coordinates);
+        for (int i = 0; rd && rt && i < 5; i++) {
+            const sm_case *a = &rd->cases[i], *b = &rt->cases[i];
+            if (a->status != SM_CASE_SOLVED)
+                continue;
+            if (cap == 1) {
+                printf("RF2 W=%g cap 1: %s\n", sweep[i], b->message);
+                TU_CHECK(b->status == SM_CASE_EIGEN_FAILED && strstr(b->message, "limited to 1 coordinates") &&
+                             b->converged && b->nodes && b->n_modes == 0,
+                         "RF2 W=%g: capped: eigen_failed with the reason, the equilibrium kept", sweep[i]);
+            } else {
+                TU_CHECK(b->status == SM_CASE_SOLVED && fabs(b->frequency[0] - a->frequency[0]) <= 1e-9 * a->frequency[0],
+                         "RF2 W=%g: cap at n: the dense answer", sweep[i]);
+            }
+        }
+        sm_result_free(rd);
+        sm_result_free(rt);
+        sm_model_free(md);
+        sm_model_free(mt);
+    }
+
     /* the automatic choice */
     sm_model *m = NULL;
     tu_angled_beam(&ab, 90, 24, 24);
