@@ -14,11 +14,19 @@
  *  - consistent mass: modes of the full consistent-mass substructure; with a
  *    truncation and the augmented basis, unit-moment static modes are added
  *    (M-orthogonalised against the kept modes).
+ *  - a large frame keeping few modes (D >= 200 DOF, modes_per_frame <= D/8:
+ *    lowmodes_use) gets the same basis without D x D matrices: Kbar, Mbar in
+ *    their sparse pattern, the nm lowest modes by subspace iteration on the
+ *    sparse LDL' of Kbar (lowmodes.h), the attachment columns from that factor,
+ *    the same order and normalisation (modes_sub_sparse).  Small frames,
+ *    complete bases and sm_options.solver == SM_SOLVER_DENSE keep the dense
+ *    path below bit for bit.
  * Then per element: T_e = C(alpha) L_e N, d_e (P_e = d_e . q_s) and the
  * bending block of G_e; and the mass points (nodes, or Gauss points of every
  * element for consistent mass, plus point masses).
  */
 #include "spatial.h"
+#include "lowmodes.h"
 
 #include <lapacke.h>
 #include <math.h>
@@ -44,8 +52,9 @@ static int modes_dof(const sm_model *m, const sm_sub *b, int k, int c)
     return 3 * nd->local + c;
 }
 
-/* Kbar (and Mbar for consistent mass) of a substructure in its frame. */
-static void modes_assemble(const sm_model *m, const sm_sub *b, dmat *K, dmat *M)
+/* Kbar (and Mbar for consistent mass, M not NULL) of a substructure in its frame, dense or
+ * into their sparse pattern. */
+static void modes_assemble(const sm_model *m, const sm_sub *b, const csym_sink *K, const csym_sink *M)
 {
     double kl[36], kf[36];
     for (int j = 0; j < b->nel; j++) {
@@ -61,21 +70,21 @@ static void modes_assemble(const sm_model *m, const sm_sub *b, dmat *K, dmat *M)
         for (int r = 0; r < 6; r++)
             for (int c = 0; c < 6; c++)
                 if (idx[r] >= 0 && idx[c] >= 0)
-                    DM(K, idx[r], idx[c]) += kf[r + 6 * c];
-        if (M && M->a) {
+                    csym_sink_add(K, idx[r], idx[c], kf[r + 6 * c]);
+        if (M) {
             fe_mass_consistent_local(e->mu, e->l, kl);
             fe_to_frame(kl, alpha, kf);
             for (int r = 0; r < 6; r++)
                 for (int c = 0; c < 6; c++)
                     if (idx[r] >= 0 && idx[c] >= 0)
-                        DM(M, idx[r], idx[c]) += kf[r + 6 * c];
+                        csym_sink_add(M, idx[r], idx[c], kf[r + 6 * c]);
         }
     }
-    if (M && M->a) /* point masses (translations) */
+    if (M) /* point masses (translations) */
         for (int i = 0; i < b->nfree; i++) {
             double pm = m->nodes[b->free_nodes[i]].point_mass;
-            DM(M, 3 * i, 3 * i) += pm;
-            DM(M, 3 * i + 1, 3 * i + 1) += pm;
+            csym_sink_add(M, 3 * i, 3 * i, pm);
+            csym_sink_add(M, 3 * i + 1, 3 * i + 1, pm);
         }
 }
 
@@ -413,16 +422,191 @@ static int modes_mass_points(sm_model *m)
     return SM_OK;
 }
 
-/* Basis, K_s, T_e and d_e of planar substructure b. */
+/*
+ * The sparse path (lowmodes.h) for a frame that keeps nm << D modes.  Both mass models are
+ * solved on the full (u, v, phi) Kbar: with lumped mass Mbar = diag(node masses) on the
+ * translations and zero on the rotations, and Kbar^-1 Mbar returns vectors whose rotations are
+ * the condensed ones (phi = X t of modes_lumped), so the Ritz problem in their span is that of
+ * Kc phi = w^2 Mt phi.  The conventions of the dense paths follow: ascending w^2, every column
+ * mass-normalised (x' Mbar x = 1), then the attachment columns as there.
+ */
+
+/* N(:, j) = X(:, j) / sqrt(x' Mbar x) for j < nm (X from lowmodes_solve); work: D doubles. */
+static int modes_sparse_kept(sm_sub *b, const csym *M, int nm, const double *X, double *work)
+{
+    int D = b->N.rows;
+    for (int j = 0; j < nm; j++) {
+        const double *x = X + (size_t)D * j;
+        double nrm = 0;
+        csym_mul(M, 1, x, D, work, D);
+        for (int r = 0; r < D; r++) /* x' M x */
+            nrm += x[r] * work[r];
+        if (!(nrm > 0))
+            return SM_SINGULAR;
+        for (int r = 0; r < D; r++)
+            DM(&b->N, r, j) = x[r] / sqrt(nrm);
+    }
+    return SM_OK;
+}
+
+/* Lumped mass: the attachment columns of modes_lumped (t = 0, phi_a = 1, phi_c = -Kcc^-1 Kca)
+ * from the sparse Kcc, the rotations of the nodes that carry no child frame. */
+static int modes_attach_sparse(sm_sub *b, const csym *K, int nm)
+{
+    int F = b->nfree, na = b->n_attach, nc = 0, rc = SM_NOMEM;
+    int *keep = malloc((size_t)F * sizeof(int)), *map = malloc((size_t)F * sizeof(int));
+    csym Kcc = {0};
+    csym_ldl Fc = {0};
+    double *Y = NULL;
+    if (!keep || !map)
+        goto done;
+    for (int i = 0; i < F; i++) {
+        map[i] = modes_is_attach(b, i) ? -1 : nc;
+        if (map[i] >= 0)
+            keep[nc++] = 3 * i + 2;
+    }
+    if (!(Y = dm_vec((size_t)nc * na)))
+        goto done;
+    for (int a = 0; a < na; a++) { /* Y = -Kca: column phi_a of Kbar on the rotations kept */
+        int col = 3 * b->attach[a] + 2;
+        for (int q = K->p[col]; q < K->p[col + 1]; q++)
+            if (K->i[q] % 3 == 2 && map[K->i[q] / 3] >= 0)
+                Y[(size_t)nc * a + map[K->i[q] / 3]] = -K->x[q];
+    }
+    if (nc > 0) { /* Y = Kcc^-1 Y */
+        if ((rc = csym_sub(K, nc, keep, &Kcc)) < 0 || (rc = csym_factor(&Kcc, &Fc)) < 0)
+            goto done;
+        if ((rc = csym_solve_refined(&Kcc, &Fc, na, Y, nc)) < 0)
+            goto done;
+    }
+    for (int a = 0; a < na; a++)
+        for (int i = 0; i < F; i++)
+            DM(&b->N, 3 * i + 2, nm + a) = map[i] < 0 ? (i == b->attach[a] ? 1.0 : 0.0) : Y[(size_t)nc * a + map[i]];
+    rc = SM_OK;
+done:
+    free(keep);
+    free(map);
+    free(Y);
+    csym_free(&Kcc);
+    csym_ldl_free(&Fc);
+    return rc;
+}
+
+/* Consistent mass: the static unit-moment modes of modes_consistent with the sparse factor Fk,
+ * M-orthogonalised (two passes of modified Gram-Schmidt) against the kept modes and the earlier
+ * ones, M-normalised. */
+static int modes_consistent_attach_sparse(sm_sub *b, const csym *K, const csym_ldl *Fk, const csym *M, int nm,
+                                          int na)
+{
+    int D = b->N.rows, rc;
+    double *MV = dm_vec((size_t)D * (nm + na)), *Z = b->N.a + (size_t)D * nm;
+    if (!MV)
+        return SM_NOMEM;
+    for (int a = 0; a < na; a++)
+        Z[(size_t)D * a + 3 * b->attach[a] + 2] = 1.0;
+    if ((rc = csym_solve_refined(K, Fk, na, Z, D)) < 0) /* Z = Kbar^-1 E */
+        goto done;
+    csym_mul(M, nm, b->N.a, D, MV, D); /* MV = M N: v_j' M x = (M v_j)' x */
+    for (int a = nm; a < nm + na; a++) {
+        double *x = b->N.a + (size_t)D * a, *mx = MV + (size_t)D * a, nrm = 0;
+        for (int pass = 0; pass < 2; pass++)
+            for (int j = 0; j < a; j++) {
+                double s = 0;
+                for (int r = 0; r < D; r++) /* s = v_j' M x */
+                    s += MV[(size_t)D * j + r] * x[r];
+                for (int r = 0; r < D; r++) /* x -= s v_j */
+                    x[r] -= s * b->N.a[(size_t)D * j + r];
+            }
+        csym_mul(M, 1, x, D, mx, D);
+        for (int r = 0; r < D; r++) /* x' M x */
+            nrm += x[r] * mx[r];
+        rc = SM_SINGULAR;
+        if (!(nrm > 1e-24))
+            goto done;
+        for (int r = 0; r < D; r++) {
+            x[r] /= sqrt(nrm);
+            mx[r] /= sqrt(nrm);
+        }
+    }
+    rc = SM_OK;
+done:
+    free(MV);
+    return rc;
+}
+
+int modes_frame_csym(const sm_model *m, const sm_sub *b, csym *K, csym *M)
+{
+    int rc = lowmodes_frame_pattern(m, b, 3, K);
+    if (rc == SM_OK)
+        rc = lowmodes_frame_pattern(m, b, 3, M);
+    if (rc < 0)
+        return rc;
+    csym_sink ks = {NULL, K}, ms = {NULL, M};
+    int consistent = m->opt.mass == SM_MASS_CONSISTENT;
+    modes_assemble(m, b, &ks, consistent ? &ms : NULL);
+    for (int i = 0; !consistent && i < b->nfree; i++) {
+        double mass = m->nodes[b->free_nodes[i]].mass;
+        csym_add(M, 3 * i, 3 * i, mass);
+        csym_add(M, 3 * i + 1, 3 * i + 1, mass);
+    }
+    return SM_OK;
+}
+
+/* modes_sub on the sparse path; *fallback = 1 (nothing allocated in b) sends it to the dense one. */
+static int modes_sub_sparse(const sm_model *m, sm_sub *b, int *fallback)
+{
+    int D = 3 * b->nfree, nm, na, rc;
+    modes_count(&m->opt, b, &nm, &na);
+    csym K = {0}, M = {0};
+    csym_ldl Fk = {0};
+    int p = lowmodes_block(D, nm);
+    double *X = dm_vec((size_t)D * p), *mu = dm_vec((size_t)p), *work = dm_vec((size_t)D);
+    if (!X || !mu || !work) {
+        rc = SM_NOMEM;
+        goto done;
+    }
+    if ((rc = modes_frame_csym(m, b, &K, &M)) < 0 || (rc = csym_factor(&K, &Fk)) < 0)
+        goto done;
+    if ((rc = lowmodes_solve(&K, &Fk, &M, nm, X, mu, fallback)) < 0 || *fallback)
+        goto done;
+    b->m = nm + na;
+    if ((rc = dm_alloc(&b->N, D, b->m)) < 0 || (rc = modes_sparse_kept(b, &M, nm, X, work)) < 0)
+        goto done;
+    if (na > 0)
+        rc = m->opt.mass == SM_MASS_CONSISTENT ? modes_consistent_attach_sparse(b, &K, &Fk, &M, nm, na)
+                                               : modes_attach_sparse(b, &K, nm);
+    if (rc == SM_OK)
+        rc = lowmodes_project(&K, &b->N, &b->K);
+    if (rc == SM_OK)
+        rc = modes_elements(m, b);
+done:
+    csym_free(&K);
+    csym_free(&M);
+    csym_ldl_free(&Fk);
+    free(X);
+    free(mu);
+    free(work);
+    return rc;
+}
+
+/* Basis, K_s, T_e and d_e of planar substructure b: sparse for a large frame keeping few modes
+ * (lowmodes_use), else dense and complete. */
 static int modes_sub(const sm_model *m, sm_sub *b)
 {
-    int D = 3 * b->nfree;
+    int D = 3 * b->nfree, nm, na, fallback = 0;
+    modes_count(&m->opt, b, &nm, &na);
+    if (lowmodes_use(&m->opt, D, nm)) {
+        int rc = modes_sub_sparse(m, b, &fallback);
+        if (rc < 0 || !fallback)
+            return rc;
+    }
     dmat K = {0}, M = {0};
     int rc = dm_alloc(&K, D, D);
     if (rc == SM_OK && m->opt.mass == SM_MASS_CONSISTENT)
         rc = dm_alloc(&M, D, D);
     if (rc == SM_OK) {
-        modes_assemble(m, b, &K, &M);
+        csym_sink ks = {&K, NULL}, ms = {&M, NULL};
+        modes_assemble(m, b, &ks, M.a ? &ms : NULL);
         rc = m->opt.mass == SM_MASS_CONSISTENT ? modes_consistent(m, b, &K, &M) : modes_lumped(m, b, &K);
     }
     if (rc == SM_OK)

@@ -11,11 +11,16 @@
  * (6 per attachment), made Kbar-orthogonal to the kept modes and
  * diagonalised among themselves (Rayleigh-Ritz), so that the joint
  * kinematics are never lost.
+ * A large frame keeping few modes (D >= 200, modes_per_frame <= D/8: lowmodes_use) takes them
+ * from the sparse Kbar, Mbar instead (modes3_sub_sparse, lowmodes.h), then the same static
+ * modes, Rayleigh-Ritz and scaling; small frames, complete bases and sm_options.solver ==
+ * SM_SOLVER_DENSE keep the dense complete decomposition bit for bit.
  * Points: every FE node (lumped mass, rotary inertia, mode shapes) and, for
  * consistent mass, 4 Gauss points per element (Hermite bending in both
  * planes, linear axial and torsion; translational and torsional inertia).
  */
 #include "spatial.h"
+#include "lowmodes.h"
 
 #include <cblas.h>
 #include <lapacke.h>
@@ -58,7 +63,7 @@ static void modes3_axes(const sm_sub *b, const sm_elem *e, double E[9])
 }
 
 /* Kbar (D x D, frame DOFs) += the element stiffness: k_frame = Q' k_loc Q, local = E' frame. */
-static void modes3_add_element(const sm_model *m, const sm_sub *b, const sm_elem *e, dmat *K)
+static void modes3_add_element(const sm_model *m, const sm_sub *b, const sm_elem *e, const csym_sink *K)
 {
     double k[144], E[9];
     int idx[2] = {modes3_dof(m, b, e->n1), modes3_dof(m, b, e->n2)};
@@ -87,7 +92,7 @@ static void modes3_add_element(const sm_model *m, const sm_sub *b, const sm_elem
             if (idx[h] >= 0 && idx[g] >= 0)
                 for (int i = 0; i < 6; i++)
                     for (int j = 0; j < 6; j++)
-                        DM(K, idx[h] + i, idx[g] + j) += kf[(6 * h + i) + 12 * (6 * g + j)];
+                        csym_sink_add(K, idx[h] + i, idx[g] + j, kf[(6 * h + i) + 12 * (6 * g + j)]);
 }
 
 /*
@@ -130,7 +135,8 @@ static void modes3_interp(const sm_elem *e, const double E[9], double xi, double
 }
 
 /* Mbar += m S_u' S_u + S_psi' I S_psi for a point with interpolation S (6 x 12) on idx. */
-static void modes3_add_point_mass(const double S[72], const int idx[2], double mass, const double I[9], dmat *M)
+static void modes3_add_point_mass(const double S[72], const int idx[2], double mass, const double I[9],
+                                  const csym_sink *M)
 {
     double IS[36]; /* I S_psi: 3 x 12 */
     for (int i = 0; i < 3; i++)
@@ -144,7 +150,7 @@ static void modes3_add_point_mass(const double S[72], const int idx[2], double m
             double s = 0;
             for (int r = 0; r < 3; r++)
                 s += mass * S[r + 6 * a] * S[r + 6 * c] + S[3 + r + 6 * a] * IS[r + 3 * c];
-            DM(M, ra + a % 6, rc + c % 6) += s;
+            csym_sink_add(M, ra + a % 6, rc + c % 6, s);
         }
 }
 
@@ -166,8 +172,8 @@ static void modes3_torsion_inertia(const sm_elem *e, const double E[9], double w
             I[r + 3 * c] = E[r] * ip * E[c];
 }
 
-/* Kbar and Mbar of substructure b (D = 6F). */
-static void modes3_assemble(const sm_model *m, const sm_sub *b, dmat *K, dmat *M)
+/* Kbar and Mbar of substructure b (D = 6F), dense or into their sparse pattern. */
+static void modes3_assemble(const sm_model *m, const sm_sub *b, const csym_sink *K, const csym_sink *M)
 {
     int consistent = m->opt.mass == SM_MASS_CONSISTENT;
     for (int j = 0; j < b->nel; j++) {
@@ -191,9 +197,9 @@ static void modes3_assemble(const sm_model *m, const sm_sub *b, dmat *K, dmat *M
         modes3_to_frame(b->A0, consistent ? nd->point_rot : nd->rot, If);
         double mass = consistent ? nd->point_mass : nd->mass;
         for (int c = 0; c < 3; c++) {
-            DM(M, 6 * i + c, 6 * i + c) += mass;
+            csym_sink_add(M, 6 * i + c, 6 * i + c, mass);
             for (int r = 0; r < 3; r++)
-                DM(M, 6 * i + 3 + r, 6 * i + 3 + c) += If[r + 3 * c];
+                csym_sink_add(M, 6 * i + 3 + r, 6 * i + 3 + c, If[r + 3 * c]);
         }
     }
 }
@@ -226,19 +232,7 @@ static int modes3_ritz(int D, int k, const dmat *K, const dmat *M, double *X, do
     cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, k, k, D, 1.0, X, D, KX, D, 0.0, Kr, k);
     cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, D, k, D, 1.0, M->a, D, X, D, 0.0, KX, D);
     cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, k, k, D, 1.0, X, D, KX, D, 0.0, Mr, k);
-    int info = LAPACKE_dsygvd(LAPACK_COL_MAJOR, 1, 'V', 'U', k, Mr, k, Kr, k, w);
-    rc = dm_lapack_status(info, info > k ? SM_SINGULAR : SM_LAPACK_FAILED);
-    if (rc < 0)
-        goto done;
-    /* descending mu: reverse the columns */
-    cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, D, k, k, 1.0, X, D, Mr, k, 0.0, Y, D);
-    for (int j = 0; j < k; j++)
-        memcpy(X + (size_t)D * j, Y + (size_t)D * (k - 1 - j), (size_t)D * sizeof(double));
-    for (int j = 0; j < k / 2; j++) {
-        double t = w[j];
-        w[j] = w[k - 1 - j];
-        w[k - 1 - j] = t;
-    }
+    rc = lowmodes_reduced(D, k, X, Kr, Mr, w, Y); /* descending mu, shared with lowmodes_ritz */
 done:
     free(KX);
     free(Kr);
@@ -453,15 +447,104 @@ inertia:
     return SM_OK;
 }
 
+/*
+ * The basis N of b from the sparse Kbar (factor F) and Mbar when it keeps nm << D modes
+ * (lowmodes.h): the nm lowest by subspace iteration, then the same steps as modes3_basis --
+ * static attachment modes, Kbar-orthogonal to the kept ones, Rayleigh-Ritz among themselves,
+ * every column scaled by modes3_scale.  *fallback = 1 (nothing allocated) when the iteration
+ * does not converge: the caller takes the dense path.
+ */
+static int modes3_basis_sparse(const sm_model *m, sm_sub *b, const csym *K, const csym_ldl *F, const csym *M,
+                               int *fallback)
+{
+    int D = 6 * b->nfree, nm, na, rc = SM_NOMEM;
+    modes3_count(&m->opt, b, &nm, &na);
+    int p = lowmodes_block(D, nm);
+    double *X = dm_vec((size_t)D * p), *w = dm_vec((size_t)p + na), *KZ = dm_vec((size_t)D * (na ? na : 1));
+    double *C = dm_vec((size_t)nm * (na ? na : 1));
+    if (!X || !w || !KZ || !C)
+        goto done;
+    if ((rc = lowmodes_solve(K, F, M, nm, X, w, fallback)) < 0 || *fallback)
+        goto done;
+    rc = SM_NOMEM;
+    b->m = nm + na;
+    if (dm_alloc(&b->N, D, b->m))
+        goto done;
+    memcpy(b->N.a, X, (size_t)D * nm * sizeof(double));
+    if (na > 0) {
+        /* static attachment modes: Kbar^-1 (unit force and moment at each attachment node) */
+        double *Z = b->N.a + (size_t)D * nm;
+        for (int a = 0; a < b->n_attach; a++)
+            for (int c = 0; c < 6; c++)
+                Z[(size_t)D * (6 * a + c) + 6 * b->attach[a] + c] = 1.0;
+        if ((rc = csym_solve_refined(K, F, na, Z, D)) < 0)
+            goto done;
+        /* Z -= Phi (Phi' Kbar Z): Kbar-orthogonal to the kept (Kbar-orthonormal) modes */
+        csym_mul_acc(K, na, Z, D, KZ, D);
+        cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, nm, na, D, 1.0, b->N.a, D, KZ, D, 0.0, C, nm);
+        cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, D, na, nm, -1.0, b->N.a, D, C, nm, 1.0, Z, D);
+        if ((rc = lowmodes_ritz(K, M, na, Z, w + nm)) < 0)
+            goto done;
+    }
+    for (int j = 0; j < b->m; j++)
+        modes3_scale(D, b->N.a + (size_t)D * j);
+    rc = SM_OK;
+done:
+    free(X);
+    free(w);
+    free(KZ);
+    free(C);
+    return rc;
+}
+
+int modes3_frame_csym(const sm_model *m, const sm_sub *b, csym *K, csym *M)
+{
+    int rc = lowmodes_frame_pattern(m, b, 6, K);
+    if (rc == SM_OK)
+        rc = lowmodes_frame_pattern(m, b, 6, M);
+    if (rc == SM_OK) {
+        csym_sink ks = {NULL, K}, ms = {NULL, M};
+        modes3_assemble(m, b, &ks, &ms);
+    }
+    return rc;
+}
+
+/* modes3_sub on the sparse path: Kbar, Mbar in their pattern, the basis, K_s, T_e, d_e. */
+static int modes3_sub_sparse(const sm_model *m, sm_sub *b, int *fallback)
+{
+    csym K = {0}, M = {0};
+    csym_ldl F = {0};
+    int rc = modes3_frame_csym(m, b, &K, &M);
+    if (rc == SM_OK)
+        rc = csym_factor(&K, &F);
+    if (rc == SM_OK)
+        rc = modes3_basis_sparse(m, b, &K, &F, &M, fallback);
+    if (rc == SM_OK && !*fallback)
+        rc = lowmodes_project(&K, &b->N, &b->K);
+    if (rc == SM_OK && !*fallback)
+        rc = modes3_elements(m, b);
+    csym_free(&K);
+    csym_free(&M);
+    csym_ldl_free(&F);
+    return rc;
+}
+
 int modes3_sub(const sm_model *m, sm_sub *b)
 {
-    int D = 6 * b->nfree;
+    int D = 6 * b->nfree, nm, na, fallback = 0;
+    modes3_count(&m->opt, b, &nm, &na);
+    if (lowmodes_use(&m->opt, D, nm)) {
+        int rc = modes3_sub_sparse(m, b, &fallback);
+        if (rc < 0 || !fallback)
+            return rc;
+    }
     dmat K = {0}, M = {0};
     int rc = dm_alloc(&K, D, D);
     if (rc == SM_OK)
         rc = dm_alloc(&M, D, D);
     if (rc == SM_OK) {
-        modes3_assemble(m, b, &K, &M);
+        csym_sink ks = {&K, NULL}, ms = {&M, NULL};
+        modes3_assemble(m, b, &ks, &ms);
         rc = modes3_basis(m, b, &K, &M);
     }
     if (rc == SM_OK)
