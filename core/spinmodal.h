@@ -204,7 +204,9 @@ typedef struct sm_options {
     double tolerance;                /* ||dq|| <= tol*max(1,||q||), default 1e-10 */
     /* Linear algebra (not part of the JSON request; results do not depend on it beyond
      * round-off): SM_SOLVER_AUTO (default) picks by size; the others force a path (tests,
-     * benchmarks). */
+     * benchmarks).  SM_SOLVER_DENSE also keeps every frame's component modes on the dense
+     * complete eigen-solve (AUTO and TREE take the few kept modes of a large frame, D >= 200
+     * DOF and modes_per_frame <= D/8, by sparse subspace iteration: core/lowmodes.c). */
     int solver;                      /* sm_solver */
     /* The tree path hands an unstable steady state (K* not positive definite) or a stalled
      * iteration to the dense eigen-analysis only up to this many coordinates (its cost is ~n^3
@@ -346,9 +348,10 @@ typedef int (*sm_progress_fn)(void *user, int done, int total);
  * before each substructure's component modes after the first, with done =
  * substructures built and total = all of them; a nonzero return stops the
  * build and returns SM_CANCELED (*out NULL, diag says how far it got).  The
- * cost of one substructure is ~(3 x its free nodes)^3, so this bounds how
- * long a cancel, a time limit or a shutdown waits.  Other returns as
- * sm_model_new.
+ * cost of one substructure is ~D^3 for its D = 3 (spatial 6) x free nodes DOF
+ * when it keeps all or many of its modes, ~D when it keeps few of a large
+ * frame (the sparse path), so this bounds how long a cancel, a time limit or
+ * a shutdown waits.  Other returns as sm_model_new.
  */
 int sm_model_build(sm_model **out, const sm_structure *st, const sm_options *opt,
                    sm_progress_fn cb, void *user, sm_diag *diag);
