@@ -60,6 +60,7 @@ typedef struct store_file_lock {
     char *path;      /* "<db>.lock", malloc'd */
     dev_t dev;       /* the locked file, to notice it being deleted or replaced */
     ino_t ino;
+    int dbfd;        /* the database file itself, OFD-locked at DB_LOCK_BYTE; -1 when not */
 } store_file_lock;
 
 /* The backend's state: s->impl of a SQLite store. */

@@ -37,6 +37,11 @@ holds; none decides a pass by elapsed time.
   cors          --cors-origin accepts one exact origin only ('*', lists and
                 paths are refused at start); OPTIONS answers 204 on a route and
                 404 on an unknown path.
+
+The db_faults scenario also starts the second daemon through a symlink and a
+hard link to the database (both used to run beside the first), and full_disk
+checks /readyz is 503 as soon as the job is failed (the small write recording
+the failure used to clear it).
 """
 import os
 import socket
@@ -334,6 +339,21 @@ def scenario_db_faults(exe, tmp):
     check(p.returncode == 1 and ("in use" in p.stderr or "lock" in p.stderr),
           "a second daemon on the same database refuses to start (exit %d: %s)"
           % (p.returncode, p.stderr.strip()[:160]))
+    link, hard = os.path.join(tmp, "link.db"), os.path.join(tmp, "hard.db")
+    os.symlink(db, link)
+    os.link(db, hard)
+    for what, path in (("a symlink", link), ("a hard link", hard)):
+        try:   # one that starts runs until the timeout kills it
+            p = subprocess.run([exe, "--db", path, "--listen", "127.0.0.1:0"],
+                               capture_output=True, text=True, timeout=timescale.budget(10))
+            rc, err = p.returncode, p.stderr
+        except subprocess.TimeoutExpired as e:
+            rc, err = "none: it started", (e.stderr or b"").decode("utf-8", "replace")
+        check(rc == 1 and "in use" in err,
+              "a second daemon on the same database through %s refuses to start (exit %s: %s)"
+              % (what, rc, err.strip()[-160:]))
+    os.unlink(link)
+    os.unlink(hard)
     check(a.get("/readyz").status == 200, "the first daemon is still ready")
     check(a.stop() == 0, "first daemon stops cleanly")
     # corrupt pages: overwrite the middle of the database file
