@@ -306,11 +306,10 @@ def scenario_full_disk(exe, tmp):
         if doc and doc.get("state") == "failed":
             check((doc.get("error") or {}).get("type") in ("store_error", "interrupted"),
                   "failed with error type store_error (%s)" % (doc.get("error") or {}).get("type"))
-        rz = wait_until(lambda: d.get("/readyz").status == 503 or None, 30)
-        r = d.get("/readyz")
+        r = d.get("/readyz")   # at once: the failure is remembered for 30 s
         db = (r.json() or {}).get("checks", {}).get("database")
-        check(rz and db in ("full", "write_failed", "ioerr"),
-              "/readyz 503 with checks.database %r" % db)
+        check(r.status == 503 and db in ("full", "write_failed", "ioerr"),
+              "/readyz 503 as soon as the job is failed, checks.database %r (%s)" % (db, r.status))
         os.unlink(filler)
         check(wait_until(lambda: d.get("/readyz").status == 200, 60),
               "/readyz is 200 again once space is freed")
