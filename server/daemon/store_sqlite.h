@@ -78,6 +78,8 @@ typedef struct store_sqlite {
     char *path;                          /* the database file, malloc'd */
     dev_t db_dev;                        /* the file opened, to notice it being */
     ino_t db_ino;                        /* deleted or replaced (store_health) */
+    double probe_at;                     /* monotonic s of store_health's last write that
+                                            succeeded, 0 after a failure (pool_lock) */
     store_file_lock lock;
 } store_sqlite;
 
