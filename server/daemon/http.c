@@ -577,6 +577,7 @@ int http_start(http **out, const http_config *cfg, jobs *j, store *st, metrics *
         rc = HTTP_ADDRESS;
         goto fail;
     }
+    http_guard_set_cap(h, cfg->connection_limit);
     rc = http_guard_start(h);
     if (rc == HTTP_OK)
         rc = http_listen(h, cfg, ai);

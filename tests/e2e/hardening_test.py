@@ -39,6 +39,12 @@ holds; none decides a pass by elapsed time.
                 404 on an unknown path.
 
 From the hostile re-run (tests/attack, issue 10), each a failure of that run:
+  spread_trickle 600 connections trickling request heads from 60 addresses,
+                reopened as fast as the daemon closes them (the per-client
+                limit does not see them): /livez still answers, because at most
+                the connection limit less an eighth may wait for a request and
+                the longest-waiting one is closed for a newcomer
+                (spinmodal_http_shed_total, event=connections_shed).
   readyz_storm  3000 GET /readyz made 3000 write transactions and a 4 MB WAL;
                 the write probe now runs at most once a second: the WAL stays
                 under 1 MB (generous: 250 probes).
@@ -443,6 +449,60 @@ def scenario_cors(exe, tmp):
           "http://localhost:5173", "OPTIONS on a route: 204 with the origin (got %s)" % r.status)
     r = d.request("OPTIONS", "/no/such/path", headers={"Origin": "http://localhost:5173"})
     check(r.status == 404, "OPTIONS on an unknown path: 404, not 204 (got %s)" % r.status)
+    check(d.stop() == 0, "daemon stops cleanly")
+
+
+def scenario_spread_trickle(exe, tmp):
+    import threading
+    n, sources = 600, 60
+    d = Daemon(exe, tmp, ["--workers", "1", "--request-deadline", "30"])
+    d.start()
+    port = d.port
+    head = b"GET /livez HTTP/1.1\r\nHost: x\r\nX-Slow: "
+    socks = [None] * n
+    stop = threading.Event()
+
+    def reopen(i):
+        try:
+            s = connect_from("127.0.0.%d" % (2 + i % sources), port)
+            s.send(head[:1])
+            socks[i] = s
+        except OSError:
+            socks[i] = None
+
+    def attacker():
+        while not stop.is_set():
+            for i in range(n):
+                s = socks[i]
+                if s is None or open_or_closed(s) == "closed":
+                    if s is not None:
+                        s.close()
+                    reopen(i)
+            stop.wait(0.2)
+    for i in range(n):
+        reopen(i)
+    th = threading.Thread(target=attacker, daemon=True)
+    th.start()
+    try:
+        for k in range(5):
+            try:
+                r = d.get("/livez", timeout=10)
+                status = r.status
+            except OSError as e:
+                status = repr(e)
+            check(status == 200, "/livez #%d answers while %d connections from %d addresses "
+                  "trickle (got %s)" % (k + 1, n, sources, status))
+    finally:
+        stop.set()
+        th.join(timescale.budget(30))
+        for s in socks:
+            if s is not None:
+                s.close()
+    got = wait_until(lambda: (metric(d, "spinmodal_http_shed_total") or 0) > 0 and
+                     metric(d, "spinmodal_http_shed_total"), 5)   # counted once a second
+    check(bool(got), "spinmodal_http_shed_total counts the closed ones (%s)" % got)
+    check(wait_until(lambda: any("connections_shed" in l for l in d.log_lines()), 5),
+          "the closures are logged (event=connections_shed)")
     check(d.stop() == 0, "daemon stops cleanly")
 
 
