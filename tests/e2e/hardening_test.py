@@ -39,6 +39,10 @@ holds; none decides a pass by elapsed time.
                 404 on an unknown path.
 
 From the hostile re-run (tests/attack, issue 10), each a failure of that run:
+  encoded_nul   a %00 in the path or a query value no longer cuts it short
+                (GET /livez%00 was /livez, ?format=csv%00json was csv, an id
+                followed by %00x was the job); an HTTP/1.1 request without
+                Host is a 400 (RFC 9112), an HTTP/1.0 one is answered.
   spread_trickle 600 connections trickling request heads from 60 addresses,
                 reopened as fast as the daemon closes them (the per-client
                 limit does not see them): /livez still answers, because at most
@@ -449,6 +453,26 @@ def scenario_cors(exe, tmp):
           "http://localhost:5173", "OPTIONS on a route: 204 with the origin (got %s)" % r.status)
     r = d.request("OPTIONS", "/no/such/path", headers={"Origin": "http://localhost:5173"})
     check(r.status == 404, "OPTIONS on an unknown path: 404, not 204 (got %s)" % r.status)
+    check(d.stop() == 0, "daemon stops cleanly")
+
+
+def scenario_encoded_nul(exe, tmp):
+    d = Daemon(exe, tmp, ["--workers", "1"])
+    d.start()
+    r = d.request("POST", "/v1/analyses?wait=%g" % timescale.wait_param(30),
+                  body=open(EXAMPLE, "rb").read(), headers={"Content-Type": "application/json"})
+    job = (r.json() or {}).get("id", "0" * 64)
+    for path, want in (("/livez%00", 404), ("/livez%00.html", 404),
+                       ("/v1/analyses/%s%%00" % job, 404), ("/v1/analyses/%s%%00x" % job, 404),
+                       ("/v1/analyses/%s/result?format=csv%%00json" % job, 400),
+                       ("/v1/analyses/%s?wait=1%%000" % job, 400),
+                       ("/v1/analyses/%s/result?format=%%63sv" % job, 200), ("/live%7a", 200)):
+        r = d.raw(("GET %s HTTP/1.1\r\nHost: x\r\nConnection: close\r\n\r\n" % path).encode())
+        check(r.status == want, "GET %s: %d (got %s)" % (path, want, r.status))
+    r = d.raw(b"GET /livez HTTP/1.1\r\nConnection: close\r\n\r\n")
+    check(r.status == 400, "HTTP/1.1 without Host: 400 (got %s)" % r.status)
+    r = d.raw(b"GET /livez HTTP/1.0\r\n\r\n")
+    check(r.status == 200, "HTTP/1.0 without Host: 200 (got %s)" % r.status)
     check(d.stop() == 0, "daemon stops cleanly")
 
 
