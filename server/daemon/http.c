@@ -491,6 +491,45 @@ static int http_configure(http *h, const http_config *cfg)
     return HTTP_OK;
 }
 
+/* The value of hex digit ch, or -1. */
+static int http_hex(char ch)
+{
+    if (ch >= '0' && ch <= '9')
+        return ch - '0';
+    if (ch >= 'a' && ch <= 'f')
+        return ch - 'a' + 10;
+    if (ch >= 'A' && ch <= 'F')
+        return ch - 'A' + 10;
+    return -1;
+}
+
+/*
+ * MHD_OPTION_UNESCAPE_CALLBACK: percent-decode s in place (the path, and
+ * each query key and value) and return its new length; "%00" is kept as
+ * the three characters.  libmicrohttpd's own decoder turns it into a NUL
+ * that silently cuts the string short: "/livez%00.html" was served as
+ * /livez, "?format=csv%00json" as csv, "/v1/analyses/{id}%00x" as the job.
+ */
+static size_t http_unescape(void *cls, struct MHD_Connection *c, char *s)
+{
+    size_t r = 0, w = 0;
+    int hi, lo;
+
+    (void)cls;
+    (void)c;
+    while (s[r]) {
+        if (s[r] == '%' && (hi = http_hex(s[r + 1])) >= 0 && (lo = http_hex(s[r + 2])) >= 0 &&
+            (hi | lo) != 0) {
+            s[w++] = (char)(hi * 16 + lo);
+            r += 3;
+        } else {
+            s[w++] = s[r++];
+        }
+    }
+    s[w] = '\0';
+    return w;
+}
+
 /* Start the libmicrohttpd daemon on ai; 0 or HTTP_LISTEN. */
 static int http_listen(http *h, const http_config *cfg, const struct addrinfo *ai)
 {
@@ -508,6 +547,8 @@ static int http_listen(http *h, const http_config *cfg, const struct addrinfo *a
                             MHD_OPTION_CONNECTION_TIMEOUT, (unsigned)cfg->connection_timeout,
                             MHD_OPTION_NOTIFY_COMPLETED, &http_completed, h,
                             MHD_OPTION_NOTIFY_CONNECTION, &http_guard_notify, h,
+                            MHD_OPTION_UNESCAPE_CALLBACK, &http_unescape, h,
+                            MHD_OPTION_STRICT_FOR_CLIENT, 1,
                             MHD_OPTION_END);
     if (!h->d)
         return HTTP_LISTEN;
@@ -577,6 +618,7 @@ int http_start(http **out, const http_config *cfg, jobs *j, store *st, metrics *
         rc = HTTP_ADDRESS;
         goto fail;
     }
+    http_guard_set_cap(h, cfg->connection_limit);
     rc = http_guard_start(h);
     if (rc == HTTP_OK)
         rc = http_listen(h, cfg, ai);

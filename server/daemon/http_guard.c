@@ -22,6 +22,17 @@
  * record is removed under the same lock in the CLOSED notification, which
  * libmicrohttpd sends before it closes the socket, so the guard never
  * touches a descriptor that was closed and reused.
+ *
+ * Shedding.  The per-client limit does not stop trickling clients spread
+ * over many addresses: 600 of them from 60 addresses held all 512
+ * connection slots, and libmicrohttpd refused every other connection
+ * (/livez included) until the deadline closed them, when they could come
+ * back.  So at most incomplete_cap connections (the limit less an eighth,
+ * http_guard_set_cap) may wait for their request; a new connection over
+ * that shuts down the incomplete one whose deadline is nearest (the one
+ * that has waited longest).  A complete request is answered at once, so
+ * the slots kept free always serve it; an idle keep-alive connection counts
+ * as incomplete and may be closed under such pressure.
  */
 #include "http_internal.h"
 
@@ -41,6 +52,36 @@ struct http_conn {
     int expired;             /* 1 once the guard shut the socket down */
     struct http_conn *prev, *next;
 };
+
+void http_guard_set_cap(http *h, int connection_limit)
+{
+    int reserve = connection_limit / 8 > 16 ? connection_limit / 8 : 16;
+
+    h->incomplete_cap = connection_limit - reserve > 1 ? connection_limit - reserve : 1;
+}
+
+/*
+ * Called with guard_lock held after a connection was added: when more than
+ * incomplete_cap connections wait for their request, shut down the one with
+ * the nearest deadline (never `except`, the newcomer).
+ */
+static void http_guard_shed(http *h, const http_conn *except)
+{
+    http_conn *k, *oldest = NULL;
+    int waiting = 0;
+
+    for (k = h->conns; k; k = k->next)
+        if (!k->expired && k->deadline > 0.0) {
+            waiting++;
+            if (k != except && (!oldest || k->deadline < oldest->deadline))
+                oldest = k;
+        }
+    if (waiting <= h->incomplete_cap || !oldest)
+        return;
+    oldest->expired = 1;
+    shutdown(oldest->fd, SHUT_RDWR);
+    h->shed_pending++;
+}
 
 /* MHD_OPTION_NOTIFY_CONNECTION: track connections from accept to close. */
 void http_guard_notify(void *cls, struct MHD_Connection *c, void **socket_context,
@@ -64,6 +105,7 @@ void http_guard_notify(void *cls, struct MHD_Connection *c, void **socket_contex
         if (h->conns)
             h->conns->prev = k;
         h->conns = k;
+        http_guard_shed(h, k);
         pthread_mutex_unlock(&h->guard_lock);
         *socket_context = k;
         return;
@@ -134,7 +176,7 @@ static void *http_guard_main(void *arg)
     http *h = arg;
     struct timespec ts;
     char count[16];
-    int n;
+    int n, shed;
 
     pthread_mutex_lock(&h->guard_lock);
     while (!h->guard_stop) {
@@ -143,6 +185,17 @@ static void *http_guard_main(void *arg)
         pthread_cond_timedwait(&h->guard_cv, &h->guard_lock, &ts);
         if (h->guard_stop)
             break;
+        shed = h->shed_pending;
+        h->shed_pending = 0;
+        if (shed > 0) { /* logged here, once a second, not once per connection */
+            pthread_mutex_unlock(&h->guard_lock);
+            snprintf(count, sizeof(count), "%d", shed);
+            log_event("warn", "connections_shed", "closed", count, "reason",
+                      "more connections waiting for their request than the slots allow",
+                      (const char *)NULL);
+            metrics_shed(h->mx, shed);
+            pthread_mutex_lock(&h->guard_lock);
+        }
         n = http_guard_sweep(h, http_mono());
         if (n > 0) {
             pthread_mutex_unlock(&h->guard_lock);

@@ -92,6 +92,8 @@ struct http {
     pthread_mutex_t guard_lock; /* guards conns and every http_conn, guard_stop */
     pthread_cond_t guard_cv; /* wakes the guard thread to stop */
     http_conn *conns;        /* open connections, newest first */
+    int incomplete_cap;      /* most connections whose request has not arrived in full */
+    int shed_pending;        /* of those, closed at accept and not yet logged */
     pthread_t guard_thread;
     int guard_started;       /* 1 while the guard thread runs */
     int guard_stop;          /* 1: the guard thread leaves */
@@ -249,6 +251,9 @@ void http_guard_answering(http *h, struct MHD_Connection *c);
 
 /** The request on c was answered: the next one must arrive within the deadline. */
 void http_guard_answered(http *h, struct MHD_Connection *c);
+
+/** Allow connection_limit less an eighth (at least 16 kept free) incomplete requests. */
+void http_guard_set_cap(http *h, int connection_limit);
 
 /** Start the guard thread; HTTP_OK or HTTP_NOMEM. */
 int http_guard_start(http *h);

@@ -293,11 +293,15 @@ static store_state jobs_record_fallback(jobs *j, const char *id, int why)
     rc = err ? store_finish(j->st, id, STORE_FAILED, log_now(), 0, err, NULL, 0, NULL, 0)
              : STORE_NOMEM;
     free(err);
-    jobs_store_health(j, rc);
+    /* these small writes may well succeed on a full disk: only their failures
+     * count, so /readyz keeps saying that a result could not be stored */
+    if (rc != STORE_OK)
+        jobs_store_health(j, rc);
     if (rc == STORE_OK || rc == STORE_CONFLICT || rc == STORE_NOT_FOUND)
         return STORE_FAILED;
     rc = store_requeue(j->st, id);
-    jobs_store_health(j, rc);
+    if (rc != STORE_OK)
+        jobs_store_health(j, rc);
     if (rc == STORE_OK) {
         pthread_mutex_lock(&j->lock);
         jobs_posted_locked(j);

@@ -38,6 +38,7 @@ struct metrics {
     unsigned long long solve_count;
     unsigned long long cache_hits, cache_misses;
     unsigned long long deadline_closed; /* connections closed by the request deadline */
+    unsigned long long shed;            /* incomplete requests closed to free a slot */
     unsigned long long store_errors[-STORE_RC_MIN + 1]; /* failures by -store_rc */
     unsigned long long store_pruned;    /* finished jobs removed by retention */
     unsigned long long lease_requeued, lease_failed; /* jobs of dead replicas */
@@ -135,6 +136,13 @@ void metrics_deadline_closed(metrics *m, int n)
 {
     pthread_mutex_lock(&m->lock);
     m->deadline_closed += (unsigned long long)(n > 0 ? n : 0);
+    pthread_mutex_unlock(&m->lock);
+}
+
+void metrics_shed(metrics *m, int n)
+{
+    pthread_mutex_lock(&m->lock);
+    m->shed += (unsigned long long)(n > 0 ? n : 0);
     pthread_mutex_unlock(&m->lock);
 }
 
@@ -251,6 +259,11 @@ static void metrics_render_locked(const metrics *m, metrics_buf *b)
                       "# TYPE spinmodal_http_deadline_closed_total counter\n"
                       "spinmodal_http_deadline_closed_total %llu\n",
                    m->deadline_closed);
+    metrics_printf(b, "# HELP spinmodal_http_shed_total Connections whose request had not "
+                      "arrived in full, closed to keep slots free for complete requests.\n"
+                      "# TYPE spinmodal_http_shed_total counter\n"
+                      "spinmodal_http_shed_total %llu\n",
+                   m->shed);
     metrics_printf(b, "# HELP spinmodal_store_errors_total Failures of the job store, by kind "
                       "(full, busy, corrupt, readonly, ioerr, gone, ...).\n"
                       "# TYPE spinmodal_store_errors_total counter\n");

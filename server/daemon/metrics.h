@@ -41,6 +41,9 @@ void metrics_cache(metrics *m, int hit);
 /** Count n connections closed because their request missed --request-deadline. */
 void metrics_deadline_closed(metrics *m, int n);
 
+/** Count n connections with an incomplete request closed to free slots (http_guard.c). */
+void metrics_shed(metrics *m, int n);
+
 /** Count one failure of the store, by kind (store_rc_name: "full", "busy", "corrupt" ...). */
 void metrics_store_error(metrics *m, int rc);
 

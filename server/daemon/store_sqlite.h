@@ -60,6 +60,7 @@ typedef struct store_file_lock {
     char *path;      /* "<db>.lock", malloc'd */
     dev_t dev;       /* the locked file, to notice it being deleted or replaced */
     ino_t ino;
+    int dbfd;        /* the database file itself, OFD-locked at DB_LOCK_BYTE; -1 when not */
 } store_file_lock;
 
 /* The backend's state: s->impl of a SQLite store. */
@@ -77,6 +78,8 @@ typedef struct store_sqlite {
     char *path;                          /* the database file, malloc'd */
     dev_t db_dev;                        /* the file opened, to notice it being */
     ino_t db_ino;                        /* deleted or replaced (store_health) */
+    double probe_at;                     /* monotonic s of store_health's last write that
+                                            succeeded, 0 after a failure (pool_lock) */
     store_file_lock lock;
 } store_sqlite;
 

@@ -10,7 +10,13 @@
  * no longer names the file opened (store_sqlite_writer_begin), and
  * store_health compares the lock file likewise, then commits one real write —
  * user_version rewritten unchanged, one WAL frame, no fsync — so read-only
- * remounts, revoked permissions and a full device show as their kinds.
+ * remounts, revoked permissions and a full device show as their kinds.  A
+ * write that succeeded is not repeated for PROBE_EVERY seconds (callers in
+ * between get STORE_OK; the two file checks run every time, and after a
+ * failure every call probes again, so a recovery shows at once): /readyz is
+ * open to anyone, and a client polling it 18 800 times a second made as many
+ * write transactions, which grew the WAL to 4 MB and kept it there — on a
+ * nearly full disk the probes ate the space a result needed.
  *
  * Retention.  Finished jobs are deleted oldest end first, in transactions
  * of at most PRUNE_BATCH rows so submissions wait at most one batch.  The
@@ -34,11 +40,14 @@
 
 #include <stdio.h>
 #include <string.h>
+#include <time.h>
 
 enum {
     PRUNE_BATCH = 256,     /* deletions per transaction */
     VACUUM_PAGES = 1024    /* pages given back per transaction (4 MiB at 4 KiB) */
 };
+
+#define PROBE_EVERY 1.0    /* s between two write probes of store_health */
 
 /* ---- probes --------------------------------------------------------------- */
 
@@ -52,11 +61,21 @@ int store_sqlite_check_writable(store *s)
     return store_sqlite_writer_end(s, STORE_OK, 0);
 }
 
+/* Monotonic seconds, for PROBE_EVERY. */
+static double probe_clock(void)
+{
+    struct timespec ts;
+
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 int store_sqlite_health(store *s)
 {
     store_sqlite *q = s->impl;
     store_conn *c = NULL;
     char sql[48];
+    double now;
     int rc, status;
 
     status = store_sqlite_same_file(s, q->path, q->db_dev, q->db_ino, "database file", "health");
@@ -65,15 +84,25 @@ int store_sqlite_health(store *s)
                                         "health");
     if (status != STORE_OK)
         return status;
+    (void)pthread_mutex_lock(&q->pool_lock);
+    now = probe_clock();
+    if (q->probe_at > 0.0 && now - q->probe_at < PROBE_EVERY) {
+        (void)pthread_mutex_unlock(&q->pool_lock);
+        return STORE_OK;
+    }
+    (void)pthread_mutex_unlock(&q->pool_lock);
     /* a real write: the schema version, rewritten unchanged, is one page */
     status = store_sqlite_writer_begin(s, &c, 0, "health");
-    if (status != STORE_OK)
-        return status;
-    snprintf(sql, sizeof sql, "PRAGMA user_version = %d", q->version);
-    rc = sqlite3_exec(c->db, sql, NULL, NULL, NULL);
-    if (rc != SQLITE_OK)
-        return store_sqlite_writer_end(s, store_sqlite_fail(c, rc), 0);
-    return store_sqlite_writer_end(s, STORE_OK, 1);
+    if (status == STORE_OK) {
+        snprintf(sql, sizeof sql, "PRAGMA user_version = %d", q->version);
+        rc = sqlite3_exec(c->db, sql, NULL, NULL, NULL);
+        status = store_sqlite_writer_end(s, rc == SQLITE_OK ? STORE_OK : store_sqlite_fail(c, rc),
+                                         rc == SQLITE_OK);
+    }
+    (void)pthread_mutex_lock(&q->pool_lock);
+    q->probe_at = status == STORE_OK ? probe_clock() : 0.0;
+    (void)pthread_mutex_unlock(&q->pool_lock);
+    return status;
 }
 
 /* ---- size ----------------------------------------------------------------- */

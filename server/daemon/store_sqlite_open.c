@@ -4,7 +4,8 @@
  * its migrations, crash recovery (store.h: store_open_with).
  *
  * Order at open, each step refusing with a sentence in err:
- *   1. lock `<db>.lock` exclusively (one store per database file);
+ *   1. lock `<db>.lock` exclusively (one store per database file), and the
+ *      database file itself (one store per inode, whatever its path);
  *   2. open the writer and look at the file: SQLite at all, ours, not newer;
  *   3. PRAGMA quick_check (optional, on by default): damaged pages refuse
  *      the open with SQLite's first findings instead of failing later, in
@@ -25,6 +26,15 @@
  * file within this process.  The file holds the owner's pid (text) for the
  * refusal message; it is never deleted (deleting it would let a newcomer
  * lock a new file while the old owner runs; store_health reports it gone).
+ * The lock file is named after the path, so a second daemon given another
+ * path to the same database — a symlink, a hard link — would lock another
+ * file and run beside the first (a hard link even with its own WAL, which
+ * corrupts the database).  So the database file itself is locked too: an
+ * OFD write lock on one byte at DB_LOCK_BYTE (2^62), far from the bytes
+ * SQLite's own POSIX locks use (2^30 … 2^30 + 511), so the two never meet;
+ * being an OFD lock it stays held when SQLite closes a descriptor of the
+ * file.  It follows the inode, whatever the path.  A file that cannot be
+ * opened for writing is left to the checks of step 2 (they refuse it).
  *
  * Schema.  PRAGMA user_version is the schema version; store_migrations[k]
  * takes a database from version k to k + 1, each in its own transaction.
@@ -167,9 +177,58 @@ static int lock_take(store_file_lock *l, const char *db, char *err, size_t errle
     return STORE_OK;
 }
 
-/* Drop the lock (closing its only descriptor) and free the path. */
+#define DB_LOCK_BYTE ((off_t)1 << 62)
+
+/* The OFD lock on the database file itself (the inode, whatever path names
+ * it).  Returns a store_rc with err set on refusal; STORE_OK also when the
+ * file cannot be opened for writing or the kernel has no OFD locks (the
+ * checks of step 2, and the lock file, then stand alone). */
+static int lock_inode(store_file_lock *l, const char *db, char *err, size_t errlen)
+{
+#ifdef F_OFD_SETLK
+    struct flock fl;
+    struct stat st;
+    int fd = open(db, O_RDWR | O_CREAT | O_CLOEXEC | O_NOCTTY | O_NONBLOCK, 0644);
+
+    if (fd < 0)
+        return STORE_OK;
+    memset(&fl, 0, sizeof fl);
+    fl.l_type = F_WRLCK;
+    fl.l_whence = SEEK_SET;
+    fl.l_start = DB_LOCK_BYTE;
+    fl.l_len = 1;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        (void)close(fd);
+        return STORE_OK;
+    }
+    if (fcntl(fd, F_OFD_SETLK, &fl) != 0) {
+        int e = errno;
+        (void)close(fd);
+        if (e == EAGAIN || e == EACCES) {
+            store_seterr(err, errlen, "database '%s' is in use by another process (another "
+                         "spinmodald has the same file open, through this path or another one: "
+                         "a symlink or a hard link); stop it, or give this daemon another "
+                         "database", db);
+            return STORE_IN_USE;
+        }
+        return STORE_OK;   /* EINVAL: no OFD locks on this file system */
+    }
+    l->dbfd = fd;
+#else
+    (void)l;
+    (void)db;
+    (void)err;
+    (void)errlen;
+#endif
+    return STORE_OK;
+}
+
+/* Drop the locks (closing their only descriptors) and free the path. */
 static void lock_drop(store_file_lock *l)
 {
+    if (l->dbfd >= 0)
+        (void)close(l->dbfd);
+    l->dbfd = -1;
     if (l->fd >= 0)
         (void)close(l->fd);
     l->fd = -1;
@@ -525,6 +584,7 @@ int store_sqlite_open(store *s, const store_settings *set, int *requeued, char *
         return STORE_NOMEM;
     }
     q->lock.fd = -1;
+    q->lock.dbfd = -1;
     q->busy_ms = set->busy_timeout_ms > 0 ? set->busy_timeout_ms : 0;
     s->impl = q;
     if (locks_init(q) != 0) {
@@ -533,6 +593,8 @@ int store_sqlite_open(store *s, const store_settings *set, int *requeued, char *
         goto fail;
     }
     rc = lock_take(&q->lock, q->path, err, errlen);
+    if (rc == STORE_OK)
+        rc = lock_inode(&q->lock, q->path, err, errlen);
     if (rc == STORE_OK)
         rc = sq_open_db(s, set, requeued, err, errlen);
     if (rc == STORE_OK)
