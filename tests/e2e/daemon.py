@@ -190,8 +190,9 @@ class Daemon:
                         self.host, self.port = addr
                         return self
                 if self.proc.poll() is not None and not any(t.is_alive() for t in self._threads):
+                    # the tail from the lines in hand: log_tail() takes the lock held here
                     raise DaemonError("spinmodald exited with %s before listening; log:\n%s"
-                                      % (self.proc.returncode, self.log_tail()))
+                                      % (self.proc.returncode, "\n".join(self._lines[-40:])))
                 left = deadline - time.monotonic()
                 if left <= 0:
                     break
