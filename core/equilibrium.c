@@ -34,6 +34,9 @@
  * first increments were rejected (140 Newton iterations on the 48-element R3 blade at 10 rad/s,
  * 36 with both; the planar path keeps its continuation, and its answers, unchanged). */
 #define EQ_SPATIAL_FIRST 4
+/* A change of sign of det(Kt) is accepted as a crossed bifurcation only on a step no larger
+ * than this fraction of the target s (the step is halved down to it first). */
+#define EQ_CROSS_STEP 1e-4
 
 typedef struct eq_ws {
     int tree;                /* 1: tangent in the tree form (t, light kin), else dense Kt */
@@ -380,8 +383,21 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
                 why = "the deformation leaves the small-strain range (axial strain above 1 %): "
                       "the steady state runs away; use more frames";
             } else if (eq_det_sign(&w, n) != sign) {
-                ok = 0;
-                why = "the tangent stiffness becomes singular (a limit or bifurcation point)";
+                /* A critical point lies inside the step.  Shrink the step until it is small;
+                 * a converged corrector that stays on the predicted branch there has crossed
+                 * a bifurcation of a branch that goes on (the symmetric steady state of a
+                 * structure past its divergence speed): accept it, the state is reported
+                 * unstable by the eigen-analysis.  A limit point (the branch turns back) is
+                 * not crossed: beyond it Newton finds nothing near the predictor. */
+                if (sn - s > EQ_CROSS_STEP * s_to) {
+                    ok = 0;
+                    why = "the tangent stiffness becomes singular (a limit point: the branch turns back)";
+                } else {
+                    sign = -sign;
+                    out->crossings++;
+                    if (out->crossings == 1)
+                        out->first_crossing_s = 0.5 * (s + sn);
+                }
             }
         } else {
             why = "Newton-Raphson did not converge";

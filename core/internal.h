@@ -249,6 +249,9 @@ typedef struct sm_eq_out {
     double residual;    /* ||F(q)|| at the returned q */
     double last_s;      /* last Omega^2 with a converged equilibrium */
     int canceled;       /* 1 when the progress callback asked to stop */
+    int crossings;      /* critical points (sign changes of det Kt) crossed on the way: the
+                           state beyond a bifurcation is an unstable steady state */
+    double first_crossing_s; /* Omega^2 (mid-step) of the first of them; 0 when none */
     char message[256];  /* why it did not converge, or the error; "" on success */
 } sm_eq_out;
 
@@ -407,5 +410,13 @@ int sweep_single(const sm_model *m, double omega, sm_progress_fn cb, void *user,
 /** Critical speeds of the tracked sweep r for m->opt.engine_orders into r->critical (cb, user:
  *  the caller's cancel callback, asked between refining solves).  SM_OK, SM_NOMEM, SM_CANCELED. */
 int crit_find(const sm_model *m, sm_result *r, const int *ord, int n, sm_progress_fn cb, void *user);
+
+/* ------------------------------------------------------------ diverge.c */
+/** Divergence speeds of a solved sweep (ord: the speeds in ascending order) into r->divergence:
+ *  SM_OK, SM_NOMEM or SM_CANCELED. */
+int div_find(const sm_model *m, sm_result *r, const int *ord, int n, sm_progress_fn cb, void *user);
+/** *lambda = the lowest eigenvalue of K* (dense, P frozen) at the steady state of omega, from rest.
+ *  SM_OK; SM_NO_EQUILIBRIUM without one; SM_NOMEM, SM_LAPACK_FAILED or SM_CANCELED (cb). */
+int sweep_lowest(const sm_model *m, double omega, sm_progress_fn cb, void *user, double *lambda);
 
 #endif

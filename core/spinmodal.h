@@ -460,11 +460,29 @@ typedef struct sm_critical {
     double label_confidence;
 } sm_critical;
 
+/** A divergence speed: between two speeds of a sweep the count of negative eigenvalues of K*
+ *  changes, the lowest eigenvalue of K* passing through zero (a static instability). */
+typedef struct sm_divergence {
+    double omega;             /* rad/s: where that eigenvalue is zero (refined by regula falsi on
+                                 single-speed solves; interpolated or the bracket's middle when
+                                 refined == 0) */
+    double omega_interpolated; /* rad/s: linear interpolation between the bracketing speeds */
+    double omega_below, omega_above; /* the bracketing speeds of the sweep, rad/s */
+    int onset;                /* 1: stability lost with rising speed (more negative eigenvalues
+                                 above), 0: regained */
+    int negative_below, negative_above; /* negative eigenvalues of K* at the two speeds */
+    int refined;              /* 1: |d omega| <= 1e-6 omega */
+    int iterations;           /* single-speed solves spent */
+    int label_kind, label_ordinal; /* the softening mode: the lowest root on the stable side */
+} sm_divergence;
+
 typedef struct sm_result {
     int n_cases;
     sm_case *cases;           /* n_cases, in the order of the requested speeds */
     int n_critical;           /* DESIGN.md 9.1: critical speeds found (engine orders given) */
     sm_critical *critical;    /* n_critical, by order then speed, or NULL */
+    int n_divergence;         /* divergence speeds found in the sweep */
+    sm_divergence *divergence; /* n_divergence, ascending, or NULL */
 } sm_result;
 
 /** The text of a label: "1st flap", "2nd edge", "3rd torsion", "1st axial", "1st bending",

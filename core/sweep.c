@@ -7,6 +7,7 @@
 #include "spatial.h"
 
 #include <complex.h>
+#include <lapacke.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -47,6 +48,7 @@ void sm_result_free(sm_result *r)
     }
     free(r->cases);
     free(r->critical);
+    free(r->divergence);
     free(r);
 }
 
@@ -355,6 +357,15 @@ static int sweep_modes(const sm_model *m, const double *q, sweep_lin *L, sm_case
     double scale = k ? hypot(e.wre[k - 1], e.wim[k - 1]) : 1;
     c->stable = e.negative == 0 && !(e.max_re > 1e-8 * fmax(scale, 1e-3));
     c->status = c->stable ? SM_CASE_SOLVED : SM_CASE_UNSTABLE;
+    if (!c->stable && e.negative > 0)
+        snprintf(c->message, sizeof c->message,
+                 "equilibrium found, unstable: K* has %d negative eigenvalue%s (a static divergence: "
+                 "the steady state exists but a disturbance grows away from it)",
+                 e.negative, e.negative == 1 ? "" : "s");
+    else if (!c->stable)
+        snprintf(c->message, sizeof c->message,
+                 "equilibrium found, unstable: a root has a positive real part %.3g (a dynamic "
+                 "instability)", e.max_re);
     eig_out_free(&e);
     sweep_lin_free(&D);
     return SM_OK;
@@ -500,6 +511,43 @@ fail:
     return rc;
 }
 
+int sweep_lowest(const sm_model *m, double omega, sm_progress_fn cb, void *user, double *lambda)
+{
+    int n = m->n, rc, found = 0;
+    double *q = dm_vec((size_t)n), *w = dm_vec((size_t)n), vl = 0, vu = 0;
+    int *ifail = calloc((size_t)n, sizeof(int));
+    sm_progress pr = {cb, user, 0, 1};
+    sm_eq_out eo;
+    sweep_lin D;
+    memset(&D, 0, sizeof D);
+    *lambda = NAN;
+    rc = SM_NOMEM;
+    if (!q || !w || !ifail)
+        goto done;
+    if ((rc = eq_solve(m, q, 0, omega * omega, 1, &pr, &eo)) < 0)
+        goto done;
+    rc = eo.canceled ? SM_CANCELED : SM_NO_EQUILIBRIUM;
+    if (!eo.converged)
+        goto done;
+    if ((rc = sweep_lin_alloc(m, &D, 0)) < 0)
+        goto done;
+    sweep_linearize(m, q, omega, &D);
+    /* the lowest eigenvalue of the symmetric K* (its sign change is that of det K*) */
+    rc = dm_lapack_status(LAPACKE_dsyevx(LAPACK_COL_MAJOR, 'N', 'I', 'L', n, D.K.a, n, vl, vu, 1, 1,
+                                         0.0, &found, w, NULL, 1, ifail),
+                          SM_LAPACK_FAILED);
+    if (rc == SM_OK && found == 1)
+        *lambda = w[0];
+    else if (rc == SM_OK)
+        rc = SM_LAPACK_FAILED;
+done:
+    sweep_lin_free(&D);
+    free(q);
+    free(w);
+    free(ifail);
+    return rc;
+}
+
 int sweep_single(const sm_model *m, double omega, sm_progress_fn cb, void *user, sm_result **out)
 {
     int rc = sweep_run(m, &omega, 1, cb, user, out, NULL);
@@ -522,7 +570,9 @@ static int sweep_trust(const sm_model *m, sm_result *r, const double *omegas, in
             goto done;
     if ((rc = track_sweep(r, ord, n)) < 0)
         goto done;
-    rc = crit_find(m, r, ord, n, cb, user);
+    if ((rc = crit_find(m, r, ord, n, cb, user)) < 0)
+        goto done;
+    rc = div_find(m, r, ord, n, cb, user);
 done:
     free(ord);
     return rc;
