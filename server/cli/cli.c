@@ -252,7 +252,8 @@ static void cli_table_rows(FILE *f, const json_t *cases, int w[CLI_TABLE_COLS], 
 static int cli_print_table(FILE *f, const json_t *result)
 {
     const json_t *cases = json_object_get(result, "cases"), *w = json_object_get(result,
-                                                                                 "input_warnings");
+                                                                                 "input_warnings"),
+                 *d;
     int width[CLI_TABLE_COLS], j;
     size_t i;
 
@@ -262,6 +263,17 @@ static int cli_print_table(FILE *f, const json_t *result)
     for (j = 0; j < CLI_TABLE_COLS; j++)
         fprintf(f, j < CLI_TABLE_COLS - 1 ? "%*s  " : "%-*s\n", width[j], cli_table_cols[j].head);
     cli_table_rows(f, cases, width, 1);
+    json_array_foreach(json_object_get(result, "divergence_speeds"), i, d) {
+        const json_t *br = json_object_get(d, "bracket");
+        int onset = !strcmp(json_string_value(json_object_get(d, "kind")), "onset");
+        fprintf(f, "divergence: %s at %.6g rad/s (%.6g rpm), %s mode %s, between %.6g and %.6g rad/s%s\n",
+                onset ? "static stability lost" : "static stability regained",
+                json_number_value(json_object_get(d, "omega_rad_s")),
+                json_number_value(json_object_get(d, "rpm")),
+                json_string_value(json_object_get(d, "mode")), onset ? "softens to zero" : "stiffens from zero",
+                json_number_value(json_array_get(br, 0)), json_number_value(json_array_get(br, 1)),
+                json_is_true(json_object_get(d, "refined")) ? "" : " (not refined)");
+    }
     for (i = 0; i < json_array_size(w); i++)
         fprintf(f, "warning: %s: %s\n",
                 json_string_value(json_object_get(json_array_get(w, i), "pointer")),

@@ -253,8 +253,10 @@ int codec_result_spanwise(char **out, size_t *len, const json_t *result, int bmo
 /**
  * The critical speeds of a result document (its "critical_speeds", DESIGN.md 9.1) as CSV:
  * header order,tracked_index,label,label_confidence,omega,rpm,frequency_rad_s,frequency_hz,
- * refined,omega_interpolated; one row per critical speed (just the header when the document
- * has none).  Works on a stored document, so the daemon can serve it without solving again.
+ * refined,omega_interpolated; one row per critical speed, then one row of order 0 per
+ * divergence speed (its "divergence_speeds": the frequency of the softening mode passes
+ * through zero; tracked_index and label_confidence empty, frequency 0), just the header when
+ * the document has neither.  Works on a stored document, so the daemon can serve it without solving again.
  * result is borrowed; *out receives a malloc'd NUL-terminated string (free), *len its length
  * (len may be NULL).  Returns SM_OK or SM_NOMEM.
  */

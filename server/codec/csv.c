@@ -11,7 +11,10 @@
  * before, so a reader that takes columns by position still works; the
  * columns label, label_confidence, tracked_index, tracking_flag (DESIGN.md
  * 9.1) follow them for the same reason.  codec_critical_speeds_csv writes
- * the critical speeds of a result document as a second table.  With an
+ * the critical speeds of a result document as a second table, and after
+ * them its divergence speeds as rows of engine order 0 (a static
+ * instability: the frequency passes through zero; tracked_index and
+ * label_confidence empty, frequency 0).  With an
  * error estimate (DESIGN.md 9) a last column error_estimate_rad_s follows;
  * without one the table is as before.
  */
@@ -177,6 +180,17 @@ int codec_critical_speeds_csv(char **out, size_t *len, const json_t *result)
         fputc(',', f);
         csv_json_num(f, c, "frequency_hz");
         fprintf(f, ",%s,", json_is_true(json_object_get(c, "refined")) ? "true" : "false");
+        csv_json_num(f, c, "omega_interpolated");
+        fputc('\n', f);
+    }
+    cs = json_object_get(result, "divergence_speeds");
+    json_array_foreach(cs, i, c) { /* engine order 0: the frequency passes through zero */
+        const char *lab = json_string_value(json_object_get(c, "mode"));
+        fprintf(f, "0,,%s,,", lab ? lab : "");
+        csv_json_num(f, c, "omega_rad_s");
+        fputc(',', f);
+        csv_json_num(f, c, "rpm");
+        fprintf(f, ",0,0,%s,", json_is_true(json_object_get(c, "refined")) ? "true" : "false");
         csv_json_num(f, c, "omega_interpolated");
         fputc('\n', f);
     }

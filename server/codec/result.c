@@ -389,6 +389,38 @@ static int res_critical_speeds(json_t *doc, const codec_request *r, const sm_res
     return 0;
 }
 
+/* One divergence speed (shared DESIGN A). */
+static json_t *res_divergence(const sm_divergence *d)
+{
+    char lab[32];
+
+    sm_mode_label(d->label_kind, d->label_ordinal, lab, sizeof(lab));
+    return json_pack("{s:o, s:o, s:s, s:s, s:[o, o], s:[i, i], s:b, s:i, s:o}", "omega_rad_s",
+                     res_real(d->omega), "rpm", res_real(d->omega * 60 / CODEC_TWO_PI), "mode", lab,
+                     "kind", d->onset ? "onset" : "recovery", "bracket", res_real(d->omega_below),
+                     res_real(d->omega_above), "negative_eigenvalues", d->negative_below,
+                     d->negative_above, "refined", d->refined, "refine_solves", d->iterations,
+                     "omega_interpolated", res_real(d->omega_interpolated));
+}
+
+/* The document's "divergence_speeds" (only when the sweep crossed one: results without keep
+ * their bytes). */
+static int res_divergence_speeds(json_t *doc, const sm_result *res)
+{
+    json_t *a;
+    int i;
+
+    if (res->n_divergence <= 0)
+        return 0;
+    a = json_array();
+    if (json_object_set_new(doc, "divergence_speeds", a))
+        return -1;
+    for (i = 0; i < res->n_divergence; i++)
+        if (json_array_append_new(a, res_divergence(&res->divergence[i])))
+            return -1;
+    return 0;
+}
+
 int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
                         const sm_result *res)
 {
@@ -428,7 +460,7 @@ int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
     if (json_array_size(warnings) &&
         json_object_set_new(doc, "input_warnings", json_deep_copy(warnings)))
         goto fail;
-    if (res_critical_speeds(doc, r, res))
+    if (res_critical_speeds(doc, r, res) || res_divergence_speeds(doc, res))
         goto fail;
     *out = doc;
     return SM_OK;
