@@ -529,6 +529,155 @@ def t_reference3d(tmp):
                       "(off by %.2g m, displacement %.4f m)" % (name, exp["omega"], coriolis, case["tip_joint"],
                                                                 limit, err_m, moved))
 
+# The square section of the CalculiX cases (tests/reference/3d/README.md).
+SQUARE = {"EA": 1.08444e8, "EI_flap": 14000.0, "EI_edge": 14000.0, "GJ": 10758.0, "mass_per_length": 1.2,
+          "flap_inertia": 1.549e-4, "edge_inertia": 1.549e-4}
+
+
+def scaled(section, **factors):
+    out = dict(section)
+    for k, f in factors.items():
+        out[k] = section[k] * f
+    return out
+
+
+def rigid_mast(omega, elements=12, gj=100.0, mast=2.0, arm=3.0):
+    """A radial arm stiff in bending and stretching, soft in torsion (GJ), carrying at its outer
+    end a stiff mast parallel to the spin axis.  The mast turning about the arm sees the
+    torsion spring k = GJ/arm and the spin softening of its mass off the plane:
+    w^2 = k/J - Omega^2, J = sum m z^2 of the mast's lumped masses; divergence at sqrt(k/J)."""
+    stiff = scaled(SQUARE, EA=100, EI_flap=100, EI_edge=100, GJ=100)
+    armsec = scaled(SQUARE, EA=100, EI_flap=100, EI_edge=100)
+    armsec["GJ"] = gj
+    return {
+        "structure": {
+            "joints": {"O": [0.5, 0, 0], "C": [0.5 + arm, 0, 0], "P": [0.5 + arm, 0, mast]},
+            "sections": {"arm": armsec, "mast": stiff},
+            "members": [{"id": "arm", "from": "O", "to": "C", "section": "arm", "elements": elements},
+                        {"id": "mast", "from": "C", "to": "P", "section": "mast", "elements": elements}],
+            "clamp": "O",
+        },
+        "frames": "per_element",
+        "analysis": {"omega": omega, "modes": 3, "coriolis": False},
+    }
+
+
+def rigid_mast_kj(elements=12, gj=100.0, mast=2.0, arm=3.0):
+    """k/J of rigid_mast: J from the lumped masses of the mast (the node at C turns on the axis)."""
+    h = mast / elements
+    mu = SQUARE["mass_per_length"]
+    j = sum(mu * h * (i * h) ** 2 for i in range(1, elements)) + 0.5 * mu * h * mast ** 2
+    return (gj / arm) / j
+
+
+def t_divergence(tmp):
+    """A static divergence, said plainly (issue 22): the rigid mast on a torsion-soft arm
+    (w^2 = k/J - Omega^2, analytic) below, at and past its divergence speed sqrt(k/J): the
+    frequencies follow the analytic line within 1 %; past it the steady state is found and
+    reported unstable with one negative eigenvalue and a real root sqrt(Omega^2 - k/J) (not
+    no_equilibrium); the sweep's divergence_speeds holds sqrt(k/J) within 0.5 % (refined, the
+    softening mode named), as an order-0 row of --critical-csv and a line under --table; with
+    Coriolis the same speed; a sweep that does not cross it reports none."""
+    kj = rigid_mast_kj()
+    wdiv = math.sqrt(kj)
+    speeds = [0.0, 0.5 * wdiv, 0.9 * wdiv, 1.2 * wdiv, 2.0 * wdiv]
+    for coriolis in (False, True):
+        req = rigid_mast(speeds)
+        req["analysis"]["coriolis"] = coriolis
+        path = write_request(tmp, "mast-%d.json" % coriolis, req)
+        rc, out, err = run(["solve", path])
+        check(rc == 0, "divergence: exit 0 for a sweep with unstable speeds (got %d; %.200s)" % (rc, err))
+        doc = parse_json(out, "divergence")
+        if not doc:
+            continue
+        tag = "Coriolis %s" % ("on" if coriolis else "off")
+        for c in doc["cases"]:
+            om = c["omega"]
+            if om < wdiv:
+                check(c["status"] == "solved" and c["stability"]["negative_eigenvalues"] == 0,
+                      "divergence %s W=%.3f (below): solved, stable (%s)" % (tag, om, c["status"]))
+                if not coriolis:
+                    want = math.sqrt(kj - om * om)
+                    got = c["modes"][0]["frequency_rad_s"]
+                    check(abs(got - want) <= 0.01 * want,
+                          "divergence W=%.3f: lowest w %.5f rad/s against sqrt(k/J - W^2) = %.5f (1 %%)" %
+                          (om, got, want))
+            else:
+                check(c["status"] == "unstable" and c["equilibrium"]["converged"] is True,
+                      "divergence %s W=%.3f (past): equilibrium found, unstable (%s)" % (tag, om, c["status"]))
+                check(c["stability"] == {"stable": False, "negative_eigenvalues": 1},
+                      "divergence %s W=%.3f: one negative eigenvalue (%s)" % (tag, om, c["stability"]))
+                msg = c.get("diagnostics", {}).get("message", "")
+                check("equilibrium found, unstable" in msg and "1 negative eigenvalue" in msg,
+                      "divergence %s W=%.3f: the message says so (%s)" % (tag, om, msg[:120]))
+                if not coriolis:
+                    re_ = abs(c["modes"][0]["eigenvalue"][0])
+                    want = math.sqrt(om * om - kj)
+                    check(abs(re_ - want) <= 0.02 * want,
+                          "divergence W=%.3f: real root %.5f against sqrt(W^2 - k/J) = %.5f (2 %%)" %
+                          (om, re_, want))
+        ds = doc.get("divergence_speeds", [])
+        if check(len(ds) == 1, "divergence %s: one divergence speed (%s)" % (tag, ds)):
+            d = ds[0]
+            check(abs(d["omega_rad_s"] - wdiv) <= 0.005 * wdiv and d["refined"] is True,
+                  "divergence %s: at %.5f rad/s against sqrt(k/J) = %.5f (0.5 %%), refined" %
+                  (tag, d["omega_rad_s"], wdiv))
+            check(d["bracket"] == [speeds[2], speeds[3]] and d["kind"] == "onset" and
+                  d["negative_eigenvalues"] == [0, 1], "divergence %s: bracket, onset, counts (%s)" % (tag, d))
+            check(abs(d["rpm"] - d["omega_rad_s"] * 60 / (2 * math.pi)) < 1e-9 and "torsion" in d["mode"],
+                  "divergence %s: rpm and the softening mode (%s)" % (tag, d["mode"]))
+        if coriolis:
+            continue
+        rc, out, err = run(["solve", "--table", path])
+        line = [l for l in out.splitlines() if l.startswith("divergence:")]
+        check(rc == 0 and len(line) == 1 and bool(ds) and "%.6g rad/s" % ds[0]["omega_rad_s"] in line[0] and
+              "torsion" in line[0], "divergence: --table ends with the divergence line (%s)" % line)
+        rc, out, err = run(["solve", "--critical-csv", path])
+        rows = [l.split(",") for l in out.splitlines()[1:]]
+        check(rc == 0 and len(rows) == 1 and rows[0][0] == "0" and abs(float(rows[0][4]) - wdiv) <= 0.005 * wdiv,
+              "divergence: --critical-csv has one order-0 row at the divergence speed (%s)" % rows)
+    # below the divergence only: nothing reported
+    rc, out, err = run(["solve", write_request(tmp, "mast-low.json", rigid_mast([0.0, 0.5 * wdiv, 0.9 * wdiv]))])
+    doc = parse_json(out, "divergence below")
+    check(doc is not None and "divergence_speeds" not in doc, "divergence: a sweep below it has no divergence_speeds")
+    # a single speed past it (from rest): found and unstable, not no_equilibrium
+    rc, out, err = run(["solve", write_request(tmp, "mast-past.json", rigid_mast(1.5 * wdiv))])
+    doc = parse_json(out, "divergence single")
+    check(doc is not None and doc["cases"][0]["status"] == "unstable" and rc == 0,
+          "divergence: one speed past it from rest: unstable (%s), exit 0" % (doc and doc["cases"][0]["status"]))
+
+
+def t_masts(tmp):
+    """Analytic masts (issue 22).  (1) A mast on the spin axis (isotropic section): in the
+    rotating frame its bending pair is w0^2 - Omega^2 without Coriolis and |w0 +- Omega| with it,
+    w0 its frequency at rest (an axisymmetric rotor).  (2) The stiff mast on a torsion-soft arm:
+    see t_divergence.  Within 0.2 %."""
+    req = {
+        "structure": {
+            "joints": {"O": [0, 0, 0], "T": [0, 0, 3.0]},
+            "sections": {"sq": SQUARE},
+            "members": [{"id": "mast", "from": "O", "to": "T", "section": "sq", "elements": 24,
+                         "flap_direction": [1, 0, 0]}],
+            "clamp": "O",
+        },
+        "frames": "per_element",
+        "analysis": {"omega": [0.0, 5.0, 10.0, 20.0], "modes": 4, "coriolis": False},
+    }
+    for coriolis in (False, True):
+        req["analysis"]["coriolis"] = coriolis
+        rc, out, err = run(["solve", write_request(tmp, "axis-%d.json" % coriolis, req)])
+        doc = parse_json(out, "mast on the axis")
+        if not check(rc == 0 and doc is not None, "masts: the mast on the axis solves (%d: %.200s)" % (rc, err)):
+            continue
+        w0 = doc["cases"][0]["modes"][0]["frequency_rad_s"]
+        for c in doc["cases"][1:]:
+            om = c["omega"]
+            got = sorted(m["frequency_rad_s"] for m in c["modes"])[:2]
+            want = sorted([abs(w0 - om), w0 + om]) if coriolis else [math.sqrt(w0 * w0 - om * om)] * 2
+            worst = max(abs(g - w) / w for g, w in zip(got, want))
+            check(worst <= 2e-3, "masts: on the axis, Coriolis %s, W=%g: %s against %s (worst %.2e)" %
+                  ("on" if coriolis else "off", om, ["%.4f" % g for g in got], ["%.4f" % w for w in want], worst))
+
 
 SCENARIOS = {
     "cantilever": t_cantilever,
@@ -542,6 +691,8 @@ SCENARIOS = {
     "error_estimate": t_error_estimate,
     "trust": t_trust,
     "reference3d": t_reference3d,
+    "divergence": t_divergence,
+    "masts": t_masts,
 }
 
 
