@@ -532,18 +532,6 @@ def t_reference3d(tmp):
                 check(err_m <= limit, "reference3d %s W=%g Coriolis %s: steady %s within %.2g m of the reference "
                       "(off by %.2g m, displacement %.4f m)" % (name, exp["omega"], coriolis, case["tip_joint"],
                                                                 limit, err_m, moved))
-
-# The square section of the CalculiX cases (tests/reference/3d/README.md).
-SQUARE = {"EA": 1.08444e8, "EI_flap": 14000.0, "EI_edge": 14000.0, "GJ": 10758.0, "mass_per_length": 1.2,
-          "flap_inertia": 1.549e-4, "edge_inertia": 1.549e-4}
-
-
-def scaled(section, **factors):
-    out = dict(section)
-    for k, f in factors.items():
-        out[k] = section[k] * f
-    return out
-
     # R2F's lowest eigenvalue against CalculiX over 0-20 rad/s (the review's R2 "divergence" was a
     # knot of ccx's: with the fillet it stays stable and rises)
     trend = {}
@@ -564,6 +552,17 @@ def scaled(section, **factors):
                   "reference3d R2F W=%g: lowest eigenvalue %.2f against CalculiX %.2f (1 %%), %s" %
                   (c["omega"], lam, want, c["status"]))
         check("divergence_speeds" not in doc, "reference3d R2F: no divergence up to 20 rad/s (as CalculiX)")
+
+# The square section of the CalculiX cases (tests/reference/3d/README.md).
+SQUARE = {"EA": 1.08444e8, "EI_flap": 14000.0, "EI_edge": 14000.0, "GJ": 10758.0, "mass_per_length": 1.2,
+          "flap_inertia": 1.549e-4, "edge_inertia": 1.549e-4}
+
+
+def scaled(section, **factors):
+    out = dict(section)
+    for k, f in factors.items():
+        out[k] = section[k] * f
+    return out
 
 
 def rigid_mast(omega, elements=12, gj=100.0, mast=2.0, arm=3.0):
