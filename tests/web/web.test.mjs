@@ -752,6 +752,210 @@ async function flaggedSpeeds(page) {
   ok(okX, 'no crossing uses a flagged speed', JSON.stringify(p.crossings.map((c) => c.omega)));
 }
 
+/** The L-shaped structure of /tmp/w/rm_sweep.json: a torsion-soft radial arm (GJ = 100 N·m²) carrying a stiff
+ *  mast along the spin axis, swept 0…5 rad/s: it diverges (1st torsion) at about 3.223 rad/s. */
+const RM_SWEEP = {
+  structure: {
+    joints: {O: [0.5, 0, 0], C: [3.5, 0, 0], P: [3.5, 0, 2]},
+    sections: {
+      sq: {EA: 108444000, EI_flap: 14000, EI_edge: 14000, GJ: 10758, mass_per_length: 1.2, flap_inertia: 0.0001549,
+        edge_inertia: 0.0001549},
+      arm: {EA: 10844400000, EI_flap: 1400000, EI_edge: 1400000, GJ: 100, mass_per_length: 1.2, flap_inertia: 0.0001549,
+        edge_inertia: 0.0001549},
+      mast: {EA: 10844400000, EI_flap: 1400000, EI_edge: 1400000, GJ: 1075800, mass_per_length: 1.2,
+        flap_inertia: 0.0001549, edge_inertia: 0.0001549},
+    },
+    members: [
+      {id: 'm1', from: 'O', to: 'C', section: 'arm', elements: 12},
+      {id: 'm2', from: 'C', to: 'P', section: 'mast', elements: 12},
+    ],
+    clamp: 'O',
+  },
+  frames: 'per_element',
+  analysis: {omega: [0, 2, 3, 4, 5], modes: 2, coriolis: false, mass: 'lumped'},
+};
+const RM_DIVERGENCE = 3.2230732746; // rad/s, the daemon's refined divergence speed
+
+/** RGBA of the pixels of a PNG (a screenshot or a download), decoded by the page. */
+async function pngPixels(page, buf, x, y, w = 1, h = 1) {
+  return page.evaluate(async ({b64, x, y, w, h}) => {
+    const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
+    const bmp = await createImageBitmap(new Blob([bytes], {type: 'image/png'}));
+    const cv = document.createElement('canvas');
+    cv.width = bmp.width;
+    cv.height = bmp.height;
+    const ctx = cv.getContext('2d');
+    ctx.drawImage(bmp, 0, 0);
+    return Array.from(ctx.getImageData(x, y, w, h).data);
+  }, {b64: buf.toString('base64'), x, y, w, h});
+}
+
+/** Is an RGBA pixel reddish (the divergence band or its line, a grid line over it or not: red well above green and
+ *  blue; white, grey and the mode colours are not)? */
+const reddish = (px) => px[0] > 120 && px[0] - px[1] > 40 && px[0] - px[2] > 40;
+
+/**
+ * Divergence speeds (result.divergence_speeds, present only when the sweep
+ * crossed one) on the page: the L-shaped arm swept 0, 2, 3 rad/s (below it)
+ * draws nothing new; swept 0…5 rad/s it diverges in 1st torsion at 3.223
+ * rad/s: a red band at that speed on the Campbell diagram (its place checked
+ * against the axis mapping of the plot area, in rad/s and in rpm) labelled
+ * "divergence 1st torsion", the unstable speeds beyond it shaded up to the
+ * end of the sweep, a table row (kind, mode, Ω, bracket, refined), a tooltip,
+ * and the band in the exported SVG and PNG.
+ */
+async function divergence(page, base) {
+  const drawn = () => page.evaluate(() => ({
+    bands: document.querySelectorAll('#campbell .campbell-divergence').length,
+    labels: Array.from(document.querySelectorAll('#campbell .campbell-divergence-label')).map((l) => l.textContent),
+    shaded: document.querySelectorAll('#campbell .campbell-unstable').length,
+    table: !document.getElementById('divergence-table').hidden,
+    note: !document.getElementById('divergence-note').hidden,
+    plotted: window.__spinmodal.campbell().divergence.length,
+    svg: /divergence|unstable/.test(window.__spinmodal.campbellSvg()),
+  }));
+  // below the divergence speed: the page as before
+  await page.fill('#json', JSON.stringify({...RM_SWEEP, analysis: {...RM_SWEEP.analysis, omega: [0, 2, 3]}}, null, 2));
+  const below = await solveHere(page, base, 'the L-shaped arm swept below its divergence speed');
+  if (!below) return;
+  let d0 = await drawn();
+  ok(!('divergence_speeds' in below.result) && below.result.cases.every((c) => c.status === 'solved') &&
+    d0.bands === 0 && d0.labels.length === 0 && d0.shaded === 0 && !d0.table && !d0.note && d0.plotted === 0 && !d0.svg,
+  'a sweep without divergence (no divergence_speeds): no band, label or shading, no divergence table, none in the SVG',
+  JSON.stringify(d0));
+
+  // through it
+  await page.fill('#json', JSON.stringify(RM_SWEEP, null, 2));
+  const got = await solveHere(page, base, 'the L-shaped arm swept through its divergence speed');
+  if (!got) return;
+  const {result} = got;
+  const ds = result.divergence_speeds || [];
+  const dv = ds[0] || {};
+  ok(ds.length === 1 && dv.kind === 'onset' && dv.mode === '1st torsion' && Math.abs(dv.omega_rad_s - RM_DIVERGENCE) < 1e-6 &&
+    JSON.stringify(dv.bracket) === '[3,4]' && dv.refined === true,
+  'API: one divergence speed, the onset of 1st torsion at 3.2231 rad/s between 3 and 4 rad/s, refined', JSON.stringify(ds));
+  ok(result.cases.filter((c) => c.omega > dv.omega_rad_s).every((c) => c.status === 'unstable' && c.stability &&
+    c.stability.stable === false), 'API: the speeds above it are unstable',
+  JSON.stringify(result.cases.map((c) => [c.omega, c.status])));
+  ok(await waitFor(page, () => document.querySelectorAll('#campbell .campbell-divergence').length === 1, null,
+    'the divergence band'), 'one divergence band on the Campbell diagram');
+
+  /** The band, its label and the shading as laid out, and where the plot's axis mapping puts the speed x. */
+  const layout = () => page.evaluate(() => {
+    const box = (el) => {
+      const r = el.getBoundingClientRect();
+      return {x: r.x, y: r.y, width: r.width, height: r.height};
+    };
+    const q = (sel) => document.querySelector(`#campbell ${sel}`);
+    const p = window.__spinmodal.campbell();
+    const lab = q('.campbell-divergence-label'), sh = q('.campbell-unstable');
+    return {plot: box(q('.u-under')), band: box(q('.campbell-divergence')), x: Number(q('.campbell-divergence').dataset.x),
+      label: lab ? {text: lab.textContent, ...box(lab)} : null, shaded: sh ? box(sh) : null,
+      bg: getComputedStyle(q('.campbell-divergence')).backgroundColor, scales: p.scales, divergence: p.divergence,
+      unstable: p.unstable};
+  });
+  const pxOf = (L, v) => L.plot.x + (v - L.scales.x[0]) / (L.scales.x[1] - L.scales.x[0]) * L.plot.width;
+  let L = await layout();
+  let want = pxOf(L, RM_DIVERGENCE), mid = L.band.x + L.band.width / 2;
+  ok(Math.abs(mid - want) <= 1.5 && L.band.width >= 4 && L.band.height === L.plot.height && L.x === dv.omega_rad_s &&
+    /^rgba\(220, 38, 38, 0\.[1-4]\d*\)$/.test(L.bg),
+  'the band (translucent red, the plot\'s height) is centred on the axis mapping of 3.2231 rad/s (within 1.5 px)',
+  `band centre ${mid.toFixed(2)} px, axis ${want.toFixed(2)} px, width ${L.band.width}, ${L.bg}`);
+  ok(L.label && L.label.text === 'divergence 1st torsion' && Math.abs(L.label.x - (L.band.x + L.band.width)) <= 4,
+    'its label "divergence 1st torsion" is beside it', JSON.stringify(L.label));
+  const end = pxOf(L, 5);
+  ok(L.shaded && Math.abs(L.shaded.x - want) <= 1.5 && Math.abs(L.shaded.x + L.shaded.width - end) <= 1.5 &&
+    L.unstable.length === 1 && L.unstable[0].from === dv.omega_rad_s && L.unstable[0].to === 5,
+  'the unstable range is shaded from the divergence speed to the end of the sweep (5 rad/s)',
+  `${JSON.stringify(L.shaded)}, ${want.toFixed(2)}…${end.toFixed(2)} px`);
+  // what is seen: the screenshot's pixels in the band are red, beside it (at the same height) not
+  await page.locator('#campbell').scrollIntoViewIfNeeded();
+  L = await layout();
+  want = pxOf(L, RM_DIVERGENCE);
+  const shotBuf = await page.screenshot({clip: {x: Math.round(want) - 30, y: Math.round(L.plot.y + L.plot.height / 2), width: 61,
+    height: 1}});
+  const row = await pngPixels(page, shotBuf, 0, 0, 61, 1);
+  const pix = (i) => row.slice(4 * i, 4 * i + 4);
+  ok(reddish(pix(30)) && !reddish(pix(5)), 'on the screen the band is red at its speed (and not 25 px before it)',
+    JSON.stringify([pix(30), pix(5)]));
+
+  // the table
+  const divRows = async () => page.$$eval('#divergence-table tbody tr', (trs) => trs.map((tr) =>
+    Array.from(tr.cells).map((td) => [td.textContent, td.dataset.value])));
+  let rows = await divRows();
+  ok(await page.isVisible('#divergence-table') && await page.isVisible('#divergence-note') && rows.length === 1 &&
+    rows[0][0][1] === 'onset' && rows[0][1][1] === '1st torsion' && Number(rows[0][2][1]) === dv.omega_rad_s &&
+    rows[0][2][0] === String(Number(dv.omega_rad_s.toPrecision(6))) && rows[0][3][0] === '3 … 4' && rows[0][4][0] === 'yes',
+  'the divergence table lists it: onset, 1st torsion, Ω in rad/s, between 3 … 4 rad/s, refined', JSON.stringify(rows));
+  ok(/Ω \(rad\/s\)/.test(await page.textContent('#divergence-table thead')), 'the table\'s speed column is in rad/s');
+
+  // pointing at the band says what it is
+  const yTip = L.plot.y + L.plot.height * 0.45;
+  await page.mouse.move(want, yTip);
+  ok(await waitFor(page, () => /^Divergence speed \(onset\) of 1st torsion at Ω = 3\.2231 rad\/s/.test(
+    document.getElementById('campbell').dataset.tip || ''), null, 'the divergence tooltip'),
+  'hovering the band names the mode and the speed', await page.getAttribute('#campbell', 'data-tip'));
+  await shot(page, '33-divergence.png');
+  await shotEl(page, 'figure.chart', '33-divergence-chart.png');
+  await page.mouse.move(L.plot.x - 20, L.plot.y - 20);
+
+  // in rpm: the band at the result's rpm, the table in rpm
+  await page.selectOption('#speed-unit', 'rpm');
+  ok(await waitFor(page, (rpm) => {
+    const b = document.querySelector('#campbell .campbell-divergence');
+    return b && Number(b.dataset.x) === rpm;
+  }, dv.rpm, 'the band in rpm'), 'in rpm the band is at the result\'s rpm');
+  L = await layout();
+  want = pxOf(L, dv.rpm);
+  mid = L.band.x + L.band.width / 2;
+  rows = await divRows();
+  ok(Math.abs(mid - want) <= 1.5 && Math.abs(dv.rpm - RM_DIVERGENCE * 60 / TWO_PI) < 1e-3 &&
+    Math.abs(L.shaded.x + L.shaded.width - pxOf(L, 5 * 60 / TWO_PI)) <= 1.5,
+  'in rpm: the band on the axis mapping of 30.778 rpm (within 1.5 px), shaded to 47.75 rpm',
+  `band centre ${mid.toFixed(2)} px, axis ${want.toFixed(2)} px`);
+  const br = rows[0][3][1].split(',').map(Number);
+  ok(Number(rows[0][2][1]) === dv.rpm && Math.abs(br[0] - 3 * 60 / TWO_PI) < 1e-9 && Math.abs(br[1] - 4 * 60 / TWO_PI) < 1e-9 &&
+    /Ω \(rpm\)/.test(await page.textContent('#divergence-table thead')),
+  'in rpm the table has the result\'s rpm and the bracket ·60/2π', JSON.stringify(rows));
+  await page.selectOption('#speed-unit', 'rad');
+  await waitFor(page, (om) => {
+    const b = document.querySelector('#campbell .campbell-divergence');
+    return b && Number(b.dataset.x) === om;
+  }, dv.omega_rad_s, 'the band in rad/s');
+
+  // the exported SVG and PNG carry the band
+  const svg = (await downloadText(page, '#campbell-svg')).text;
+  const clip = /<clipPath id="plot"><rect x="([\d.]+)" y="([\d.]+)" width="([\d.]+)" height="([\d.]+)"/.exec(svg);
+  const band = /<rect class="divergence-band" x="([\d.]+)" y="[\d.]+" width="([\d.]+)"/.exec(svg);
+  L = await layout();
+  let svgWant = NaN, svgMid = NaN;
+  if (clip && band) {
+    const [cx, , cw] = clip.slice(1).map(Number);
+    svgWant = cx + (RM_DIVERGENCE - L.scales.x[0]) / (L.scales.x[1] - L.scales.x[0]) * cw;
+    svgMid = Number(band[1]) + Number(band[2]) / 2;
+  }
+  ok(Math.abs(svgMid - svgWant) <= 1 && />divergence 1st torsion<\/text>/.test(svg) && /class="unstable-range"/.test(svg) &&
+    />divergence speed<\/text>/.test(svg),
+  'the exported SVG has the band at 3.2231 rad/s on its axis (within 1 px), its label, the shading and a legend row',
+    `band centre ${svgMid} vs ${svgWant}`);
+  const png = await downloadText(page, '#campbell-png', null);
+  let pngOk = false, pngPix = null;
+  if (clip) {
+    const y = Math.round(2 * (Number(clip[2]) + Number(clip[4]) / 2));
+    const x = Math.round(2 * svgWant); // svgToPng draws at twice the SVG's size
+    pngPix = [await pngPixels(page, png.buf, x, y), await pngPixels(page, png.buf, x - 40, y)];
+    pngOk = reddish(pngPix[0]) && !reddish(pngPix[1]);
+  }
+  ok(/\.png$/.test(png.name) && pngOk, 'the exported PNG is red at the band (and not beside it)', JSON.stringify(pngPix));
+
+  // back below it: the band goes
+  await page.fill('#json', JSON.stringify({...RM_SWEEP, analysis: {...RM_SWEEP.analysis, omega: [0, 2, 3]}}, null, 2));
+  if (!await solveHere(page, base, 'the sweep below the divergence speed again')) return;
+  d0 = await drawn();
+  ok(d0.bands === 0 && d0.labels.length === 0 && d0.shaded === 0 && !d0.table && d0.plotted === 0 && !d0.svg,
+    'the next result without divergence speeds: the band, shading and table are gone', JSON.stringify(d0));
+}
+
 /**
  * Blades (issue 12): the BModes certification blade Test01 opened with "Open
  * blade file…" (the .bmi and its section file) loads as a blade-form request,
@@ -1256,6 +1460,7 @@ async function run() {
     await keepTheDesign(page, base);
     try {
       await trust(page, base);
+      await divergence(page, base);
     } finally { // the next pages open with the stored request: the β = 90° example again
       await page.selectOption('#example', 'angled-90');
       await page.click('#load-example');

@@ -18,6 +18,16 @@
 // dash, and labelled where they leave the plot.  Drag selects a zoom box (x,
 // y or both); double click resets.  A reference result (another design) can
 // be overlaid: its modes are thin dashed lines.
+//
+// Divergence speeds (the result's divergence_speeds, present only when the
+// sweep crossed one): where the steady state loses (onset) or regains
+// (recovery) static stability, the lowest eigenvalue of K* passing through
+// zero.  Each is a translucent red vertical band with a label ("divergence 1st
+// torsion"), the statically unstable range (an onset to the next recovery or
+// the end of the sweep) is shaded lightly.  Both are elements under uPlot's
+// canvas (.u-under, so the lines stay on top; the labels are in .u-over),
+// placed by the draw hook from the x scale, so they follow zoom and resize;
+// divergenceSvg adds them to the exported SVG.
 
 import uPlot from 'uplot';
 import 'uplot/dist/uPlot.min.css';
@@ -167,12 +177,68 @@ export function speedIn(su, row) {
 }
 
 /**
+ * The result's divergence speeds (divergence_speeds; [] without them), sorted
+ * by speed: [{omega (rad/s), rpm, mode, kind ('onset' | 'recovery'), bracket
+ * ([lo, hi] rad/s or null), negative ([before, after] or null), refined,
+ * refineSolves, omegaInterpolated}].
+ */
+export function divergenceSpeeds(result) {
+  const ds = result && Array.isArray(result.divergence_speeds) ? result.divergence_speeds : [];
+  const num = (v) => typeof v === 'number' && Number.isFinite(v);
+  return ds.filter((d) => d && num(d.omega_rad_s)).map((d) => ({
+    omega: d.omega_rad_s,
+    rpm: num(d.rpm) ? d.rpm : d.omega_rad_s * 60 / TWO_PI,
+    mode: typeof d.mode === 'string' && d.mode ? d.mode : null,
+    kind: d.kind === 'recovery' ? 'recovery' : 'onset',
+    bracket: Array.isArray(d.bracket) && d.bracket.length === 2 && d.bracket.every(num) ? d.bracket.slice() : null,
+    negative: Array.isArray(d.negative_eigenvalues) && d.negative_eigenvalues.length === 2 &&
+      d.negative_eigenvalues.every(Number.isInteger) ? d.negative_eigenvalues.slice() : null,
+    refined: d.refined === true,
+    refineSolves: Number.isInteger(d.refine_solves) ? d.refine_solves : null,
+    omegaInterpolated: num(d.omega_interpolated) ? d.omega_interpolated : null,
+  })).sort((a, b) => a.omega - b.omega);
+}
+
+/** A divergence speed's label on the diagram: "divergence 1st torsion" ("… ends" at a recovery). */
+export function divergenceLabel(d) {
+  return `divergence ${d.mode || 'mode'}${d.kind === 'recovery' ? ' ends' : ''}`;
+}
+
+/**
+ * The speed ranges (rad/s) where the steady state is statically unstable (K*
+ * has negative eigenvalues): from an onset to the next recovery, or to the end
+ * of the sweep; before a first recovery, from the start of the sweep.  The
+ * count of negative eigenvalues is each entry's negative_eigenvalues, else
+ * counted by kind.  [{from, to}] within [rows' first, last speed].
+ */
+export function unstableRanges(divs, rows) {
+  if (!divs.length || !rows.length) return [];
+  const lo = rows[0].omega, hi = rows[rows.length - 1].omega;
+  let count = divs[0].negative ? divs[0].negative[0] : divs[0].kind === 'recovery' ? 1 : 0;
+  let start = count > 0 ? lo : null;
+  const out = [];
+  for (const d of divs) {
+    const after = d.negative ? d.negative[1] : Math.max(0, count + (d.kind === 'onset' ? 1 : -1));
+    if (start === null && after > 0) start = d.omega;
+    else if (start !== null && after <= 0) {
+      out.push({from: start, to: d.omega});
+      start = null;
+    }
+    count = after;
+  }
+  if (start !== null && hi > start) out.push({from: start, to: hi});
+  return out.filter((r) => r.to > r.from);
+}
+
+/**
  * The aligned uPlot data for rows, lines, orders, units {speed, freq}, the
  * daemon's critical speeds {orders (covered), points} and an optional
  * reference {rows, lines}: [x, lines…, orders…, crossings, critical, tracking
- * marks, ref lines…], with meta[i] = {kind, line?} for each column.
+ * marks, ref lines…], with meta[i] = {kind, line?} for each column.  The
+ * divergence speeds (divergenceSpeeds) are no column: div [{…, x, label}] and
+ * unstable [{from, to, x0, x1}] (x in the speed unit) are drawn by the hook.
  */
-export function plotData(rows, lines, orders, units, ref = null, critical = null) {
+export function plotData(rows, lines, orders, units, ref = null, critical = null, divergence = []) {
   const su = units.speed, fu = units.freq;
   const covered = new Set(critical ? critical.orders : []);
   const cross = crossings(rows, lines, orders.filter((k) => !covered.has(k)));
@@ -245,7 +311,17 @@ export function plotData(rows, lines, orders, units, ref = null, critical = null
   const critPts = crit.map((c) => ({...c, x: critX(c), y: yOf(c.freq, c.omega, c.order)}));
   const markPts = marks.map((m) => ({...m, x: xOf(m.omega), y: yOf(m.freq, m.omega)}));
   const crossPts = cross.map((c) => ({...c, x: xOf(c.omega), y: yOf(c.freq, c.omega, c.order)}));
-  return {data, meta, cross: crossPts, crit: critPts, marks: markPts, flagged, errbars};
+  const divX = (d) => (su === 'rpm' ? d.rpm : xOf(d.omega));
+  const div = divergence.map((d) => ({...d, x: divX(d), label: divergenceLabel(d)}));
+  const unstable = unstableRanges(divergence, rows).map((r) => ({...r, x0: xOf(r.from), x1: xOf(r.to)}));
+  // the ends of the range in rpm: the result's own rpm where the end is a case or a divergence speed
+  for (const r of unstable) {
+    if (su !== 'rpm') continue;
+    const at = (om) => div.find((d) => d.omega === om) || rows.find((q) => q.omega === om);
+    if (at(r.from)) r.x0 = at(r.from).rpm;
+    if (at(r.to)) r.x1 = at(r.to).rpm;
+  }
+  return {data, meta, cross: crossPts, crit: critPts, marks: markPts, flagged, errbars, div, unstable};
 }
 
 /** "1, 2, 4-6" -> [1, 2, 4, 5, 6] (whole orders 1…50, sorted, unique); anything else is ignored. */
@@ -428,6 +504,136 @@ function decorations(getLast, onDraw) {
   };
 }
 
+/** Half-width (CSS px) of a divergence speed's band, on the page and in the exported SVG. */
+export const DIV_BAND_PX = 4;
+
+/**
+ * The draw hook of the divergence speeds: the unstable ranges (light) and the
+ * bands (translucent red, a line at the speed) as elements of .u-under (under
+ * the canvas, whose lines stay on top), the labels in .u-over; placed from
+ * the x scale at every draw (zoom, resize).  Nothing without divergence speeds.
+ */
+function divergenceBands(getLast) {
+  return (u) => {
+    for (const el of Array.from(u.root.querySelectorAll('.div-el'))) el.remove();
+    const L = getLast();
+    if (!L || !L.div || !L.div.length) return;
+    const W = u.bbox.width / (uPlot.pxRatio || 1);
+    const X = (v) => u.valToPos(v, 'x');
+    const su = SPEED_UNITS[L.units.speed].label;
+    // the ranges' words under the bands' labels (which stack from the top)
+    const wordsTop = 4 + 18 * L.div.length;
+    for (const r of L.unstable) {
+      const a = Math.max(-2, X(r.x0)), b = Math.min(W + 2, X(r.x1));
+      if (!(b > a)) continue;
+      const el = document.createElement('div');
+      el.className = 'div-el campbell-unstable';
+      el.style.left = `${a}px`;
+      el.style.width = `${b - a}px`;
+      el.dataset.x0 = String(r.x0);
+      el.dataset.x1 = String(r.x1);
+      const t = document.createElement('span');
+      t.textContent = 'statically unstable';
+      t.style.top = `${wordsTop}px`;
+      el.append(t);
+      u.under.append(el);
+    }
+    L.div.forEach((d, i) => {
+      const x = X(d.x);
+      if (!(x >= -DIV_BAND_PX && x <= W + DIV_BAND_PX)) return; // zoomed out of view
+      const band = document.createElement('div');
+      band.className = `div-el campbell-divergence ${d.kind}`;
+      band.style.left = `${x - DIV_BAND_PX}px`;
+      band.style.width = `${2 * DIV_BAND_PX}px`;
+      Object.assign(band.dataset, {x: String(d.x), omega: String(d.omega), mode: d.mode || '', kind: d.kind});
+      u.under.append(band);
+      const lab = document.createElement('div');
+      lab.className = `div-el campbell-divergence-label ${d.kind}`;
+      lab.textContent = d.label;
+      lab.dataset.x = String(d.x);
+      lab.style.top = `${4 + 18 * i}px`;
+      lab.style.left = `${x + DIV_BAND_PX + 2}px`;
+      lab.title = `${d.label} at Ω = ${sig(d.x)} ${su}`;
+      u.over.append(lab);
+      if (x + DIV_BAND_PX + 2 + lab.offsetWidth > W) lab.style.left = `${Math.max(0, x - DIV_BAND_PX - 2 - lab.offsetWidth)}px`;
+    });
+  };
+}
+
+/** A divergence speed in words (the tooltip and the SVG's titles). */
+function divergenceText(d, su) {
+  const n = (v) => String(Number(v.toPrecision(5)));
+  const u = SPEED_UNITS[su];
+  return `Divergence speed (${d.kind}) of ${d.mode || 'a mode'} at Ω = ${n(d.x)} ${u.label}: the steady state ` +
+    `${d.kind === 'onset' ? 'loses' : 'regains'} static stability (the lowest eigenvalue of K* passes through zero)` +
+    (d.bracket ? `; between the speeds ${n(u.of(d.bracket[0]))} and ${n(u.of(d.bracket[1]))} ${u.label}` : '') +
+    (d.refined ? `, refined${d.refineSolves !== null ? ` by ${d.refineSolves} solves` : ''}` : ', not refined (interpolated)');
+}
+
+/**
+ * The exported Campbell SVG (export.js campbellSvg's text, drawn from u and
+ * last) with the divergence speeds: the unstable ranges and the bands under
+ * the lines, the labels above them, inside its plot's clip.  The text as it
+ * was without divergence speeds.
+ */
+export function divergenceSvg(text, u, last) {
+  if (!text || !u || !last || !last.div || !last.div.length) return text;
+  const m = /<clipPath id="plot"><rect x="([-\d.]+)" y="([-\d.]+)" width="([-\d.]+)" height="([-\d.]+)"\/><\/clipPath><g clip-path="url\(#plot\)">/
+    .exec(text);
+  if (!m) return text;
+  const [L, T, pw, ph] = m.slice(1, 5).map(Number);
+  const xs = u.scales.x;
+  const X = (v) => L + ((v - xs.min) / (xs.max - xs.min || 1)) * pw;
+  const r2 = (v) => Math.round(v * 100) / 100;
+  const esc = (t) => String(t).replace(/&/g, '&amp;').replace(/</g, '&lt;').replace(/>/g, '&gt;').replace(/"/g, '&quot;');
+  const under = [], over = [];
+  for (const r of last.unstable) {
+    const a = Math.max(L - 2, X(r.x0)), b = Math.min(L + pw + 2, X(r.x1));
+    if (!(b > a)) continue;
+    under.push(`<rect class="unstable-range" x="${r2(a)}" y="${T}" width="${r2(b - a)}" height="${ph}" fill="#dc2626" ` +
+      'fill-opacity="0.07"><title>statically unstable</title></rect>');
+    over.push(`<text class="unstable-label" x="${r2(Math.max(a, L) + 6)}" y="${r2(T + 15 + 18 * last.div.length)}" ` +
+      'fill="#b91c1c" fill-opacity="0.8" font-size="10.5">statically unstable</text>');
+  }
+  last.div.forEach((d, i) => {
+    const x = X(d.x);
+    if (!(x >= L - DIV_BAND_PX && x <= L + pw + DIV_BAND_PX)) return;
+    const title = `<title>${esc(divergenceText(d, last.units.speed))}</title>`;
+    under.push(`<rect class="divergence-band" x="${r2(x - DIV_BAND_PX)}" y="${T}" width="${2 * DIV_BAND_PX}" height="${ph}" ` +
+      `fill="#dc2626" fill-opacity="0.28">${title}</rect>`);
+    under.push(`<line class="divergence-line" x1="${r2(x)}" y1="${T}" x2="${r2(x)}" y2="${T + ph}" stroke="#b91c1c" ` +
+      'stroke-width="1.5"/>');
+    const w = 6.1 * d.label.length, y = T + 15 + 18 * i;
+    const right = x + DIV_BAND_PX + 3 + w > L + pw;
+    const lx = right ? x - DIV_BAND_PX - 3 : x + DIV_BAND_PX + 3;
+    over.push(`<rect x="${r2(right ? lx - w - 2 : lx - 2)}" y="${r2(y - 11)}" width="${r2(w + 4)}" height="15" fill="#ffffff" ` +
+      'fill-opacity="0.85"/>');
+    over.push(`<text class="divergence-label" x="${r2(lx)}" y="${r2(y)}"${right ? ' text-anchor="end"' : ''} fill="#991b1b" ` +
+      `font-size="11" font-weight="600">${esc(d.label)}</text>`);
+  });
+  const start = m.index + m[0].length;
+  const close = text.indexOf('</g>', start);
+  if (close < 0) return text;
+  // two rows under the legend's last (export.js: rows 17 px apart, the text 26 px right of the marker)
+  const legend = [];
+  const rowsL = Array.from(text.slice(close).matchAll(/<text x="([\d.]+)" y="([\d.]+)" fill="#1b1f24">/g));
+  if (rowsL.length) {
+    const lx = Number(rowsL[rowsL.length - 1][1]) - 26, ly0 = Number(rowsL[rowsL.length - 1][2]) - 4 + 17;
+    [['divergence speed', 0.28], ['statically unstable', 0.07]].forEach(([t, op], k) => {
+      const ly = ly0 + 17 * k;
+      if (k === 1 && !last.unstable.length) return;
+      legend.push(`<rect x="${r2(lx + 10 - (k ? 10 : DIV_BAND_PX))}" y="${r2(ly - 6)}" width="${k ? 20 : 2 * DIV_BAND_PX}" ` +
+        `height="12" fill="#dc2626" fill-opacity="${op}"/>` +
+        (k ? '' : `<line x1="${r2(lx + 10)}" y1="${r2(ly - 6)}" x2="${r2(lx + 10)}" y2="${r2(ly + 6)}" stroke="#b91c1c" ` +
+          'stroke-width="1.5"/>') +
+        `<text x="${r2(lx + 26)}" y="${r2(ly + 4)}" fill="#1b1f24">${t}</text>`);
+    });
+  }
+  const end = text.lastIndexOf('</svg>');
+  return text.slice(0, start) + '\n' + under.join('\n') + text.slice(start, close) + over.join('\n') + '\n' +
+    (legend.length && end > close ? text.slice(close, end) + legend.join('\n') + '\n' + text.slice(end) : text.slice(close));
+}
+
 /** What lies under the cursor (CSS px in the plot area): the nearest marker or point within 8 px, as text. */
 function hoverText(u, L, cx, cy) {
   const fu = FREQ_UNITS[L.units.freq].label, su = SPEED_UNITS[L.units.speed].label;
@@ -448,6 +654,11 @@ function hoverText(u, L, cx, cy) {
   for (const c of L.cross) {
     consider(c.x, c.y, 2, `${c.name} meets ${c.order}P at Ω = ${n(c.x)} ${su}, ${n(c.y)} ${fu} (interpolated between ` +
       'the speeds solved; tick "find critical speeds" and solve again to have it refined)');
+  }
+  // a divergence band: anywhere along it, after the markers and points close by
+  for (const d of L.div || []) {
+    const dist = Math.abs(u.valToPos(d.x, 'x') - cx) + 2;
+    if (dist <= 8 && (!best || dist < best.d)) best = {d: dist, text: divergenceText(d, L.units.speed)};
   }
   const eb = new Map(L.errbars.map((b) => [`${b.line}:${b.x}`, b]));
   L.meta.forEach((m, i) => {
@@ -484,7 +695,7 @@ export function campbellChart(container, onDraw = null) {
   function update({result, orders, units, ref = null, critical = null}) {
     const {rows, lines, nModes} = campbellData(result);
     const refData = ref ? campbellData(ref) : null;
-    const pd = plotData(rows, lines, orders, units, refData, critical);
+    const pd = plotData(rows, lines, orders, units, refData, critical, divergenceSpeeds(result));
     const {data, meta, flagged} = pd;
     last = {rows, lines, nModes, orders, units, ref: refData, ...pd};
     if (plot) plot.destroy();
@@ -521,7 +732,7 @@ export function campbellChart(container, onDraw = null) {
       // drag a box to zoom in x and y (a mostly horizontal or vertical drag zooms that axis only); double click resets
       cursor: {drag: {x: true, y: true, uni: 25}},
       hooks: {
-        draw: [decorations(() => last, onDraw)],
+        draw: [divergenceBands(() => last), decorations(() => last, onDraw)],
         setCursor: [(u) => {
           const {left, top} = u.cursor;
           const t = left >= 0 && top >= 0 && last ? hoverText(u, last, left, top) : '';
@@ -547,11 +758,14 @@ export function campbellChart(container, onDraw = null) {
           `${sig(speedIn(units.speed, rows[rows.length - 1]))} ${su.label}, frequencies in ${fu.label}, engine orders ` +
           `${orders.join(', ') || 'none'}, ${pd.cross.length + pd.crit.length} crossings with them (listed below)` +
           (pd.marks.length ? `, ${pd.marks.length} mode crossings or veerings` : '') +
-          (flagged.length ? `, ${new Set(flagged.map((p) => p.x)).size} speeds flagged (hollow grey)` : '')
+          (flagged.length ? `, ${new Set(flagged.map((p) => p.x)).size} speeds flagged (hollow grey)` : '') +
+          (pd.div.length ? `, divergence speeds (red bands; listed below): ${pd.div.map((d) =>
+            `${d.label} at ${sig(d.x)} ${su.label}`).join(', ')}` : '')
         : 'Campbell diagram: no speeds');
     }
     container.dataset.cases = String(rows.length);
     container.dataset.crossings = String(pd.cross.length);
+    container.dataset.divergence = String(pd.div.length);
     return last;
   }
 
@@ -578,6 +792,8 @@ export function campbellChart(container, onDraw = null) {
         marks: last.marks.map((m) => ({...m})),
         errbars: {list: last.errbars.map((b) => ({...b})), ...(last.errDrawn || {})},
         flagged: last.flagged.map((p) => ({...p})),
+        divergence: last.div.map((d) => ({...d})),
+        unstable: last.unstable.map((r) => ({...r})),
         scales: {x: [plot.scales.x.min, plot.scales.x.max], y: [plot.scales.y.min, plot.scales.y.max]},
         axisLabels: plot.axes.map((a) => a.label),
         xTicks: plot.axes[0]._values ? Array.from(plot.axes[0]._values) : [],

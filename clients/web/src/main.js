@@ -13,7 +13,8 @@ import {DEFAULTS, prettyJSON, structureToRows, rowsToStructure, speedsForm, spee
 import {buildMesh} from './mesh.js';
 import {drawStructure, modeView} from './drawing.js';
 import {drawStructure3d, modeView3d, attachOrbit, homeCamera, PRESETS} from './view3d.js';
-import {campbellChart, parseOrders, freqIn, errIn, flaggedCase, campbellData, COLORS} from './campbell.js';
+import {campbellChart, parseOrders, freqIn, errIn, flaggedCase, campbellData, COLORS, divergenceSpeeds, divergenceSvg}
+  from './campbell.js';
 import {exportSvg, svgToPng, campbellSvg, saveBlob} from './export.js';
 import {StructureEditor} from './editor.js';
 import {EXAMPLES} from './examples.js';
@@ -1097,6 +1098,48 @@ function updateChart() {
   }
   $('critical-hint').hidden = !!critical || d.rows.length < 2 || !orders.length;
   criticalTable(critical);
+  divergenceTable(S.result.result);
+}
+
+/**
+ * The result's divergence speeds (divergence_speeds, only when the sweep
+ * crossed one) in the speed unit shown: kind, mode, Ω, the bracket of sweep
+ * speeds, refined; hidden without them.
+ */
+function divergenceTable(result) {
+  const ds = divergenceSpeeds(result);
+  const t = $('divergence-table');
+  t.hidden = !ds.length;
+  $('divergence-note').hidden = !ds.length;
+  const tb = t.tBodies[0];
+  tb.textContent = '';
+  if (!ds.length) return;
+  const su = units().speed, ul = SPEED_UNITS[su].label;
+  const sp = (d) => (su === 'rpm' ? d.rpm : SPEED_UNITS[su].of(d.omega));
+  $('div-speed-h').textContent = `Ω (${ul})`;
+  $('div-bracket-h').textContent = `between (${ul})`;
+  for (const d of ds) {
+    const tr = tb.insertRow();
+    tr.className = `divergence ${d.kind}`;
+    const br = d.bracket ? d.bracket.map((om) => SPEED_UNITS[su].of(om)) : null;
+    const cells = [[d.kind, d.kind], [d.mode || '–', d.mode || ''], [sig(sp(d), 6), sp(d)],
+      [br ? `${sig(br[0], 6)} … ${sig(br[1], 6)}` : '–', br ? br.join(',') : ''], [d.refined ? 'yes' : 'no', d.refined]];
+    for (const [text, v] of cells) {
+      const td = tr.insertCell();
+      td.textContent = text;
+      td.dataset.value = String(v);
+    }
+    tr.cells[0].title = d.kind === 'onset'
+      ? 'the steady state loses static stability here: the lowest eigenvalue of K* passes through zero (a static divergence)'
+      : 'the steady state regains static stability here: the lowest eigenvalue of K* comes back through zero';
+    if (d.negative) tr.cells[0].title += `; negative eigenvalues of K*: ${d.negative[0]} → ${d.negative[1]}`;
+    tr.cells[3].title = 'the speeds of the sweep on either side of the divergence speed';
+    tr.cells[4].title = d.refined
+      ? `refined by ${d.refineSolves ?? 'a few'} solve(s) at single speeds (regula falsi on the lowest eigenvalue of K*)` +
+        (d.omegaInterpolated !== null ? `; linear interpolation between the sweep's speeds gave ` +
+          `${sig(SPEED_UNITS[su].of(d.omegaInterpolated), 6)} ${ul}` : '')
+      : 'interpolated between the speeds of the sweep (not refined)';
+  }
 }
 
 /**
@@ -1649,7 +1692,9 @@ function exportName(what, ext) {
 
 function campbellExportSvg() {
   const u = units();
-  return campbellSvg(chart.plot, chart.last, `Campbell diagram (${SPEED_UNITS[u.speed].label}, ${FREQ_UNITS[u.freq].label})`);
+  // the divergence speeds' bands are added to export.js's drawing (the PNG is this SVG rasterised)
+  return divergenceSvg(campbellSvg(chart.plot, chart.last,
+    `Campbell diagram (${SPEED_UNITS[u.speed].label}, ${FREQ_UNITS[u.freq].label})`), chart.plot, chart.last);
 }
 
 function modeExportSvg() {
