@@ -380,8 +380,13 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
                 why = "the solution jumped to another branch";
             } else if (eq_max_strain(m, q, w.P) > EQ_MAX_STRAIN) {
                 ok = 0;
-                why = "the deformation leaves the small-strain range (axial strain above 1 %): "
-                      "the steady state runs away; use more frames";
+                /* With one frame per element the frames cannot be refined: the strain is the
+                 * structure's own (the speed is beyond what its EA carries), not an artefact. */
+                why = m->n_subs >= m->n_elems
+                          ? "an element stretches past 1 % axial strain: the speed exceeds what the "
+                            "structure's axial stiffness EA carries (frames are per element already)"
+                          : "the deformation leaves the small-strain range (axial strain above 1 %): "
+                            "the steady state runs away; use more frames";
             } else if (eq_det_sign(&w, n) != sign) {
                 /* A critical point lies inside the step.  Shrink the step until it is small;
                  * a converged corrector that stays on the predicted branch there has crossed

@@ -188,6 +188,14 @@ def t_no_equilibrium(tmp):
           "no equilibrium: diagnostics %s" % d)
     check(d.get("last_omega") is not None and d["last_omega"] < 20, "no equilibrium: last_omega < 20")
     check(case["modes"] == [], "no equilibrium: no modes")
+    # per-element frames already: the advice is not "use more frames" (issue 26)
+    req = angled_beam(20, "per_element")
+    req["analysis"]["omega"] = 2000
+    rc, out, err = run(["solve", write_request(tmp, "overspeed.json", req)])
+    doc = parse_json(out, "overspeed stdout")
+    msg = doc["cases"][0].get("diagnostics", {}).get("message", "") if doc else ""
+    check(rc == 3 and "1 % axial strain" in msg and "per element already" in msg and "use more frames" not in msg,
+          "no equilibrium past the axial strength with per-element frames: says so, no frame advice (%s)" % msg)
 
 
 def t_csv(tmp):
