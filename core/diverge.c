@@ -8,8 +8,9 @@
  * eigen-analyses ran (solved or unstable), a change in the count of negative
  * eigenvalues of K* brackets a divergence.  lambda(Omega), the lowest
  * eigenvalue of K* at the steady state of Omega (sweep_lowest: equilibrium
- * from rest, dense K*), is refined by regula falsi with the Illinois
- * modification to |dOmega| <= DIV_TOL Omega.  Where the dense K* is too large
+ * from rest, dense K*), is refined in s = Omega^2 (where K*'s centrifugal
+ * terms are linear) by regula falsi with the Illinois modification to
+ * |dOmega| <= DIV_TOL Omega.  Where the dense K* is too large
  * (more than DIV_DENSE_MAX coordinates) the speed is interpolated from the
  * sweep's own eigenvalues (Coriolis off: lambda = w^2 of the lowest root, or
  * -Re^2 of a real one) or the bracket's middle, and marked not refined.
@@ -23,7 +24,8 @@
 
 #define DIV_TOL 1e-6          /* |dOmega| / Omega that ends the refinement */
 #define DIV_MAX_SOLVES 40
-#define DIV_DENSE_MAX 1200    /* coordinates up to which lambda comes from a dense K* */
+#define DIV_DENSE_MAX 600     /* coordinates up to which lambda comes from a dense K* (a dsyevx of
+                                 ~0.1 s; each refining solve also solves the equilibrium from rest) */
 
 typedef struct div_ctx {
     const sm_model *m;
@@ -92,12 +94,12 @@ static void div_label(const sm_case *c, sm_divergence *d)
  */
 static int div_refine(div_ctx *x, const sm_case *A, const sm_case *B, sm_divergence *d)
 {
-    double a = A->omega, b = B->omega, fa = NAN, fb = NAN;
+    /* in s = Omega^2, where the centrifugal terms of K* are linear: lambda(s) is nearly so */
+    double a = A->omega * A->omega, b = B->omega * B->omega, fa = NAN, fb = NAN, prev = NAN;
     int ok_a = 0, ok_b = 0, rc, side = 0;
-    d->omega = 0.5 * (a + b);
-    d->omega_interpolated = d->omega;
+    d->omega = d->omega_interpolated = sqrt(0.5 * (a + b));
     if (x->m->n <= DIV_DENSE_MAX) {
-        if ((rc = div_eval(x, a, &fa, &ok_a)) < 0 || (rc = div_eval(x, b, &fb, &ok_b)) < 0)
+        if ((rc = div_eval(x, A->omega, &fa, &ok_a)) < 0 || (rc = div_eval(x, B->omega, &fb, &ok_b)) < 0)
             return rc;
         d->iterations = 2;
     } else {
@@ -106,24 +108,25 @@ static int div_refine(div_ctx *x, const sm_case *A, const sm_case *B, sm_diverge
     }
     if (!ok_a || !ok_b || !(fa * fb < 0))
         return SM_OK; /* the bracket's middle, not refined */
-    d->omega = d->omega_interpolated = b - fb * (b - a) / (fb - fa); /* w_i = b - f(b) (b - a) / (f(b) - f(a)) */
+    /* s_i = b - f(b) (b - a) / (f(b) - f(a)) */
+    d->omega = d->omega_interpolated = sqrt(b - fb * (b - a) / (fb - fa));
     if (x->m->n > DIV_DENSE_MAX)
         return SM_OK;
-    double prev = NAN;
     for (int it = 0; it < DIV_MAX_SOLVES; it++) {
         double c = b - fb * (b - a) / (fb - fa), fc;
         int ok;
-        if ((rc = div_eval(x, c, &fc, &ok)) < 0)
+        if ((rc = div_eval(x, sqrt(c), &fc, &ok)) < 0)
             return rc;
         d->iterations++;
         if (!ok)
             break;
-        d->omega = c;
-        if (fc == 0 || fabs(b - a) <= DIV_TOL * c || fabs(c - prev) <= DIV_TOL * c) {
+        d->omega = sqrt(c);
+        /* |d Omega| <= DIV_TOL Omega  <=>  |d s| <= 2 DIV_TOL s */
+        if (fc == 0 || fabs(b - a) <= 2 * DIV_TOL * c || fabs(c - prev) <= 2 * DIV_TOL * c) {
             d->refined = 1;
             break;
         }
-        if (fc * fb < 0) { /* the zero lies in [c, b] */
+        if (fc * fb < 0) { /* the zero lies between c and b */
             a = b, fa = fb;
             side = 0;
         } else if (side == -1) { /* Illinois: halve the stale end's value */

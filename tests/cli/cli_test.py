@@ -668,6 +668,16 @@ def t_divergence(tmp):
         rows = [l.split(",") for l in out.splitlines()[1:]]
         check(rc == 0 and len(rows) == 1 and rows[0][0] == "0" and abs(float(rows[0][4]) - wdiv) <= 0.005 * wdiv,
               "divergence: --critical-csv has one order-0 row at the divergence speed (%s)" % rows)
+    # a model over the dense bound of the refinement (720 coordinates): interpolated in Omega^2
+    # from the sweep's own roots (Coriolis off), not refined
+    big = rigid_mast([0.0, 0.9 * wdiv, 1.1 * wdiv], elements=60)
+    rc, out, err = run(["solve", write_request(tmp, "mast-big.json", big)])
+    doc = parse_json(out, "divergence big")
+    ds = doc.get("divergence_speeds", []) if doc else []
+    wbig = math.sqrt(rigid_mast_kj(elements=60))
+    check(len(ds) == 1 and ds[0]["refined"] is False and abs(ds[0]["omega_rad_s"] - wbig) <= 0.005 * wbig,
+          "divergence: 720 coordinates: interpolated (not refined) within 0.5 %% of sqrt(k/J) = %.5f (%s)" %
+          (wbig, ds))
     # below the divergence only: nothing reported
     rc, out, err = run(["solve", write_request(tmp, "mast-low.json", rigid_mast([0.0, 0.5 * wdiv, 0.9 * wdiv]))])
     doc = parse_json(out, "divergence below")
