@@ -18,6 +18,7 @@
 #include "import_internal.h"
 
 #include <ctype.h>
+#include <float.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -46,6 +47,31 @@ int import_format_known(const char *name)
 {
     return name && (!strcmp(name, "bmodes") || !strcmp(name, "elastodyn") ||
                     !strcmp(name, "csv"));
+}
+
+/* ----------------------------------------------------------- encoding */
+
+int imp_encoding(import_diag *d, const import_file *f, size_t *skip)
+{
+    const unsigned char *u = (const unsigned char *)f->text;
+    const char *nul;
+
+    *skip = 0;
+    if (f->len >= 2 && ((u[0] == 0xFF && u[1] == 0xFE) || (u[0] == 0xFE && u[1] == 0xFF)))
+        return imp_fail(d, f->name, 1, "encoding", "the file is UTF-16 (byte-order mark %02X "
+                        "%02X): save it as UTF-8 (Excel: \"CSV UTF-8\"; Notepad: Save as, "
+                        "Encoding UTF-8)", u[0], u[1]);
+    if (f->len >= 3 && u[0] == 0xEF && u[1] == 0xBB && u[2] == 0xBF)
+        *skip = 3; /* UTF-8 byte-order mark, as Excel's "CSV UTF-8" writes */
+    if ((nul = memchr(f->text, '\0', f->len))) {
+        int line = 1;
+        const char *p;
+        for (p = f->text; p < nul; p++) /* LF, CRLF or CR ends a line (imp_next) */
+            line += *p == '\n' || (*p == '\r' && p + 1 < nul && p[1] != '\n');
+        return imp_fail(d, f->name, line, "encoding", "the file holds NUL bytes: it is UTF-16 "
+                        "or binary, not text; save it as UTF-8 (Excel: \"CSV UTF-8\")");
+    }
+    return SM_OK;
 }
 
 /* -------------------------------------------------------------- lines */
@@ -148,6 +174,31 @@ void imp_tok_copy(char *dst, size_t cap, const imp_tok *t)
     dst[n] = '\0';
 }
 
+void imp_excerpt(char *dst, size_t cap, const imp_tok *t)
+{
+    size_t i, k = 0, room = cap - 4 < IMP_EXCERPT ? cap - 4 : IMP_EXCERPT; /* "..." + NUL */
+
+    for (i = 0; i < t->n; i++) {
+        unsigned char c = (unsigned char)t->s[i];
+        char one[5];
+        size_t w;
+        if (c < 0x20 || c >= 0x7f)
+            w = (size_t)snprintf(one, sizeof(one), "\\x%02x", c);
+        else if (c == '"' || c == '\\')
+            w = (size_t)snprintf(one, sizeof(one), "\\%c", c);
+        else
+            w = (size_t)snprintf(one, sizeof(one), "%c", c);
+        if (k + w > room) {
+            memcpy(dst + k, "...", 3);
+            k += 3;
+            break;
+        }
+        memcpy(dst + k, one, w);
+        k += w;
+    }
+    dst[k] = '\0';
+}
+
 json_t *imp_string(const char *s)
 {
     imp_tok t = {s ? s : "", s ? strlen(s) : 0};
@@ -192,6 +243,11 @@ double imp_round(double v)
     return strtod(buf, NULL);
 }
 
+int imp_finite(double v)
+{
+    return isfinite(v) && isfinite(imp_round(v));
+}
+
 /* -------------------------------------------------------- diagnostics */
 
 int imp_fail(import_diag *d, const char *file, int line, const char *field, const char *fmt,
@@ -220,6 +276,9 @@ int imp_check(import_diag *d, const char *file, int line, const char *field, int
 {
     if (!isfinite(v))
         return imp_fail(d, file, line, field, "not a finite number (%g)", v);
+    if (!imp_finite(v))
+        return imp_fail(d, file, line, field, "out of range: %.17g is beyond the largest "
+                        "number a request carries (%s in magnitude)", v, IMP_MAX_ABS_TEXT);
     if (kind == IMP_POSITIVE && !(v > 0.0))
         return imp_fail(d, file, line, field, "must be > 0 (%.15g)", v);
     if (kind == IMP_NONNEG && v < 0.0)
@@ -230,12 +289,12 @@ int imp_check(import_diag *d, const char *file, int line, const char *field, int
 int imp_value(import_diag *d, const char *file, int line, const char *field, const imp_tok *t,
               int kind, double *v)
 {
-    char shown[48];
+    char shown[IMP_EXCERPT_SIZE];
 
     if (t->n == 0)
         return imp_fail(d, file, line, field, "missing value");
     if (imp_number(t, v)) {
-        imp_tok_copy(shown, sizeof(shown), t);
+        imp_excerpt(shown, sizeof(shown), t);
         return imp_fail(d, file, line, field, "not a number (\"%s\")", shown);
     }
     return imp_check(d, file, line, field, kind, *v);
@@ -365,17 +424,73 @@ static json_t *imp_vec(const double *v, int n)
 #define IMP_EA_RATIO 1e4
 #define IMP_GJ_RATIO 10.0
 
-json_t *imp_assumed_section(const imp_table *t, double length, json_t *warnings,
-                            const char *format)
+/* The station whose EI_flap or EI_edge is the largest, and that key (for the line of a message). */
+static const imp_station *imp_largest_ei(const imp_table *t, imp_key *k)
+{
+    const imp_station *best = NULL;
+    double m = -1.0;
+    int i;
+
+    *k = IK_EI_FLAP;
+    for (i = 0; i < t->n; i++) {
+        if (t->st[i].v[IK_EI_FLAP] > m)
+            best = &t->st[i], m = t->st[i].v[IK_EI_FLAP], *k = IK_EI_FLAP;
+        if (t->st[i].v[IK_EI_EDGE] > m)
+            best = &t->st[i], m = t->st[i].v[IK_EI_EDGE], *k = IK_EI_EDGE;
+    }
+    return best;
+}
+
+/*
+ * An assumed stiffness (EA or GJ) must be a number the request carries: finite when printed and
+ * a normal positive double.  Overflow is the EI's fault (the line of the largest); underflow
+ * too, unless a length over 1 m divides it (EA): then the line that gives the length.
+ */
+static int imp_assumed_check(import_diag *d, const char *file, const imp_table *t,
+                             const imp_blade *b, const char *key, const char *formula,
+                             double v, const char *const *ei_names)
+{
+    imp_key k;
+    const imp_station *s = imp_largest_ei(t, &k);
+    const char *ei = ei_names[k == IK_EI_EDGE];
+
+    if (!imp_finite(v))
+        return imp_fail(d, file, s ? s->line : 0, ei, "%.15g N m^2 makes the "
+                        "assumed %s = %s overflow (length %.15g m): give %s", s ? s->v[k] : 0.0,
+                        key, formula, b->length, key);
+    if (!(imp_round(v) >= DBL_MIN) && (strcmp(key, "EA") || !(b->length > 1.0)))
+        return imp_fail(d, file, s ? s->line : 0, ei, "%.15g N m^2 makes the assumed %s = %s "
+                        "underflow to %g (length %.15g m): give %s", s ? s->v[k] : 0.0, key,
+                        formula, v, b->length, key);
+    if (!(imp_round(v) >= DBL_MIN))
+        return imp_fail(d, file, b->length_line, b->length_field ? b->length_field : "length",
+                        "the blade length %.15g m makes the assumed %s = %s underflow to %g "
+                        "(largest EI %.15g N m^2): give %s", b->length, key, formula, v,
+                        s ? s->v[k] : 0.0, key);
+    return SM_OK;
+}
+
+int imp_assumed_section(json_t **out, import_diag *d, const char *file, const imp_table *t,
+                        const imp_blade *b, json_t *warnings, const char *format,
+                        const char *const *ei_names)
 {
     double ei = imp_table_max(t, IK_EI_FLAP), ee = imp_table_max(t, IK_EI_EDGE);
-    json_t *sec = json_object();
-    int bad = 0;
+    double length = b->length;
+    json_t *sec;
+    int bad = 0, st;
 
-    if (!sec)
-        return NULL;
+    *out = NULL;
     if (ee > ei)
         ei = ee;
+    if (!(t->mask & (1u << IK_EA)) &&
+        (st = imp_assumed_check(d, file, t, b, "EA", "1e4 x EI / length^2",
+                                IMP_EA_RATIO * ei / (length * length), ei_names)))
+        return st;
+    if (!(t->mask & (1u << IK_GJ)) &&
+        (st = imp_assumed_check(d, file, t, b, "GJ", "10 x EI", IMP_GJ_RATIO * ei, ei_names)))
+        return st;
+    if (!(sec = json_object()))
+        return SM_NOMEM;
     if (!(t->mask & (1u << IK_EA))) {
         double ea = imp_round(IMP_EA_RATIO * ei / (length * length));
         bad |= json_object_set_new(sec, "EA", json_real(ea));
@@ -393,20 +508,49 @@ json_t *imp_assumed_section(const imp_table *t, double length, json_t *warnings,
     }
     if (bad) {
         json_decref(sec);
-        return NULL;
+        return SM_NOMEM;
     }
-    return sec;
+    *out = sec;
+    return SM_OK;
+}
+
+int imp_length(import_diag *d, const char *file, int line, const char *field, double hub,
+               double length)
+{
+    double tip = hub + length;
+
+    if (!imp_finite(length) || !imp_finite(tip))
+        return imp_fail(d, file, line, field, "the blade length %.17g m is beyond the largest "
+                        "number a request carries (%s in magnitude)", length, IMP_MAX_ABS_TEXT);
+    if (!(length >= IMPORT_MIN_LENGTH) || !(length >= IMPORT_MIN_LENGTH_RATIO * tip))
+        return imp_fail(d, file, line, field,
+                        "the blade length %.15g m (tip radius %.17g m less hub radius %.17g m) "
+                        "is below the shortest the numerics carry: at least %g m and %g x the "
+                        "tip radius", length, tip, hub, IMPORT_MIN_LENGTH,
+                        IMPORT_MIN_LENGTH_RATIO);
+    return SM_OK;
+}
+
+int imp_option(import_diag *d, const char *file, const char *field, double v)
+{
+    if (isnan(v))
+        return SM_OK;
+    if (!(v >= 0.0 && isfinite(v)))
+        return imp_fail(d, file, 0, field, "must be >= 0 (%g)", v);
+    if (!imp_finite(v))
+        return imp_fail(d, file, 0, field, "out of range: %.17g is beyond the largest number a "
+                        "request carries (%s in magnitude)", v, IMP_MAX_ABS_TEXT);
+    return SM_OK;
 }
 
 int imp_options_apply(import_diag *d, const char *file, const import_options *o,
                       int length_known, imp_blade *b, json_t *warnings)
 {
-    int bad = 0;
+    int bad = 0, st;
 
-    if (!isnan(o->hub_radius) && !(o->hub_radius >= 0.0 && isfinite(o->hub_radius)))
-        return imp_fail(d, file, 0, "hub_radius", "must be >= 0 (%g)", o->hub_radius);
-    if (!isnan(o->rpm) && !(o->rpm >= 0.0 && isfinite(o->rpm)))
-        return imp_fail(d, file, 0, "rpm", "must be >= 0 (%g)", o->rpm);
+    if ((st = imp_option(d, file, "hub_radius", o->hub_radius)) ||
+        (st = imp_option(d, file, "rpm", o->rpm)))
+        return st;
     if (!isnan(o->rpm))
         b->rpm = o->rpm;
     else
@@ -433,7 +577,13 @@ int imp_options_apply(import_diag *d, const char *file, const import_options *o,
     if (!(isfinite(o->tip_radius) && o->tip_radius > b->hub_radius))
         return imp_fail(d, file, 0, "tip_radius", "must be greater than the hub radius %g (%g)",
                         b->hub_radius, o->tip_radius);
+    if ((st = imp_option(d, file, "tip_radius", o->tip_radius)))
+        return st;
     b->length = o->tip_radius - b->hub_radius;
+    b->length_line = 0;
+    b->length_field = "tip_radius";
+    if ((st = imp_length(d, file, 0, "tip_radius", b->hub_radius, b->length)))
+        return st;
     return bad ? SM_NOMEM : SM_OK;
 }
 
@@ -564,14 +714,20 @@ char *import_dumps(const json_t *doc, int pretty)
                                (pretty ? JSON_INDENT(2) : JSON_COMPACT));
 }
 
-json_t *imp_document_assumed(const imp_blade *b, const imp_table *t, const char *format,
-                             json_t *warnings, json_t *source)
+int imp_document_assumed(json_t **out, import_diag *d, const char *file, const imp_blade *b,
+                         const imp_table *t, const char *format, const char *const *ei_names,
+                         json_t *warnings, json_t *source)
 {
-    json_t *sec = warnings ? imp_assumed_section(t, b->length, warnings, format) : NULL;
-    if (!sec) {
+    json_t *sec = NULL;
+    int st = warnings ? imp_assumed_section(&sec, d, file, t, b, warnings, format, ei_names)
+                      : SM_NOMEM;
+
+    *out = NULL;
+    if (st) {
         json_decref(warnings);
         json_decref(source);
-        return NULL;
+        return st;
     }
-    return imp_document(b, t, sec, warnings, source);
+    *out = imp_document(b, t, sec, warnings, source);
+    return *out ? SM_OK : SM_NOMEM;
 }

@@ -16,6 +16,12 @@
  * whose "request" is what `spinmodal solve` takes.  A bad file is refused
  * with one diagnostic naming the file, the line and the field:
  * "blade_sec_props.dat:7: axial_stff: not a number (\"abc\")".
+ * Numbers too large for the request (past 1.79769313486231e+308, which
+ * prints as infinity at 15 digits), derived values that overflow (rot_rpm x
+ * rpm_mult, an assumed EA or GJ) and blades shorter than IMPORT_MIN_LENGTH
+ * are refused the same way; a message quotes at most a short, escaped
+ * excerpt of the file (40 characters).  Text: UTF-8 (a byte-order mark is
+ * skipped) or ASCII; UTF-16 is refused.
  *
  * Ownership: the json_t *out is a new reference (json_decref).  Status
  * codes: SM_OK, SM_INVALID_INPUT (diag filled), SM_NOMEM.
@@ -37,6 +43,9 @@ extern "C" {
 #define IMPORT_MAX_BYTES ((size_t)16 << 20) /* one input file */
 #define IMPORT_ELEMENTS 48         /* elements of the imported blade */
 #define IMPORT_DEFAULT_MODES 10    /* analysis.modes when the file gives none */
+#define IMPORT_MIN_LENGTH 1e-6       /* m: the shortest blade (tip radius - hub radius) */
+#define IMPORT_MIN_LENGTH_RATIO 1e-6 /* and at least this fraction of the tip radius: the
+                                        stations' radii hub + s length stay distinct */
 
 /** One input file: its name for messages and its text (need not be NUL-terminated). */
 typedef struct import_file {

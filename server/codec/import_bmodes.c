@@ -94,6 +94,8 @@ typedef struct bm_main {
     char title[200];
     long beam_type, hub_conn, modepr, nselt;
     double rot_rpm, rpm_mult, radius, hub_rad, precone, bl_thp;
+    double rpm;         /* rot_rpm x rpm_mult, finite (checked where it is made) */
+    int length_line;    /* line of hub_rad, which makes the length radius - hub_rad */
     double tip[9];  /* tip_mass, cm_loc, cm_axial, ixx, iyy, izz, ixy, izx, iyz */
     char sec_file[256]; /* as printed (ASCII) */
     char sec_raw[256];  /* as written, for the loader */
@@ -132,13 +134,23 @@ static int bm_general(bm_in *b, bm_main *m)
         return imp_fail(b->d, b->file, b->r.line, "beam_type",
                         "must be 1 (blade) or 2 (tower) (%ld)", m->beam_type);
     if ((st = bm_num(b, "rot_rpm", IMP_NONNEG, &m->rot_rpm)) ||
-        (st = bm_num(b, "rpm_mult", IMP_NONNEG, &m->rpm_mult)) ||
-        (st = bm_num(b, "radius", IMP_POSITIVE, &m->radius)) ||
+        (st = bm_num(b, "rpm_mult", IMP_NONNEG, &m->rpm_mult)))
+        return st;
+    m->rpm = m->rot_rpm * m->rpm_mult; /* BModes.f90: romg = rot_rpm * rpm_mult */
+    if (!imp_finite(m->rpm))
+        return imp_fail(b->d, b->file, b->r.line, "rpm_mult", "rot_rpm x rpm_mult = %.15g x "
+                        "%.15g overflows: beyond the largest number a request carries (%s)",
+                        m->rot_rpm, m->rpm_mult, IMP_MAX_ABS_TEXT);
+    if ((st = bm_num(b, "radius", IMP_POSITIVE, &m->radius)) ||
         (st = bm_num(b, "hub_rad", IMP_NONNEG, &m->hub_rad)))
         return st;
     if (!(m->hub_rad < m->radius))
         return imp_fail(b->d, b->file, b->r.line, "hub_rad",
                         "must be less than radius %.15g (%.15g)", m->radius, m->hub_rad);
+    m->length_line = b->r.line;
+    if ((st = imp_length(b->d, b->file, b->r.line, "hub_rad", m->hub_rad,
+                         m->radius - m->hub_rad)))
+        return st;
     if ((st = bm_num(b, "precone", IMP_ANY, &m->precone)) ||
         (st = bm_num(b, "bl_thp", IMP_ANY, &m->bl_thp)) ||
         (st = bm_int(b, "hub_conn", 1, 3, &m->hub_conn)))
@@ -192,10 +204,35 @@ static int bm_props(bm_in *b, bm_main *m)
     return SM_OK;
 }
 
+/*
+ * Element boundary k of n (el_loc, rounded as printed): fractions of the blade length from the
+ * root, the first exactly 0, the last exactly 1, increasing (BModes' elements run root to tip
+ * and bmodes_mesh makes them members: a boundary out of order folds the blade back on itself).
+ */
+static int bm_el_loc(bm_in *b, long k, long n, double x, double *prev)
+{
+    if (x < 0.0 || x > 1.0)
+        return imp_fail(b->d, b->file, b->r.line, "el_loc", "boundary %ld of %ld is %.15g: "
+                        "must be in [0, 1] (a fraction of the blade length from the root)",
+                        k + 1, n, x);
+    if (k == 0 && x != 0.0)
+        return imp_fail(b->d, b->file, b->r.line, "el_loc", "the first boundary must be at "
+                        "the root, 0 (got %.15g)", x);
+    if (k > 0 && !(x > *prev))
+        return imp_fail(b->d, b->file, b->r.line, "el_loc", "boundaries out of order: %.15g "
+                        "after %.15g (must increase)", x, *prev);
+    if (k == n - 1 && x != 1.0)
+        return imp_fail(b->d, b->file, b->r.line, "el_loc", "the last boundary must be at the "
+                        "tip, 1 (got %.15g)", x);
+    *prev = x;
+    return SM_OK;
+}
+
 /* nselt and el_loc (nselt + 1 numbers, over as many lines as they take). */
 static int bm_mesh(bm_in *b, bm_main *m, json_t *el_loc)
 {
     imp_tok t[IMP_MAX_TOKENS];
+    double prev = 0.0;
     long got = 0;
     int st, i, n;
 
@@ -211,7 +248,8 @@ static int bm_mesh(bm_in *b, bm_main *m, json_t *el_loc)
             n = IMP_MAX_TOKENS;
         for (i = 0; i < n && got < m->nselt + 1; i++, got++) {
             double v;
-            if ((st = imp_value(b->d, b->file, b->r.line, "el_loc", &t[i], IMP_ANY, &v)))
+            if ((st = imp_value(b->d, b->file, b->r.line, "el_loc", &t[i], IMP_ANY, &v)) ||
+                (st = bm_el_loc(b, got, m->nselt + 1, imp_round(v), &prev)))
                 return st;
             if (json_array_append_new(el_loc, json_real(imp_round(v))))
                 return SM_NOMEM;
@@ -295,7 +333,9 @@ static int bm_blade(const bm_main *m, const import_options *o, imp_blade *bl, js
     bl->hub_radius = m->hub_rad;
     bl->precone_deg = m->precone;
     bl->pitch_deg = m->bl_thp;
-    bl->rpm = m->rot_rpm * m->rpm_mult;
+    bl->rpm = m->rpm;
+    bl->length_line = m->length_line;
+    bl->length_field = "hub_rad";
     if (!isnan(o->rpm)) {
         bad |= imp_warn(warn, "rotor speed %g rpm given: the file's %g rpm (rot_rpm x "
                         "rpm_mult) is not used", o->rpm, bl->rpm);
@@ -531,8 +571,9 @@ int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void
                   const import_options *o, import_diag *d)
 {
     json_t *warn = json_array(), *el_loc = json_array(), *src, *sec;
-    import_file sf = {NULL, NULL, 0};
+    import_file sf = {NULL, NULL, 0}, body;
     imp_table t = {NULL, 0, 0, 0};
+    size_t skip;
     imp_blade bl;
     bm_main m;
     bm_in b;
@@ -546,18 +587,31 @@ int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void
         st = SM_NOMEM;
         goto done;
     }
-    bm_init(&b, bmi, d);
+    if ((st = imp_option(d, bmi->name, "rpm", o->rpm)) || (st = imp_encoding(d, bmi, &skip)))
+        goto done;
+    body = *bmi;
+    body.text += skip;
+    body.len -= skip;
+    bm_init(&b, &body, d);
     if ((st = bm_general(&b, &m)) || (st = bm_props(&b, &m)) || (st = bm_mesh(&b, &m, el_loc)))
         goto done;
     why[0] = '\0';
     st = load(ctx, m.sec_raw, &sf, why, sizeof(why));
-    if (st == SM_INVALID_INPUT)
+    if (st == SM_INVALID_INPUT) {
+        imp_tok nt = {m.sec_raw, strlen(m.sec_raw)};
+        char shown[IMP_EXCERPT_SIZE];
+        imp_excerpt(shown, sizeof(shown), &nt);
         st = imp_fail(d, bmi->name, m.sec_line, "sec_props_file", "cannot read \"%s\": %s",
-                      m.sec_file, why);
+                      shown, why);
+    }
     if (st)
         goto done;
     if (!sf.name)
         sf.name = m.sec_file;
+    if ((st = imp_encoding(d, &sf, &skip)))
+        goto done;
+    sf.text += skip;
+    sf.len -= skip;
     bm_init(&b, &sf, d);
     if ((st = bm_sections(&b, &m, &t)) || (st = bm_blade(&m, o, &bl, warn)))
         goto done;

@@ -15,6 +15,10 @@
  * assumed (imp_assumed_section, with a warning).  Units must be the SI ones
  * (spelled with or without spaces, '*', '.', '-', '^': "N m^2", "Nm2",
  * "N*m^2"); any other unit is an error, never a silent conversion.
+ * The text is UTF-8 or ASCII: a UTF-8 byte-order mark (Excel's "CSV UTF-8")
+ * is skipped, UTF-16 refused (imp_encoding).  With r, the blade must be
+ * longer than IMPORT_MIN_LENGTH and IMPORT_MIN_LENGTH_RATIO x the last r
+ * (imp_length).
  */
 #include "import_internal.h"
 
@@ -145,14 +149,14 @@ static int csv_header_field(imp_reader *r, import_diag *d, const imp_tok *f, int
 {
     const char *file = r->f->name, *lb = memchr(f->s, '[', f->n);
     imp_tok name = *f;
-    char shown[64], unit[32];
+    char shown[IMP_EXCERPT_SIZE], unit[32];
     int k;
 
     if (lb)
         name.n = (size_t)(lb - f->s);
     while (name.n > 0 && (name.s[name.n - 1] == ' ' || name.s[name.n - 1] == '\t'))
         name.n--;
-    imp_tok_copy(shown, sizeof(shown), &name);
+    imp_excerpt(shown, sizeof(shown), &name);
     if (name.n == 0)
         return imp_fail(d, file, r->line, "header", "a column has no name");
     for (k = 0; k < CSV_NCOLS; k++)
@@ -170,11 +174,11 @@ static int csv_header_field(imp_reader *r, import_diag *d, const imp_tok *f, int
     {
         const char *rb = memchr(lb, ']', f->n - (size_t)(lb - f->s));
         imp_tok u = {lb + 1, rb ? (size_t)(rb - lb - 1) : 0};
-        char ushown[40];
+        char ushown[IMP_EXCERPT_SIZE];
         if (!rb || !imp_blank(rb + 1, f->n - (size_t)(rb + 1 - f->s)))
             return imp_fail(d, file, r->line, shown, "the unit must be in brackets after the "
                             "name, as in \"EI_flap [N m^2]\"");
-        imp_tok_copy(ushown, sizeof(ushown), &u);
+        imp_excerpt(ushown, sizeof(ushown), &u);
         if (csv_unit_norm(u.s, u.n, unit, sizeof(unit)) || strcmp(unit, csv_cols[k].unit))
             return imp_fail(d, file, r->line, shown, "unknown unit [%s]; expected [%s] (SI)",
                             ushown, csv_cols[k].shown);
@@ -254,7 +258,7 @@ static int csv_rows(imp_reader *r, import_diag *d, const int *col, int ncol, imp
 static int csv_radii(import_diag *d, const char *file, imp_table *t, imp_blade *bl)
 {
     double r0, len;
-    int i;
+    int i, st;
 
     for (i = 1; i < t->n; i++)
         if (!(t->st[i].v[IK_S] > t->st[i - 1].v[IK_S]))
@@ -268,6 +272,10 @@ static int csv_radii(import_diag *d, const char *file, imp_table *t, imp_blade *
     len = t->st[t->n - 1].v[IK_S] - r0;
     bl->hub_radius = r0;
     bl->length = len;
+    bl->length_line = t->st[t->n - 1].line;
+    bl->length_field = "r";
+    if ((st = imp_length(d, file, bl->length_line, "r", r0, len)))
+        return st;
     for (i = 0; i < t->n; i++)
         t->st[i].v[IK_S] = (t->st[i].v[IK_S] - r0) / len;
     t->st[0].v[IK_S] = 0.0;
@@ -295,6 +303,8 @@ static json_t *csv_source(const char *file, const int *col, int ncol)
     return src;
 }
 
+static const char *const csv_ei_names[2] = {"EI_flap", "EI_edge"};
+
 int import_csv(json_t **out, const import_file *f, const import_options *o, import_diag *d)
 {
     json_t *warn = json_array();
@@ -302,12 +312,19 @@ int import_csv(json_t **out, const import_file *f, const import_options *o, impo
     int col[CSV_MAX_COLUMNS], ncol = 0, has_r, c, st;
     imp_blade bl;
     imp_reader r;
+    import_file body;
+    size_t skip;
 
     *out = NULL;
     imp_blade_init(&bl);
     if (!warn)
         return SM_NOMEM;
-    imp_reader_init(&r, f);
+    if ((st = imp_encoding(d, f, &skip)))
+        goto done;
+    body = *f;
+    body.text += skip;
+    body.len -= skip;
+    imp_reader_init(&r, &body);
     if ((st = csv_header(&r, d, col, &ncol)) || (st = csv_rows(&r, d, col, ncol, &t)))
         goto done;
     for (has_r = 0, c = 0; c < ncol; c++)
@@ -317,9 +334,9 @@ int import_csv(json_t **out, const import_file *f, const import_options *o, impo
     if ((st = imp_table_order(d, f->name, &t, has_r ? "r" : "s")) ||
         (st = imp_options_apply(d, f->name, o, has_r, &bl, warn)))
         goto done;
-    *out = imp_document_assumed(&bl, &t, "CSV", warn, csv_source(f->name, col, ncol));
+    st = imp_document_assumed(out, d, f->name, &bl, &t, "CSV", csv_ei_names, warn,
+                              csv_source(f->name, col, ncol));
     warn = NULL;
-    st = *out ? SM_OK : SM_NOMEM;
 done:
     json_decref(warn);
     imp_table_clear(&t);

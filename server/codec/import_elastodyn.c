@@ -250,6 +250,8 @@ static json_t *ed_source(const ed_params *p, const char *file)
     return src;
 }
 
+static const char *const ed_ei_names[2] = {"FlpStff", "EdgStff"};
+
 int import_elastodyn(json_t **out, const import_file *f, const import_options *o,
                      import_diag *d)
 {
@@ -259,20 +261,27 @@ int import_elastodyn(json_t **out, const import_file *f, const import_options *o
     imp_blade bl;
     ed_params p;
     imp_reader r;
+    import_file body;
+    size_t skip;
 
     *out = NULL;
     memset(&p, 0, sizeof(p));
     imp_blade_init(&bl);
     if (!warn)
         return SM_NOMEM;
-    imp_reader_init(&r, f);
+    if ((st = imp_encoding(d, f, &skip)))
+        goto done;
+    body = *f;
+    body.text += skip;
+    body.len -= skip;
+    imp_reader_init(&r, &body);
     if ((st = ed_head(&r, d, &p)) || (st = ed_columns(&r, d, col, &ncol, warn)) ||
         (st = ed_rows(&r, d, &p, col, ncol, &t)) ||
         (st = imp_options_apply(d, f->name, o, 0, &bl, warn)))
         goto done;
-    *out = imp_document_assumed(&bl, &t, "ElastoDyn blade", warn, ed_source(&p, f->name));
+    st = imp_document_assumed(out, d, f->name, &bl, &t, "ElastoDyn blade", ed_ei_names, warn,
+                              ed_source(&p, f->name));
     warn = NULL;
-    st = *out ? SM_OK : SM_NOMEM;
 done:
     json_decref(warn);
     imp_table_clear(&t);

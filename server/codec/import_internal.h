@@ -57,6 +57,17 @@ int imp_split(const char *s, size_t n, const char *seps, imp_tok *t, int max);
 /** Copy a token into dst[cap] (truncated, ASCII: control and other bytes as '?'). */
 void imp_tok_copy(char *dst, size_t cap, const imp_tok *t);
 
+#define IMP_EXCERPT 40                 /* characters of file text an error may quote */
+#define IMP_EXCERPT_SIZE (IMP_EXCERPT + 4) /* a buffer for imp_excerpt: "..." and the NUL */
+
+/**
+ * A short, escaped excerpt of t for a message into dst[cap] (cap >= IMP_EXCERPT_SIZE): at most
+ * IMP_EXCERPT characters, bytes outside printable ASCII as \xNN, '"' and '\\' escaped, "..."
+ * when cut.  Errors quote file text only through this (a file may hold anything: a section
+ * file named by a .bmi may be any file the CLI can read).
+ */
+void imp_excerpt(char *dst, size_t cap, const imp_tok *t);
+
 /** A JSON string of s made ASCII as imp_tok_copy does (at most 255 bytes); NULL = NOMEM. */
 json_t *imp_string(const char *s);
 
@@ -67,6 +78,12 @@ int imp_number(const imp_tok *t, double *v);
 
 /** v rounded to 15 significant digits (what import_dumps prints, exactly). */
 double imp_round(double v);
+
+/** The largest magnitude a request carries: larger ones round to infinity at 15 digits. */
+#define IMP_MAX_ABS_TEXT "1.79769313486231e+308"
+
+/** 1 when v is finite and stays finite rounded to 15 significant digits (imp_round). */
+int imp_finite(double v);
 
 /* ------------------------------------------------------- diagnostics */
 
@@ -85,7 +102,7 @@ enum { IMP_ANY = 0, IMP_POSITIVE, IMP_NONNEG };
 int imp_value(import_diag *d, const char *file, int line, const char *field, const imp_tok *t,
               int kind, double *v);
 
-/** Check v (after a multiplier) against kind; SM_OK or SM_INVALID_INPUT (d). */
+/** Check v (after a multiplier) against kind and imp_finite; SM_OK or SM_INVALID_INPUT (d). */
 int imp_check(import_diag *d, const char *file, int line, const char *field, int kind,
               double v);
 
@@ -166,6 +183,8 @@ typedef struct imp_blade {
     double tip_products[3]; /* [I12, I23, I31] kg m^2 */
     double rpm;          /* rev/min */
     int modes;           /* analysis.modes */
+    int length_line;     /* the line that gives the length (0 = an option) */
+    const char *length_field; /* its field ("r", "radius", "tip_radius"), for messages */
 } imp_blade;
 
 /** Zero everything, modes IMPORT_DEFAULT_MODES. */
@@ -174,11 +193,27 @@ void imp_blade_init(imp_blade *b);
 /**
  * When the table gives no EA or no GJ, the blade section gets assumed
  * values (stiff: the models these files come from are rigid in extension
- * and torsion) and warnings says so.  Returns the section object (new
- * reference, possibly empty) or NULL when out of memory.
+ * and torsion) and warnings says so.  *out: the section object (new
+ * reference, possibly empty).  An assumed value that is not a number the
+ * request carries (overflow, underflow) is refused naming the line of the
+ * largest EI (ei_names: the file's names of EI_flap and EI_edge) or the
+ * line that gives the length (b->length_line).  SM_OK, SM_INVALID_INPUT
+ * (d), SM_NOMEM.
  */
-json_t *imp_assumed_section(const imp_table *t, double length, json_t *warnings,
-                            const char *format);
+int imp_assumed_section(json_t **out, import_diag *d, const char *file, const imp_table *t,
+                        const imp_blade *b, json_t *warnings, const char *format,
+                        const char *const *ei_names);
+
+/**
+ * The blade length made from the radii: finite, at least IMPORT_MIN_LENGTH and
+ * IMPORT_MIN_LENGTH_RATIO x the tip radius (hub + length).  SM_OK or
+ * SM_INVALID_INPUT (d, at line and field).
+ */
+int imp_length(import_diag *d, const char *file, int line, const char *field, double hub,
+               double length);
+
+/** An option (NAN = not given): >= 0 and imp_finite.  SM_OK or SM_INVALID_INPUT (d, line 0). */
+int imp_option(import_diag *d, const char *file, const char *field, double v);
 
 /**
  * Apply the user's options common to ElastoDyn and CSV: length from
@@ -196,9 +231,20 @@ int imp_options_apply(import_diag *d, const char *file, const import_options *o,
 json_t *imp_document(const imp_blade *b, const imp_table *t, json_t *section,
                      json_t *warnings, json_t *source);
 
-/** imp_document with the section imp_assumed_section makes for a file without EA/GJ (ElastoDyn,
- *  CSV; format names it in the warning); takes warnings and source like imp_document. */
-json_t *imp_document_assumed(const imp_blade *b, const imp_table *t, const char *format,
-                             json_t *warnings, json_t *source);
+/**
+ * imp_document with the section imp_assumed_section makes for a file without EA/GJ (ElastoDyn,
+ * CSV; format names it in the warning, ei_names the file's EI columns); takes warnings and
+ * source like imp_document.  *out: the document.  SM_OK, SM_INVALID_INPUT (d), SM_NOMEM.
+ */
+int imp_document_assumed(json_t **out, import_diag *d, const char *file, const imp_blade *b,
+                         const imp_table *t, const char *format, const char *const *ei_names,
+                         json_t *warnings, json_t *source);
+
+/**
+ * The text encoding of f: a UTF-8 byte-order mark is skipped (*skip = 3, else 0); UTF-16 (a
+ * byte-order mark FF FE or FE FF, or any NUL byte) is refused, saying to save the file as
+ * UTF-8.  SM_OK or SM_INVALID_INPUT (d).
+ */
+int imp_encoding(import_diag *d, const import_file *f, size_t *skip);
 
 #endif /* SPINMODAL_IMPORT_INTERNAL_H */

@@ -9,6 +9,7 @@
  */
 #include <math.h>
 #include <stdarg.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -555,6 +556,195 @@ static void test_csv(void)
     }
 }
 
+/* ------------------------------------------------------ issue 23, items 4 to 6 */
+
+static const char dbl_max[] = "1.7976931348623157e308"; /* rounds to inf at 15 digits */
+
+static int bmodes_rpm(json_t **doc, const char *bmi, const char *sec, double rpm,
+                      import_diag *d)
+{
+    import_file f = {"T.bmi", bmi, strlen(bmi)};
+    import_options o;
+
+    import_default_options(&o);
+    o.rpm = rpm;
+    return import_bmodes(doc, &f, load_sec, (void *)sec, &o, d);
+}
+
+static int csv_opt(json_t **doc, const char *text, size_t len, double tip, double rpm,
+                   import_diag *d)
+{
+    import_file f = {"st.csv", text, len == SIZE_MAX ? strlen(text) : len};
+    import_options o;
+
+    import_default_options(&o);
+    o.tip_radius = tip;
+    o.rpm = rpm;
+    return import_csv(doc, &f, &o, d);
+}
+
+/*
+ * Issue 23 item 4: numbers that are merely extreme were "out of memory" (json_real of an
+ * infinity: a value past 1.79769313486231e308 rounds to inf at 15 digits; an assumed EA or
+ * rot_rpm x rpm_mult overflows): each is now SM_INVALID_INPUT with the file, line and field.
+ */
+static void test_overflow_is_invalid(void)
+{
+    char *bmi = slurp("bmodes_certtest/Test01_nonunif_blade.bmi");
+    char *sec = slurp("bmodes_certtest/blade_sec_props.dat");
+    char *ed = slurp("elastodyn/NRELOffshrBsline5MW_Blade.dat");
+    double big = strtod(dbl_max, NULL);
+    json_t *doc = NULL;
+    import_diag d;
+    static const char ok[] = "s,mass_per_length,EI_flap,EI_edge\n0,1,1,1\n1,1,1,1\n";
+
+    expect_error("4: CSV EI_flap 1e305, EA assumed",
+                 csv_opt(&doc, "s,mass_per_length,EI_flap,EI_edge\n0,1,1e305,1\n1,1,1,1\n",
+                         SIZE_MAX, 20, 12, &d), &d,
+                 "st.csv:2: EI_flap: 1e+305 N m^2 makes the assumed EA = 1e4 x EI / length^2 "
+                 "overflow (length 20 m): give EA");
+    json_decref(doc), doc = NULL;
+    expect_error("4: CSV EI_edge 1e308, GJ assumed",
+                 csv_opt(&doc, "s,mass_per_length,EI_flap,EI_edge,EA\n0,1,1,1,1\n1,1,1,1e308,1\n",
+                         SIZE_MAX, 20, 12, &d), &d,
+                 "st.csv:3: EI_edge: 1e+308 N m^2 makes the assumed GJ = 10 x EI overflow "
+                 "(length 20 m): give GJ");
+    json_decref(doc), doc = NULL;
+    expect_error("4: ?tip_radius=DBL_MAX", csv_opt(&doc, ok, SIZE_MAX, big, 12, &d), &d,
+                 "st.csv: tip_radius: out of range: 1.7976931348623157e+308 is beyond the largest "
+                 "number a request carries (1.79769313486231e+308 in magnitude)");
+    json_decref(doc), doc = NULL;
+    expect_error("4: ?rpm=DBL_MAX", csv_opt(&doc, ok, SIZE_MAX, 20, big, &d), &d,
+                 "st.csv: rpm: out of range: 1.7976931348623157e+308 is beyond the largest number "
+                 "a request carries (1.79769313486231e+308 in magnitude)");
+    json_decref(doc), doc = NULL;
+    expect_error("4: BModes ?rpm=DBL_MAX", bmodes_rpm(&doc, bmi, sec, big, &d), &d,
+                 "T.bmi: rpm: out of range: 1.7976931348623157e+308 is beyond the largest number "
+                 "a request carries (1.79769313486231e+308 in magnitude)");
+    json_decref(doc), doc = NULL;
+    {
+        char *a = edit(bmi, 7, "60.0", "1e200"), *b = edit(a, 8, "1.0 ", "1e200 ");
+        bad_bmodes_main("4: rot_rpm 1e200 x rpm_mult 1e200", b,
+                        "T.bmi:8: rpm_mult: rot_rpm x rpm_mult = 1e+200 x 1e+200 overflows: "
+                        "beyond the largest number a request carries (1.79769313486231e+308)");
+        free(a);
+    }
+    bad_bmodes_main("4: radius DBL_MAX", edit(bmi, 9, "35.0", dbl_max),
+                    "T.bmi:9: radius: out of range: 1.7976931348623157e+308 is beyond the largest "
+                    "number a request carries (1.79769313486231e+308 in magnitude)");
+    bad_bmodes_main("4: el_loc DBL_MAX", edit(bmi, 48, "0.90", dbl_max),
+                    "T.bmi:48: el_loc: out of range: 1.7976931348623157e+308 is beyond the "
+                    "largest number a request carries (1.79769313486231e+308 in magnitude)");
+    bad_bmodes_sec("4: axial_stff DBL_MAX", edit(sec, 8, "2611.3E+06", dbl_max),
+                   "blade_sec_props.dat:8: axial_stff: out of range: 1.7976931348623157e+308 is "
+                   "beyond the largest number a request carries (1.79769313486231e+308 in "
+                   "magnitude)");
+    expect_error("4: ElastoDyn tip_radius DBL_MAX", elastodyn(&doc, ed, big, 1.5, &d), &d,
+                 "blade.dat: tip_radius: out of range: 1.7976931348623157e+308 is beyond the "
+                 "largest number a request carries (1.79769313486231e+308 in magnitude)");
+    json_decref(doc), doc = NULL;
+    free(bmi), free(sec), free(ed);
+}
+
+/* Issue 23 item 5: el_loc (BModes' element boundaries) in [0, 1], from 0 to 1, increasing. */
+static void test_el_loc_checked(void)
+{
+    char *bmi = slurp("bmodes_certtest/Test01_nonunif_blade.bmi");
+
+    bad_bmodes_main("5: el_loc unsorted", edit(bmi, 48, "0.08  0.16", "0.16  0.08"),
+                    "T.bmi:48: el_loc: boundaries out of order: 0.08 after 0.16 (must increase)");
+    bad_bmodes_main("5: el_loc repeated", edit(bmi, 48, "0.08  0.16", "0.16  0.16"),
+                    "T.bmi:48: el_loc: boundaries out of order: 0.16 after 0.16 (must increase)");
+    bad_bmodes_main("5: el_loc negative", edit(bmi, 48, "0.08", "-0.08"),
+                    "T.bmi:48: el_loc: boundary 2 of 13 is -0.08: must be in [0, 1] (a fraction "
+                    "of the blade length from the root)");
+    bad_bmodes_main("5: el_loc above 1", edit(bmi, 48, "0.90   1.0", "1.20   1.0"),
+                    "T.bmi:48: el_loc: boundary 12 of 13 is 1.2: must be in [0, 1] (a fraction "
+                    "of the blade length from the root)");
+    bad_bmodes_main("5: el_loc first not 0", edit(bmi, 48, "0.  0.08", "0.01  0.08"),
+                    "T.bmi:48: el_loc: the first boundary must be at the root, 0 (got 0.01)");
+    bad_bmodes_main("5: el_loc last not 1", edit(bmi, 48, "0.90   1.0", "0.90   0.95"),
+                    "T.bmi:48: el_loc: the last boundary must be at the tip, 1 (got 0.95)");
+    /* over two lines: the line of the value that is wrong */
+    bad_bmodes_main("5: el_loc on the next line", edit(bmi, 48, "0.48  0.56", "0.48\n0.46"),
+                    "T.bmi:49: el_loc: boundaries out of order: 0.46 after 0.48 (must increase)");
+    free(bmi);
+}
+
+/*
+ * Issue 23 item 6: CSV with a UTF-8 byte-order mark (Excel "CSV UTF-8") imports as without;
+ * UTF-16 is refused saying so; the r form's radii near 1e308 (an assumed EA of 0) and a blade
+ * of 2.2e-16 m are refused with the line.
+ */
+static void test_csv_encoding_and_radii(void)
+{
+    static const char plain[] = "s,mass_per_length,EI_flap,EI_edge\n0,1,1,1\n1,1,1,1\n";
+    char bom[sizeof(plain) + 3], u16[2 * sizeof(plain) + 2];
+    char *a = NULL, *b = NULL;
+    json_t *doc = NULL, *ref = NULL;
+    import_diag d;
+    size_t i, n;
+
+    memcpy(bom, "\xEF\xBB\xBF", 3);
+    memcpy(bom + 3, plain, sizeof(plain));
+    if (csv_opt(&ref, plain, strlen(plain), 20, 12, &d) != SM_OK ||
+        csv_opt(&doc, bom, strlen(bom), 20, 12, &d) != SM_OK)
+        fail("6: CSV with a UTF-8 BOM: %s", d.text);
+    else if (!(a = import_dumps(doc, 0)) || !(b = import_dumps(ref, 0)) || strcmp(a, b))
+        fail("6: CSV with a UTF-8 BOM: not the document without it");
+    free(a), free(b);
+    json_decref(doc), json_decref(ref), doc = NULL;
+    /* UTF-16 LE with its BOM, then without (NUL bytes) */
+    u16[0] = (char)0xFF, u16[1] = (char)0xFE;
+    for (i = 0, n = strlen(plain); i < n; i++)
+        u16[2 + 2 * i] = plain[i], u16[3 + 2 * i] = '\0';
+    expect_error("6: UTF-16 LE", csv_opt(&doc, u16, 2 + 2 * n, 20, 12, &d), &d,
+                 "st.csv:1: encoding: the file is UTF-16 (byte-order mark FF FE): save it as "
+                 "UTF-8 (Excel: \"CSV UTF-8\"; Notepad: Save as, Encoding UTF-8)");
+    json_decref(doc), doc = NULL;
+    u16[0] = (char)0xFE, u16[1] = (char)0xFF;
+    expect_error("6: UTF-16 BE", csv_opt(&doc, u16, 2 + 2 * n, 20, 12, &d), &d,
+                 "st.csv:1: encoding: the file is UTF-16 (byte-order mark FE FF): save it as "
+                 "UTF-8 (Excel: \"CSV UTF-8\"; Notepad: Save as, Encoding UTF-8)");
+    json_decref(doc), doc = NULL;
+    expect_error("6: UTF-16 without a BOM", csv_opt(&doc, u16 + 2, 2 * n, 20, 12, &d), &d,
+                 "st.csv:1: encoding: the file holds NUL bytes: it is UTF-16 or binary, not "
+                 "text; save it as UTF-8 (Excel: \"CSV UTF-8\")");
+    json_decref(doc), doc = NULL;
+    expect_error("6: r near 1e308 (EA 0)",
+                 csv_opt(&doc, "r,mass_per_length,EI_flap,EI_edge\n1e308,1,1,1\n1.7e308,1,1,1\n",
+                         SIZE_MAX, NAN, 12, &d), &d,
+                 "st.csv:3: r: the blade length 7e+307 m makes the assumed EA = 1e4 x EI / "
+                 "length^2 underflow to 0 (largest EI 1 N m^2): give EA");
+    json_decref(doc), doc = NULL;
+    expect_error("6: r 1 to 1+2e-16",
+                 csv_opt(&doc, "r,mass_per_length,EI_flap,EI_edge,EA,GJ\n1,1,1,1,1,1\n"
+                         "1.0000000000000002,1,1,1,1,1\n", SIZE_MAX, NAN, 12, &d), &d,
+                 "st.csv:3: r: the blade length 2.22044604925031e-16 m (tip radius "
+                 "1.0000000000000002 m less hub radius 1 m) is below the shortest the numerics "
+                 "carry: at least 1e-06 m and 1e-06 x the tip radius");
+    json_decref(doc), doc = NULL;
+    expect_error("6: r 1e6 to 1e6+0.5 (below 1e-6 x the tip radius)",
+                 csv_opt(&doc, "r,mass_per_length,EI_flap,EI_edge\n1e6,1,1,1\n1000000.5,1,1,1\n",
+                         SIZE_MAX, NAN, 12, &d), &d,
+                 "st.csv:3: r: the blade length 0.5 m (tip radius 1000000.5 m less hub radius "
+                 "1000000 m) is below the shortest the numerics carry: at least 1e-06 m and 1e-06 "
+                 "x the tip radius");
+    json_decref(doc), doc = NULL;
+    expect_error("6: tip_radius 1e-7 (below 1e-6 m)", csv_opt(&doc, plain, SIZE_MAX, 1e-7, 12, &d),
+                 &d, "st.csv: tip_radius: the blade length 1e-07 m (tip radius "
+                 "9.9999999999999995e-08 m less hub radius 0 m) is below the shortest the numerics "
+                 "carry: at least 1e-06 m and 1e-06 x the tip radius");
+    json_decref(doc), doc = NULL;
+    /* an excerpt of file text is short and escaped */
+    expect_error("6: excerpt", csv_opt(&doc, "s,mass_per_length,EI_flap,EI_edge\n"
+                                       "0,1,\x1b[31m\"red\"\\0123456789012345678901234567890,1\n",
+                                       SIZE_MAX, 20, 12, &d), &d,
+                 "st.csv:2: EI_flap: not a number (\"\\x1b[31m\\\"red\\\"\\\\01234567890123456789"
+                 "012...\")"); /* 40 characters, escapes counted */
+    json_decref(doc);
+}
+
 /*
  * Every 7th/11th prefix of a good file: an error or a document, never a
  * crash (the ASan build runs this too) nor a document with an error status.
@@ -601,6 +791,9 @@ int main(int argc, char **argv)
     test_bmodes_bad();
     test_elastodyn();
     test_csv();
+    test_overflow_is_invalid();
+    test_el_loc_checked();
+    test_csv_encoding_and_radii();
     test_prefixes();
     if (failures) {
         printf("%d failures\n", failures);
