@@ -5,8 +5,9 @@
  *
  * How it fits: cli.c's main() hands every `import` command line here.  This
  * file reads the files (BModes: the .bmi, then the section-properties file
- * it names, relative to the .bmi's folder), calls the importer and prints
- * the request; the importer's warnings (values it had to assume) go to
+ * it names, relative to the .bmi's folder and, without --allow-outside,
+ * inside it: no absolute path, no '..', never '-'), calls the importer and
+ * prints the request; the importer's warnings (values it had to assume) go to
  * stderr as "spinmodal: warning: ..." lines.  --full prints the whole import
  * document {"request", "warnings", "source"} instead (what POST
  * /v1/import/{format} answers).
@@ -28,11 +29,27 @@
 enum { CLI_IMPORT_OK = 0, CLI_IMPORT_FAILED = 1, CLI_IMPORT_INVALID = 2, CLI_IMPORT_USAGE = 64 };
 
 static const char cli_import_usage_text[] =
-    "usage: spinmodal import bmodes FILE.bmi [--rpm N] [--bmodes-mesh K] [--pretty] [--full]\n"
+    "usage: spinmodal import bmodes FILE.bmi [--rpm N] [--bmodes-mesh K] [--allow-outside] "
+    "[--pretty] [--full]\n"
     "       spinmodal import elastodyn FILE --tip-radius R [--hub-radius H] [--rpm N] "
     "[--pretty] [--full]\n"
     "       spinmodal import csv FILE [--tip-radius R] [--hub-radius H] [--rpm N] [--pretty] "
     "[--full]\n";
+
+static const char cli_import_help_text[] =
+    "\noptions:\n"
+    "  --tip-radius R   m from the spin axis to the tip (ElastoDyn; CSV with s)\n"
+    "  --hub-radius H   m from the spin axis to the root (default 0, with a warning)\n"
+    "  --rpm N          rotor speed, rev/min (overrides the file's)\n"
+    "  --bmodes-mesh K  BModes: its own elements as members, K FE elements each\n"
+    "  --allow-outside  BModes: let the .bmi's sec_props_file be an absolute path or\n"
+    "                   go up with '..' (by default it must lie in the .bmi's folder\n"
+    "                   or below; '-' is never standard input)\n"
+    "  --full           print the import document {request, warnings, source}\n"
+    "  --pretty         indent the JSON output\n"
+    "  -h, --help       show this help\n\n"
+    "exit status: 0 imported, 2 the file is refused (FILE:LINE: FIELD: ... on stderr),\n"
+    "1 a file cannot be read or another error, 64 usage error\n";
 
 /* Command-line settings of `import`. */
 typedef struct cli_import_args {
@@ -40,12 +57,14 @@ typedef struct cli_import_args {
     const char *path;   /* the file, "-" = stdin */
     int pretty;         /* --pretty */
     int full;           /* --full: the import document, not only the request */
+    int allow_outside;  /* --allow-outside: sec_props_file may leave the .bmi's folder */
     import_options opt; /* --tip-radius, --hub-radius, --rpm */
 } cli_import_args;
 
 /* A file read whole; the loader's context for BModes. */
 typedef struct cli_import_files {
     const char *main_path; /* the .bmi as given */
+    int allow_outside;     /* --allow-outside */
     char *sec;             /* the section file's text (malloc'd) */
 } cli_import_files;
 
@@ -56,12 +75,13 @@ static int cli_import_usage(const char *why)
 }
 
 /*
- * Read all of path ("-" = stdin) into *buf (malloc'd, NUL-terminated), at
- * most IMPORT_MAX_BYTES: 0, EFBIG when larger, or an errno value.
+ * Read all of path (stdin_ok and "-": standard input) into *buf (malloc'd,
+ * NUL-terminated), at most IMPORT_MAX_BYTES: 0, EFBIG when larger, or an
+ * errno value.
  */
-static int cli_import_read(const char *path, char **buf, size_t *len)
+static int cli_import_read(const char *path, int stdin_ok, char **buf, size_t *len)
 {
-    FILE *f = strcmp(path, "-") ? fopen(path, "rb") : stdin;
+    FILE *f = stdin_ok && !strcmp(path, "-") ? stdin : fopen(path, "rb");
     size_t cap = 65536, n = 0, got;
     char *b, *nb;
     int err = 0;
@@ -104,21 +124,51 @@ static int cli_import_read(const char *path, char **buf, size_t *len)
     return 0;
 }
 
+/*
+ * Why the section file's name is refused ("" = it is not): '-' (standard input), control
+ * characters, and unless --allow-outside an absolute path or a '..' component (the name is a
+ * line of the .bmi: a .bmi from elsewhere must not make the CLI read, and quote in its errors,
+ * any file the user can read).
+ */
+static const char *cli_import_sec_name_refused(const char *name, int allow_outside)
+{
+    const char *p;
+
+    if (!strcmp(name, "-"))
+        return "'-' is not standard input here: name the section file";
+    for (p = name; *p; p++)
+        if ((unsigned char)*p < 0x20 || *p == 0x7f)
+            return "the name holds control characters";
+    if (allow_outside)
+        return "";
+    if (name[0] == '/')
+        return "an absolute path, outside the .bmi's folder (give --allow-outside to read it)";
+    for (p = name; *p; p = strchr(p, '/') ? strchr(p, '/') + 1 : p + strlen(p))
+        if (p[0] == '.' && p[1] == '.' && (p[2] == '/' || p[2] == '\0'))
+            return "a '..' component leaves the .bmi's folder (give --allow-outside to read it)";
+    return "";
+}
+
 /* import_loader: the section file, relative to the folder of the .bmi. */
 static int cli_import_load(void *ctx, const char *name, import_file *out, char *why, size_t cap)
 {
     cli_import_files *fs = ctx;
     const char *slash = strrchr(fs->main_path, '/');
+    const char *refused = cli_import_sec_name_refused(name, fs->allow_outside);
     size_t dir = slash && name[0] != '/' ? (size_t)(slash - fs->main_path) + 1 : 0;
-    char *path = malloc(dir + strlen(name) + 1);
+    char *path;
     size_t len;
     int err;
 
-    if (!path)
+    if (*refused) {
+        snprintf(why, cap, "%s", refused);
+        return SM_INVALID_INPUT;
+    }
+    if (!(path = malloc(dir + strlen(name) + 1)))
         return SM_NOMEM;
     memcpy(path, fs->main_path, dir);
     strcpy(path + dir, name);
-    err = cli_import_read(path, &fs->sec, &len);
+    err = cli_import_read(path, 0, &fs->sec, &len);
     free(path);
     if (err == ENOMEM)
         return SM_NOMEM;
@@ -167,6 +217,14 @@ static int cli_import_args_parse(int argc, char **argv, cli_import_args *a)
             a->full = 1;
             continue;
         }
+        if (!opts_done && !strcmp(s, "--allow-outside")) {
+            a->allow_outside = 1;
+            continue;
+        }
+        if (!opts_done && (!strcmp(s, "--help") || !strcmp(s, "-h"))) {
+            printf("%s%s", cli_import_usage_text, cli_import_help_text);
+            return -1; /* done: exit 0 */
+        }
         if (!opts_done && !strcmp(s, "--bmodes-mesh")) {
             double per;
             if (i + 1 >= argc || cli_import_number(argv[i + 1], &per) || per < 1 ||
@@ -213,6 +271,8 @@ static int cli_import_args_parse(int argc, char **argv, cli_import_args *a)
         return cli_import_usage("a file (or - for standard input) is required");
     if (a->opt.bmodes_mesh && strcmp(a->format, "bmodes"))
         return cli_import_usage("--bmodes-mesh applies to bmodes only");
+    if (a->allow_outside && strcmp(a->format, "bmodes"))
+        return cli_import_usage("--allow-outside applies to bmodes only");
     return 0;
 }
 
@@ -243,7 +303,7 @@ static int cli_import_print(const cli_import_args *a, const json_t *doc)
 int cli_import_main(int argc, char **argv)
 {
     cli_import_args a;
-    cli_import_files fs = {NULL, NULL};
+    cli_import_files fs = {NULL, 0, NULL};
     import_file f;
     import_diag d;
     json_t *doc = NULL;
@@ -253,8 +313,8 @@ int cli_import_main(int argc, char **argv)
 
     memset(&a, 0, sizeof(a));
     if ((rc = cli_import_args_parse(argc, argv, &a)))
-        return rc;
-    err = cli_import_read(a.path, &text, &len);
+        return rc < 0 ? CLI_IMPORT_OK : rc;
+    err = cli_import_read(a.path, 1, &text, &len);
     if (err) {
         fprintf(stderr, "spinmodal: cannot read %s: %s\n",
                 strcmp(a.path, "-") ? a.path : "standard input",
@@ -265,6 +325,7 @@ int cli_import_main(int argc, char **argv)
     f.text = text;
     f.len = len;
     fs.main_path = strcmp(a.path, "-") ? a.path : "";
+    fs.allow_outside = a.allow_outside;
     if (!strcmp(a.format, "bmodes"))
         st = import_bmodes(&doc, &f, cli_import_load, &fs, &a.opt, &d);
     else if (!strcmp(a.format, "elastodyn"))

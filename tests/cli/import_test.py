@@ -83,6 +83,99 @@ def bmodes_own_model(exe, ref, tmp):
                   "(its tip mass is left out of the tension)" % (test, pub[0], pub[2]))
 
 
+def extreme_numbers_exit_2(exe, bm, tmp):
+    """Issue 23 item 4: numbers that are merely extreme were "import: out of memory", exit 1;
+    now exit 2 with FILE:LINE: FIELD (the option's name when it came from an option)."""
+    big = "1.7976931348623157e308"
+    csv = os.path.join(tmp, "ok.csv")
+    with open(csv, "w") as f:
+        f.write("s,mass_per_length,EI_flap,EI_edge\n0,1,1,1\n1,1,1,1\n")
+    ei = os.path.join(tmp, "ei.csv")
+    with open(ei, "w") as f:
+        f.write("s,mass_per_length,EI_flap,EI_edge\n0,1,1e305,1\n1,1,1,1\n")
+    with open(os.path.join(bm, "Test01_nonunif_blade.bmi")) as f:
+        bmi = f.read().split("\n")
+    rpm = list(bmi)
+    rpm[6] = rpm[6].replace("60.0", "1e200")
+    rpm[7] = rpm[7].replace("1.0 ", "1e200 ")
+    with open(os.path.join(tmp, "rpm.bmi"), "w") as f:
+        f.write("\n".join(rpm))
+    shutil.copy(os.path.join(bm, "blade_sec_props.dat"), tmp)
+    cases = ((["csv", ei, "--tip-radius", "20"], ei + ":2: EI_flap: "),
+             (["csv", csv, "--tip-radius", big], csv + ": tip_radius: out of range"),
+             (["csv", csv, "--tip-radius", "20", "--rpm", big], csv + ": rpm: out of range"),
+             (["bmodes", os.path.join(tmp, "rpm.bmi")],
+              os.path.join(tmp, "rpm.bmi") + ":8: rpm_mult: rot_rpm x rpm_mult"))
+    for args, want in cases:
+        rc, out, err = run(exe, ["import"] + args)
+        check(rc == 2 and out == "" and err.startswith(want) and "out of memory" not in err,
+              "item 4: %s -> exit 2, %s... (got %d: %s)" % (" ".join(args[:1] + args[2:]), want,
+                                                           rc, err.strip()))
+
+
+def sec_props_file_confined(exe, bm, tmp):
+    """Issue 23 item 8: the .bmi's sec_props_file could name any file ('../../../etc/passwd'
+    printed its line 2; '-' read standard input).  It is relative to the .bmi's folder and must
+    stay inside it unless --allow-outside; '-' is refused; an error quotes at most 40 escaped
+    characters of a line."""
+    with open(os.path.join(bm, "Test01_nonunif_blade.bmi")) as f:
+        bmi = f.read()
+    sub = os.path.join(tmp, "confined", "sub")
+    os.makedirs(os.path.join(sub, "inner"))
+    secret = os.path.join(tmp, "confined", "secret.dat")
+    with open(secret, "w") as f:
+        f.write("title\nSECRET-" + "x" * 60 + "\x1b[2J\n")
+    shutil.copy(os.path.join(bm, "blade_sec_props.dat"), os.path.join(sub, "inner", "s.dat"))
+
+    def bmi_naming(name):
+        path = os.path.join(sub, "p.bmi")
+        with open(path, "w") as f:
+            f.write(bmi.replace("'blade_sec_props.dat'", "'%s'" % name))
+        return path
+
+    deep = "../" * 12 + "etc/passwd"
+    for name, why in ((deep, "a '..' component leaves the .bmi's folder"),
+                      ("../secret.dat", "a '..' component leaves the .bmi's folder"),
+                      ("inner/../../secret.dat", "a '..' component leaves the .bmi's folder"),
+                      (secret, "an absolute path, outside the .bmi's folder"),
+                      ("/etc/passwd", "an absolute path, outside the .bmi's folder")):
+        path = bmi_naming(name)
+        rc, out, err = run(exe, ["import", "bmodes", path])
+        check(rc == 2 and out == "" and err.startswith(path + ":31: sec_props_file: cannot read")
+              and why in err and "--allow-outside" in err and "SECRET" not in err
+              and "root:" not in err, "item 8: %s refused (%s)" % (name, err.strip()))
+    bmi_naming("-")  # the .bmi in the working folder: its "-" was standard input
+    rc, out, err = run(exe, ["import", "bmodes", "p.bmi"], cwd=sub, stdin=b"title\n21\n")
+    check(rc == 2 and "'-' is not standard input" in err, "item 8: '-' refused, stdin not read "
+          "(%s)" % err.strip())
+    # inside the folder: read, relative to the .bmi wherever the command runs
+    rc, out, err = run(exe, ["import", "bmodes", bmi_naming("inner/s.dat")], cwd="/")
+    check(rc == 0 and json.loads(out)["blade"]["length"] == 33.25,
+          "item 8: inner/s.dat below the .bmi's folder is read (%s)" % err.strip())
+    # --allow-outside reads it; the error quotes a short, escaped excerpt of the line only
+    rc, out, err = run(exe, ["import", "bmodes", bmi_naming("../secret.dat"), "--allow-outside"])
+    line = err.strip()
+    check(rc == 2 and line.startswith("../secret.dat:2: n_secs: not a number (\"SECRET-xxx") and
+          "x" * 34 not in line and line.endswith("...\")") and "\x1b" not in line,
+          "item 8: --allow-outside reads it; at most 40 characters of its line quoted (%s)" % line)
+    rc, out, err = run(exe, ["import", "csv", "x.csv", "--allow-outside"])
+    check(rc == 64 and "usage:" in err, "item 8: --allow-outside on csv: usage, exit 64")
+    rc, out, err = run(exe, ["import", "--help"])
+    check(rc == 0 and "--allow-outside" in out, "item 8: import --help documents --allow-outside")
+
+
+def csv_bom(exe, tmp):
+    """Issue 23 item 6: Excel's "CSV UTF-8" (a byte-order mark) imports; UTF-16 is refused."""
+    text = "s, mass_per_length, EI_flap, EI_edge\n0,1,1,1\n1,1,1,1\n"
+    rc, out, err = run(exe, ["import", "csv", "-", "--tip-radius", "20"], stdin=text.encode())
+    rc2, out2, err2 = run(exe, ["import", "csv", "-", "--tip-radius", "20"],
+                          stdin=b"\xef\xbb\xbf" + text.encode())
+    check(rc == rc2 == 0 and out == out2, "item 6: a UTF-8 BOM imports as without (%s)" % err2.strip())
+    rc, out, err = run(exe, ["import", "csv", "-", "--tip-radius", "20"],
+                       stdin=text.encode("utf-16"))
+    check(rc == 2 and "UTF-16" in err and "UTF-8" in err, "item 6: UTF-16 refused (%s)" % err.strip())
+
+
 def main(argv):
     if len(argv) != 3:
         print("usage: import_test.py SPINMODAL REFERENCE_BLADES_DIR", file=sys.stderr)
@@ -186,6 +279,9 @@ def main(argv):
             rc, out, err = run(exe, args)
             check(rc == 64 and out == "" and "usage:" in err, "usage: %s -> exit 64 (got %d)" % (what, rc))
         bmodes_own_model(exe, ref, tmp)
+        extreme_numbers_exit_2(exe, bm, tmp)
+        sec_props_file_confined(exe, bm, tmp)
+        csv_bom(exe, tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     print("%d failure(s)" % len(FAILURES))
