@@ -52,6 +52,14 @@ From the hostile re-run (tests/attack, issue 10), each a failure of that run:
   readyz_storm  3000 GET /readyz made 3000 write transactions and a 4 MB WAL;
                 the write probe now runs at most once a second: the WAL stays
                 under 1 MB (generous: 250 probes).
+From issue 23:
+  import_extremes  POST /v1/import with numbers that are merely extreme (1.797e308
+                in a file or a query, rot_rpm x rpm_mult 1e200 x 1e200, an EI that
+                makes the assumed EA overflow) was 503 "out of memory" with
+                Retry-After: now 422 with the file, line and field (items 4);
+                BModes el_loc out of order or outside [0, 1] (item 5); CSV with a
+                UTF-8 byte-order mark, UTF-16, radii near 1e308 or 2e-16 apart
+                (item 6).
 The db_faults scenario also starts the second daemon through a symlink and a
 hard link to the database (both used to run beside the first), and full_disk
 checks /readyz is 503 as soon as the job is failed (the small write recording
@@ -550,6 +558,95 @@ def scenario_readyz_storm(exe, tmp):
     wal = os.path.getsize(d.db + "-wal") if os.path.exists(d.db + "-wal") else 0
     check(wal < 1 << 20, "the WAL stays under 1 MB: %d bytes (one 4 KB frame per probe "
           "made it 4 MB)" % wal)
+    check(d.stop() == 0, "daemon stops cleanly")
+
+
+def scenario_import_extremes(exe, tmp):
+    """Issue 23 items 4-6 over HTTP: POST /v1/import/{format} with numbers that are merely
+    extreme answered 503 "out of memory" with Retry-After (a client retries forever); each is
+    now a 422 naming the file, line and field (or /query/NAME for an option).  BModes el_loc
+    out of order is a 422 at its line; CSV with a UTF-8 byte-order mark is the same 200 as
+    without, UTF-16 a 422 saying so; the r form's radii near 1e308 and 1 -> 1+2e-16 are 422."""
+    from urllib.parse import quote
+    ref = os.path.join(HERE, os.pardir, "reference", "blades")
+    bm = os.path.join(ref, "bmodes_certtest")
+    with open(os.path.join(bm, "Test01_nonunif_blade.bmi")) as f:
+        bmi = f.read()
+    with open(os.path.join(bm, "blade_sec_props.dat")) as f:
+        sec = f.read()
+    with open(os.path.join(ref, "elastodyn", "NRELOffshrBsline5MW_Blade.dat")) as f:
+        ed = f.read()
+    big = "1.7976931348623157e308"  # rounds to infinity at the 15 digits of the document
+
+    def line_edit(text, n, old, new):
+        lines = text.split("\n")
+        assert old in lines[n - 1], (n, old)
+        lines[n - 1] = lines[n - 1].replace(old, new, 1)
+        return "\n".join(lines)
+
+    ok_csv = "s,mass_per_length,EI_flap,EI_edge\n0,1,1,1\n1,1,1,1\n"
+    cases = (  # (what, format, query, body, line, field)
+        ("CSV EI_flap 1e305 (assumed EA overflows)", "csv", "?tip_radius=20",
+         "s,mass_per_length,EI_flap,EI_edge\n0,1,1e305,1\n1,1,1,1\n", 2, "EI_flap"),
+        ("CSV ?tip_radius=DBL_MAX", "csv", "?tip_radius=" + big, ok_csv, 0, "tip_radius"),
+        ("CSV ?rpm=DBL_MAX", "csv", "?tip_radius=20&rpm=" + big, ok_csv, 0, "rpm"),
+        ("ElastoDyn ?tip_radius=DBL_MAX", "elastodyn", "?tip_radius=" + big, ed, 0, "tip_radius"),
+        ("ElastoDyn ?rpm=DBL_MAX", "elastodyn", "?tip_radius=63&rpm=" + big, ed, 0, "rpm"),
+        ("BModes ?rpm=DBL_MAX", "bmodes", "?rpm=" + big, {"main": bmi, "sec_props": sec}, 0, "rpm"),
+        ("BModes rot_rpm 1e200 x rpm_mult 1e200", "bmodes", "",
+         {"main": line_edit(line_edit(bmi, 7, "60.0", "1e200"), 8, "1.0 ", "1e200 "),
+          "sec_props": sec}, 8, "rpm_mult"),
+        ("BModes el_loc DBL_MAX", "bmodes", "",
+         {"main": line_edit(bmi, 48, "0.90", big), "sec_props": sec}, 48, "el_loc"),
+        ("BModes radius DBL_MAX", "bmodes", "",
+         {"main": line_edit(bmi, 9, "35.0", big), "sec_props": sec}, 9, "radius"),
+        ("BModes radius DBL_MAX, bmodes_mesh", "bmodes", "?bmodes_mesh=2",
+         {"main": line_edit(bmi, 9, "35.0", big), "sec_props": sec}, 9, "radius"),
+        ("BModes axial_stff DBL_MAX", "bmodes", "",
+         {"main": bmi, "sec_props": line_edit(sec, 8, "2611.3E+06", big)}, 8, "axial_stff"),
+        # item 5
+        ("BModes el_loc unsorted, bmodes_mesh", "bmodes", "?bmodes_mesh=4",
+         {"main": line_edit(bmi, 48, "0.08  0.16", "0.16  0.08"), "sec_props": sec}, 48, "el_loc"),
+        ("BModes el_loc negative", "bmodes", "",
+         {"main": line_edit(bmi, 48, "0.08", "-0.08"), "sec_props": sec}, 48, "el_loc"),
+        ("BModes el_loc above 1", "bmodes", "",
+         {"main": line_edit(bmi, 48, "0.90", "1.5"), "sec_props": sec}, 48, "el_loc"),
+        # item 6
+        ("CSV UTF-16", "csv", "?tip_radius=20", ok_csv.encode("utf-16"), 1, "encoding"),
+        ("CSV r near 1e308 (assumed EA 0)", "csv", "",
+         "r,mass_per_length,EI_flap,EI_edge\n1e308,1,1,1\n1.7e308,1,1,1\n", 3, "r"),
+        ("CSV r 1 -> 1+2e-16", "csv", "",
+         "r,mass_per_length,EI_flap,EI_edge\n1,1,1,1\n1.0000000000000002,1,1,1\n", 3, "r"),
+    )
+    d = Daemon(exe, tmp, ["--workers", "1"])
+    d.start()
+    for what, fmt, query, body, line, field in cases:
+        path = "/v1/import/" + fmt + query.replace("+", quote("+"))
+        if isinstance(body, dict):
+            r = d.post(path, body)
+        else:
+            r = d.request("POST", path, body=body, headers={"Content-Type": "text/csv"})
+        p = r.json() or {}
+        pointer = (p.get("errors") or [{}])[0].get("pointer")
+        if line == 0:
+            want_ptr = "/query/" + field
+        elif isinstance(body, dict):
+            want_ptr = "/sec_props" if field == "axial_stff" else "/main"
+        else:
+            want_ptr = ""  # the body is the file
+        check(r.status == 422 and "Retry-After" not in r.headers and p.get("line") == line and
+              p.get("field") == field and "out of memory" not in r.text(2000) and
+              pointer == want_ptr,
+              "%s: 422 at line %d, field %s (got %s: %s)" % (what, line, field, r.status,
+                                                             p.get("detail", r.text())))
+    plain = d.request("POST", "/v1/import/csv?tip_radius=20", body=ok_csv.encode(),
+                      headers={"Content-Type": "text/csv"})
+    bom = d.request("POST", "/v1/import/csv?tip_radius=20", body=b"\xef\xbb\xbf" + ok_csv.encode(),
+                    headers={"Content-Type": "text/csv"})
+    check(plain.status == bom.status == 200 and plain.body == bom.body,
+          "CSV with a UTF-8 byte-order mark: the same 200 as without (got %s: %s)"
+          % (bom.status, bom.text()))
+    check(d.get("/livez").status == 200, "/livez answers")
     check(d.stop() == 0, "daemon stops cleanly")
 
 
