@@ -25,6 +25,11 @@ per category, and runs:
               a symlink and a hard link) while the first is under load, a full
               disk (a 3 MB tmpfs; skipped when this process may not mount)
               (faults.py);
+  imports     hostile blade files to POST /v1/import/{format} (imports.py):
+              extreme numbers, el_loc out of order, UTF-16, degenerate radii:
+              each a 422 with its line and field, never a 5xx; and a .bmi
+              whose sec_props_file leaves its folder (the CLI: exit 2, the file
+              not read);
   load        cached-result GET rate and p99 for --load seconds (wrk when on
               PATH, else a Python client) (load.py);
   soak        --soak seconds of submissions, GETs and malformed validates:
@@ -56,9 +61,10 @@ import abuses  # noqa: E402
 import bodies  # noqa: E402
 import durability  # noqa: E402
 import faults  # noqa: E402
+import imports  # noqa: E402
 import load  # noqa: E402
 
-CATEGORIES = ["bodies", "http", "trickle", "durability", "faults", "load", "soak"]
+CATEGORIES = ["bodies", "http", "trickle", "imports", "durability", "faults", "load", "soak"]
 
 
 def done_job(d):
@@ -113,6 +119,18 @@ def cat_trickle(exe, tmp, tally, args):
         crash_free(d, tally, "trickle")
     finally:
         finish(d, tally, "trickle")
+
+
+def cat_imports(exe, tmp, tally, args):
+    d = Daemon(exe, tmp, ["--workers", "1"], name="imports")
+    d.start()
+    try:
+        imports.run(d, tally)
+        tally.check(d.alive(), "imports", "the daemon is alive at the end")
+        crash_free(d, tally, "imports")
+    finally:
+        finish(d, tally, "imports")
+    imports.cli(exe, tmp, tally)
 
 
 def crash_free(d, tally, category):
@@ -176,7 +194,7 @@ def main():
     tally = Tally(verbose=args.verbose)
     tmp = tempfile.mkdtemp(prefix="spinmodal-attack-")
     t0 = time.monotonic()
-    funcs = {"bodies": cat_bodies, "http": cat_http, "trickle": cat_trickle,
+    funcs = {"bodies": cat_bodies, "http": cat_http, "trickle": cat_trickle, "imports": cat_imports,
              "durability": durability.category, "faults": faults.category,
              "load": load.category_load, "soak": load.category_soak}
     try:
