@@ -259,10 +259,10 @@ static void sp_point_wrench(const sp_point *p, const sp_cx R[3], const sp_cx A[9
         if (p->has_c) /* F acts at the offset: its moment about the node, F.dr = (dh x F).dtheta */
             rot3_cross(dh, F, Mo);
     }
-    if (p->has_I) {
+    if (p->has_Ic) {
         sp_cx v[3], u[3], Ic[9], y[3], z[3], mr[3];
         for (int i = 0; i < 9; i++)
-            Ic[i] = p->I[i];
+            Ic[i] = p->Ic[i];
         rot3_tmv(A, ez, v);
         rot3_tmv(L, v, u);
         rot3_mv(Ic, u, y);
@@ -286,7 +286,7 @@ static void sp_frame_wrench(const sm_model *m, sp_kin *k, int s, const sp_cx *q)
     for (int t = k->pt_ptr[s]; t < k->pt_ptr[s + 1]; t++) {
         int pi = k->pt_idx[t];
         const sp_point *p = &m->pt[pi];
-        int rot = p->has_I || p->has_c;
+        int rot = p->has_Ic || p->has_c;
         sp_cx w[3], psi[3], aw[3], F[3] = {0, 0, 0}, Mo[3] = {0, 0, 0}, L[9], T[9];
         sp_point_state(m, k, pi, q, rot, w, psi, L, T);
         rot3_mv(A, w, aw);

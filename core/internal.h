@@ -57,6 +57,9 @@ typedef struct sm_elem {
     double ax[9];
     double GJ, EI_edge, EI_flap; /* torsion; bending in the p2 and p3 directions */
     double i_flap, i_edge;       /* mass moments per length about p2, p3, kg m */
+    double rot_pl[9];            /* spatial: the section's rotary inertia per length about its centre
+                                    of mass (torsion i_flap + i_edge, i_flap, i_edge in the inertia
+                                    axes), hub axes at rest, kg m */
     double ip_over_a;            /* Wagner ratio I_p/A, m^2 */
     double sc[2], tc[2];         /* shear and tension centre offsets along (p2, p3), m (p2 as in
                                     ax: it turns with the element's direction) */

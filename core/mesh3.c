@@ -436,6 +436,8 @@ int mesh3_elements(sm_model *m, const sm_structure *st, sm_diag *d)
          * inertia axes; torsion = i_flap + i_edge) on each node, at the centre of mass */
         double dg[3] = {el->i_flap + el->i_edge, el->i_flap, el->i_edge};
         double hm = 0.5 * el->mu * el->l;
+        memset(el->rot_pl, 0, sizeof el->rot_pl);
+        mesh3_add_tensor(el->rot_pl, iax, dg, 1.0);
         sm_node *ends[2] = {na, nz};
         for (int h = 0; h < 2; h++) {
             ends[h]->mass += hm;

@@ -429,6 +429,11 @@ int modes3_points(sm_model *m)
                     p->ub[i] = u[0][i] + xi * (u[1][i] - u[0][i]);
                 p->mass = e->mu * wl;
                 modes3_torsion_inertia(e, E, wl, p->I);
+                double Iw[9];
+                for (int i = 0; i < 9; i++)
+                    Iw[i] = e->rot_pl[i] * wl;
+                modes3_to_frame(b->A0, Iw, p->Ic);
+                p->has_Ic = 2; /* set: not a copy of I */
                 if (e->cg[0] != 0.0 || e->cg[1] != 0.0 || e->cg[2] != 0.0) {
                     const double *A0 = b->A0;
                     for (int i = 0; i < 3; i++)
@@ -441,9 +446,16 @@ int modes3_points(sm_model *m)
         }
     }
 inertia:
-    for (int k = 0; k < m->n_pt; k++)
-        for (int i = 0; i < 9; i++)
-            m->pt[k].has_I |= m->pt[k].I[i] != 0.0;
+    for (int k = 0; k < m->n_pt; k++) {
+        sp_point *p = &m->pt[k];
+        if (p->has_Ic != 2) /* every point but a consistent-mass Gauss point */
+            memcpy(p->Ic, p->I, sizeof p->Ic);
+        p->has_I = p->has_Ic = 0;
+        for (int i = 0; i < 9; i++) {
+            p->has_I |= p->I[i] != 0.0;
+            p->has_Ic |= p->Ic[i] != 0.0;
+        }
+    }
     return SM_OK;
 }
 

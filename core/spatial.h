@@ -44,6 +44,12 @@ typedef struct sp_point {
     double mass;        /* kg (0: carries no mass) */
     double I[9];        /* rotary inertia at rest in frame axes, kg m^2 */
     int has_I;          /* 1 when I is not all zero */
+    double Ic[9];       /* rotary inertia in the centrifugal potential (the propeller moment
+                           1/2 Omega^2 e_z' A Ic A' e_z), frame axes at rest: = I, except at the
+                           Gauss points of consistent mass, whose I is torsion only (no bending
+                           rotary inertia in M*, C*) while Ic is the whole section tensor:
+                           without it torsion lost its centrifugal stiffening */
+    int has_Ic;         /* 1 when Ic is not all zero */
     double c[3];        /* offset of the mass from the node it moves with, frame axes at rest, m:
                            it is at w + Lambda(psi) c (a section centre of mass or a point-mass
                            offset, DESIGN.md 8) */

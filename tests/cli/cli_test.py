@@ -693,7 +693,7 @@ def t_masts(tmp):
     """Analytic masts (issue 22).  (1) A mast on the spin axis (isotropic section): in the
     rotating frame its bending pair is w0^2 - Omega^2 without Coriolis and |w0 +- Omega| with it,
     w0 its frequency at rest (an axisymmetric rotor).  (2) The stiff mast on a torsion-soft arm:
-    see t_divergence.  Within 0.2 %."""
+    see t_divergence.  Within 0.2 %.  (3) The propeller moment of torsion with either mass model."""
     req = {
         "structure": {
             "joints": {"O": [0, 0, 0], "T": [0, 0, 3.0]},
@@ -719,6 +719,34 @@ def t_masts(tmp):
             worst = max(abs(g - w) / w for g, w in zip(got, want))
             check(worst <= 2e-3, "masts: on the axis, Coriolis %s, W=%g: %s against %s (worst %.2e)" %
                   ("on" if coriolis else "off", om, ["%.4f" % g for g in got], ["%.4f" % w for w in want], worst))
+    # The propeller moment: a flat radial blade soft in torsion (GJ 1 N m^2, i_edge 9 i_flap) at
+    # 60 rpm.  Its torsion stiffens by Omega^2 (i_edge - i_flap) per length besides the Wagner
+    # term; consistent mass (no bending rotary inertia in M*) must keep it in the centrifugal
+    # potential: 0.7.0 lost it there, 1st torsion 8.488 rad/s against 10.180 lumped.
+    blade_req = {
+        "structure": {
+            "joints": {"O": [1, 0, 0], "T": [11, 0, 0]},
+            "sections": {"flat": {"EA": 8.4e7, "EI_flap": 2.8e5, "EI_edge": 2.52e6, "GJ": 1.0,
+                                  "mass_per_length": 3.0, "flap_inertia": 1e-4, "edge_inertia": 9e-4}},
+            "members": [{"id": "b", "from": "O", "to": "T", "section": "flat", "elements": 48}],
+            "clamp": "O",
+        },
+        "analysis": {"omega": [0.0, 2 * math.pi], "modes": 3, "coriolis": False},
+    }
+    tors = {}
+    for mass in ("lumped", "consistent"):
+        blade_req["analysis"]["mass"] = mass
+        rc, out, err = run(["solve", write_request(tmp, "prop-%s.json" % mass, blade_req)])
+        doc = parse_json(out, "propeller %s" % mass)
+        if doc:
+            tors[mass] = [[m["frequency_rad_s"] for m in c["modes"] if m.get("label") == "1st torsion"][:1]
+                          for c in doc["cases"]]
+    ok = len(tors) == 2 and all(len(x) == 1 for v in tors.values() for x in v)
+    if check(ok, "masts: propeller moment: the 1st torsion mode of both mass models (%s)" % tors):
+        (l0, l1), (c0, c1) = [x[0] for x in tors["lumped"]], [x[0] for x in tors["consistent"]]
+        check(abs(c1 - l1) <= 2e-3 * l1 and abs(c0 - l0) <= 2e-3 * l0 and l1 > 1.8 * l0,
+              "masts: propeller moment: 1st torsion at rest %.4f / %.4f, at 60 rpm %.4f / %.4f rad/s "
+              "(lumped / consistent, within 0.2 %%)" % (l0, c0, l1, c1))
 
 
 SCENARIOS = {

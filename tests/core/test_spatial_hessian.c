@@ -194,17 +194,24 @@ static void orientation(const sm_model *m, const sp_kin *k, int p, double O[9])
 }
 
 /* X = O I O', the hub inertia of point p at k. */
-static void hub_inertia(const sm_model *m, const sp_kin *k, int p, double X[9])
+static void hub_inertia_of(const sm_model *m, const sp_kin *k, int p, const double I[9], double X[9])
 {
     double O[9], t[9];
     orientation(m, k, p, O);
-    rot3_mul_r(O, m->pt[p].I, t);
+    rot3_mul_r(O, I, t);
     for (int j = 0; j < 3; j++)
         for (int i = 0; i < 3; i++)
             X[i + 3 * j] = t[i] * O[j] + t[i + 3] * O[j + 3] + t[i + 6] * O[j + 6];
 }
 
-/* T0~ = sum 1/2 m |P r|^2 + 1/2 e' X e at the kinematics k. */
+/* The kinetic rotary inertia of point p in the hub frame (M*, C*). */
+static void hub_inertia(const sm_model *m, const sp_kin *k, int p, double X[9])
+{
+    hub_inertia_of(m, k, p, m->pt[p].I, X);
+}
+
+/* T0~ = sum 1/2 m |P r|^2 + 1/2 e' Xc e at the kinematics k (Xc from the centrifugal inertia Ic:
+ * the whole section tensor at consistent-mass Gauss points, whose kinetic I is torsion only). */
 static double potential(const sm_model *m, const sp_kin *k)
 {
     double T = 0;
@@ -214,9 +221,9 @@ static double potential(const sm_model *m, const sp_kin *k)
             continue;
         const double *r = k->r + 3 * p;
         T += 0.5 * pt->mass * (r[0] * r[0] + r[1] * r[1]);
-        if (pt->has_I) {
+        if (pt->has_Ic) {
             double X[9];
-            hub_inertia(m, k, p, X);
+            hub_inertia_of(m, k, p, pt->Ic, X);
             T += 0.5 * X[8];
         }
     }

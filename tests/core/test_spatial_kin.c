@@ -97,7 +97,7 @@ static double potential(const sm_model *m, const sp_kin *k)
         rot3_tmv(L, a, v);
         for (int i = 0; i < 3; i++)
             for (int j = 0; j < 3; j++)
-                T += 0.5 * creal(v[i] * pt->I[i + 3 * j] * v[j]);
+                T += 0.5 * creal(v[i] * pt->Ic[i + 3 * j] * v[j]);
     }
     return T;
 }
