@@ -38,6 +38,66 @@ static int mesh_positive(double v)
     return isfinite(v) && v > 0.0;
 }
 
+/*
+ * The smallest member or element length the numerics carry (issue 23 item 7: a 1e-15 m member
+ * at 0.5 m from the hub solved at 2.9e18 rad/s; a 1e-300 m one was told its flap_direction was
+ * along the member).  A joint coordinate of magnitude S is held to eps S (eps = 2.2e-16), so a
+ * length l taken as the difference of two joints is known to eps S / l, its direction alike,
+ * and the element stiffness EI/l^3 to 3 eps S / l.  With l >= MESH_MIN_RELATIVE S that is
+ * 2.2e-10 for length and direction (7e-10 for EI/l^3): far inside the 1e-6 with which the axes
+ * are checked (MESH3_PARALLEL) and the results are reported, so round-off of the geometry never
+ * decides an answer.  (Conditioning between long and short elements is stricter: the codec
+ * refuses element lengths below 1e-4 of the longest.)  S is the structure's size: its largest
+ * joint coordinate (hub frame, m), which bounds every joint's distance from the hub centre and
+ * from the clamp to within a factor 2 sqrt 3 and cannot overflow.  The absolute floor
+ * MESH_MIN_ABSOLUTE is where the steps the solver takes in metres stop being small: the complex
+ * step of the spatial Hessian (1e-20 m, frames3.c) is exact to (h/l)^2, below round-off only for
+ * l >> 1e-12 m; 1e-9 m keeps that at 1e-22 (and lengths squared, cubed and to the fourth far
+ * from underflow), and no beam is shorter than a nanometre.
+ */
+#define MESH_MIN_RELATIVE 1e-6 /* of the largest joint coordinate */
+#define MESH_MIN_ABSOLUTE 1e-9 /* m */
+
+/* The structure's size: its largest joint coordinate (m); coordinates are finite. */
+static double mesh_size(const sm_structure *st)
+{
+    double s = 0.0;
+    for (int j = 0; j < st->n_joints; j++) {
+        s = fmax(s, fmax(fabs(st->joint_xy[2 * j]), fabs(st->joint_xy[2 * j + 1])));
+        s = fmax(s, fabs(MESH_Z(st, j)));
+    }
+    return s;
+}
+
+/*
+ * Member i of length l (m) against the smallest length the numerics carry (size: mesh_size):
+ * the member (field "", as for a zero-length member: no one joint is at fault, and the
+ * codec's blade form has no "from"/"to" to point at) and then its elements ("elements"; then
+ * l >= lmin > l / elements, so l / lmin < elements fits an int).
+ */
+static int mesh_length(sm_diag *d, int i, double l, int elements, double size)
+{
+    double rel = MESH_MIN_RELATIVE * size, lmin = fmax(rel, MESH_MIN_ABSOLUTE), le = l / elements;
+    char why[96];
+    if (l >= lmin && le >= lmin)
+        return SM_OK;
+    if (rel >= MESH_MIN_ABSOLUTE)
+        snprintf(why, sizeof why, "%g of the structure's size %.3g m, its largest joint coordinate",
+                 MESH_MIN_RELATIVE, size);
+    else
+        snprintf(why, sizeof why, "%g m", MESH_MIN_ABSOLUTE);
+    int rc = mesh_fail(d, SM_ITEM_MEMBER, i, l < lmin ? "" : "elements", "");
+    if (d && l < lmin)
+        snprintf(d->message, sizeof d->message,
+                 "the member is %.3g m long: shorter than the smallest length the numerics carry "
+                 "(%s): move its joints apart or merge it into its neighbour", l, why);
+    else if (d)
+        snprintf(d->message, sizeof d->message,
+                 "%d elements of %.3g m: shorter than the smallest length the numerics carry (%s): "
+                 "use at most %d elements", elements, le, why, (int)(l / lmin));
+    return rc;
+}
+
 /* Check numbers, indices and options; topology is checked by mesh_walk. */
 static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
 {
@@ -70,6 +130,7 @@ static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
                              "mass_per_length must be a positive number (kg/m)");
     }
     long total = 0;
+    double size = mesh_size(st);
     for (int i = 0; i < st->n_members; i++) {
         const sm_member *b = &st->members[i];
         if (b->from < 0 || b->from >= st->n_joints)
@@ -86,8 +147,12 @@ static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
         double dx = st->joint_xy[2 * b->to] - st->joint_xy[2 * b->from];
         double dy = st->joint_xy[2 * b->to + 1] - st->joint_xy[2 * b->from + 1];
         double dz = st->spatial && st->joint_z ? st->joint_z[b->to] - st->joint_z[b->from] : 0.0;
-        if (b->from == b->to || !(hypot(hypot(dx, dy), dz) > 0.0))
+        double l = hypot(hypot(dx, dy), dz);
+        if (b->from == b->to || !(l > 0.0))
             return mesh_fail(d, SM_ITEM_MEMBER, i, "", "zero-length member: its joints coincide");
+        rc = mesh_length(d, i, l, b->elements, size);
+        if (rc < 0)
+            return rc;
     }
     for (int i = 0; i < st->n_point_masses; i++) {
         const sm_point_mass *p = &st->point_masses[i];
