@@ -749,6 +749,66 @@ def t_masts(tmp):
               "(lumped / consistent, within 0.2 %%)" % (l0, c0, l1, c1))
 
 
+def t_bmodes_model(tmp):
+    """Issue 22 item 4: the residual against BModes on CertTest Test01 (modes 4, 7, 8, 10 were
+    0.7-1.3 % high at 96-192 elements) is BModes' model, not ours.  BModes (i) bends edgewise
+    about the shear centre, taking EI_edge - EA (tc - sc)^2 (its only axial-edge coupling uses
+    tc - sc), (ii) uses the c.g. offset as filed, not c.g. - shear centre, for its only
+    flap-torsion coupling, (iii) has no bending rotary inertia (BModes.f90:706, 1132; Struct.f90
+    1156-1169, 1222, 1258).  (1) Fed that model (shear centre on the axis, tension centre at
+    tc - sc, EI_edge - EA (tc - sc)^2, c.g. as filed, consistent mass), our 96 elements give
+    BModes' own 96-element numbers (bmodes_refined.csv, stock): bending modes within 0.3 %, the
+    torsion modes within 0.6 % (a residual of -0.3 to -0.5 % we leave open).  (2) Physics says a
+    shear-centre offset alone does not change edge bending (BModes: 26 % lower on a uniform beam
+    with 0.3 m): ours at rest moves by less than 1e-6."""
+    ref = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "reference", "blades")
+    bmi = os.path.join(ref, "bmodes_certtest", "Test01_nonunif_blade.bmi")
+    rc, out, err = run(["import", "bmodes", bmi])
+    if not check(rc == 0, "bmodes model: Test01 imports (%d %.200s)" % (rc, err)):
+        return
+    req = json.loads(out)
+    req["blade"]["elements"] = 96
+    req["analysis"].update({"modes": 10, "coriolis": False, "mass": "consistent", "mode_shapes": False})
+    for st in req["blade"]["stations"]:
+        sc, tc = st["shear_center_offset"][0], st["tension_center_offset"][0]
+        st["shear_center_offset"] = [0.0, 0.0]
+        st["tension_center_offset"] = [tc - sc, 0.0]
+        st["EI_edge"] = st["EI_edge"] - st["EA"] * (tc - sc) ** 2
+    rc, out, err = run(["solve", write_request(tmp, "t01-bmodes-model.json", req)])
+    doc = parse_json(out, "bmodes model")
+    want = []
+    with open(os.path.join(ref, "bmodes_refined.csv")) as f:
+        for line in f:
+            p = line.strip().split(",")
+            if len(p) == 4 and p[0] == "Test01_nonunif_blade" and p[1] == "stock":
+                want.append(float(p[3]))
+    if check(doc is not None and len(want) == 10, "bmodes model: solved, 10 BModes modes"):
+        ours = [m["frequency_hz"] for m in doc["cases"][0]["modes"]]
+        labels = [m.get("label", "") for m in doc["cases"][0]["modes"]]
+        for i, w in enumerate(want):
+            j = min(range(len(ours)), key=lambda k: abs(ours[k] - w))
+            e = 100 * (ours[j] / w - 1)
+            tol = 0.6 if "torsion" in labels[j] else 0.3
+            check(abs(e) <= tol, "bmodes model: BModes mode %d %.4f Hz, ours (%s) %.4f Hz: %+.2f %% (within %g %%)" %
+                  (i + 1, w, labels[j], ours[j], e, tol))
+    # (2) a shear-centre offset alone at rest: edge bending unchanged
+    base = {"blade": {"length": 30.0, "hub_radius": 1.0, "elements": 48,
+                      "section": {"EA": 1e10, "EI_flap": 1e8, "EI_edge": 1e9, "GJ": 5e7, "mass_per_length": 400.0,
+                                  "flap_inertia": 10.0, "edge_inertia": 40.0}},
+            "analysis": {"omega": 0, "modes": 8, "coriolis": False}}
+    freqs = []
+    for sc in (0.0, 0.3):
+        r = json.loads(json.dumps(base))
+        r["blade"]["section"]["shear_center_offset"] = [sc, 0.0]
+        rc, out, err = run(["solve", write_request(tmp, "sc-%g.json" % sc, r)])
+        d = parse_json(out, "shear centre %g" % sc)
+        freqs.append({m["label"]: m["frequency_hz"] for m in d["cases"][0]["modes"]} if d else {})
+    edge = [k for k in freqs[0] if "edge" in k]
+    check(bool(edge) and all(k in freqs[1] and abs(freqs[1][k] / freqs[0][k] - 1) < 1e-6 for k in edge),
+          "bmodes model: a 0.3 m shear-centre offset leaves the edge modes at rest (%s -> %s)" %
+          ({k: round(freqs[0][k], 6) for k in edge}, {k: round(freqs[1].get(k, 0), 6) for k in edge}))
+
+
 SCENARIOS = {
     "cantilever": t_cantilever,
     "invalid": t_invalid,
@@ -763,6 +823,7 @@ SCENARIOS = {
     "reference3d": t_reference3d,
     "divergence": t_divergence,
     "masts": t_masts,
+    "bmodes_model": t_bmodes_model,
 }
 
 
