@@ -397,21 +397,42 @@ static json_t *bm_source(const bm_main *m, const char *bmi, json_t *el_loc)
 
 /* ------------------------------------------------ BModes' own model (option bmodes_mesh) */
 
-/* Value x of station key k at fraction f between stations a and b (arrays element by element). */
-static json_t *bm_lerp(const json_t *a, const json_t *b, double f)
+/*
+ * A sampled number as a JSON real: rounded as printed; one that is not a number the request
+ * carries sets *big and is written as 0 (the caller refuses the file: json_real(inf) would be
+ * NULL, read as out of memory).
+ */
+static json_t *bm_real(double v, int *big)
 {
+    if (!imp_finite(v)) {
+        *big = 1;
+        v = 0.0;
+    }
+    return json_real(imp_round(v));
+}
+
+/* Value x of station key k at fraction f between stations a and b (arrays element by element). */
+static json_t *bm_lerp(const json_t *a, const json_t *b, double f, int *big)
+{
+    double va, vb, v;
+
     if (json_is_array(a)) {
         json_t *o = json_array();
         size_t i;
         for (i = 0; o && i < json_array_size(a); i++)
-            if (json_array_append_new(o, bm_lerp(json_array_get(a, i), json_array_get(b, i), f))) {
+            if (json_array_append_new(o, bm_lerp(json_array_get(a, i), json_array_get(b, i), f,
+                                                 big))) {
                 json_decref(o);
                 return NULL;
             }
         return o;
     }
-    return json_real(imp_round(json_number_value(a) + f * (json_number_value(b) -
-                                                          json_number_value(a))));
+    va = json_number_value(a);
+    vb = json_number_value(b);
+    v = va + f * (vb - va);
+    if (!isfinite(vb - va)) /* opposite signs near the largest double: (1 - f) a + f b */
+        v = (1.0 - f) * va + f * vb;
+    return bm_real(v, big);
 }
 
 /* sts[j] key's number (0 when absent). */
@@ -427,7 +448,7 @@ static double bm_st(const json_t *st, const char *key)
  * reference axis, the edge moment moved there for that and back to the centre of mass
  * (the importer's edge_inertia = edge_iner - mass cg^2).  A new station object without "s".
  */
-static json_t *bm_sample(const json_t *sts, double x)
+static json_t *bm_sample(const json_t *sts, double x, int *big)
 {
     size_t j = 0, n = json_array_size(sts);
     const json_t *a, *b, *v;
@@ -441,20 +462,21 @@ static json_t *bm_sample(const json_t *sts, double x)
     b = json_array_get(sts, j + 1);
     f = (x - bm_st(a, "s")) / (bm_st(b, "s") - bm_st(a, "s"));
     json_object_foreach((json_t *)a, key, v)
-        if (strcmp(key, "s") && json_object_set_new(o, key, bm_lerp(v, json_object_get(b, key), f)))
+        if (strcmp(key, "s") && json_object_set_new(o, key, bm_lerp(v, json_object_get(b, key), f,
+                                                                     big)))
             goto fail;
     mu = bm_st(o, "mass_per_length");
     ra = bm_st(a, "flap_inertia") / bm_st(a, "mass_per_length");
     rb = bm_st(b, "flap_inertia") / bm_st(b, "mass_per_length");
-    if (json_object_set_new(o, "flap_inertia", json_real(imp_round(mu * (ra + f * (rb - ra))))))
+    if (json_object_set_new(o, "flap_inertia", bm_real(mu * (ra + f * (rb - ra)), big)))
         goto fail;
 #define BM_CG(st) json_number_value(json_array_get(json_object_get(st, "cg_offset"), 0))
     ra = bm_st(a, "edge_inertia") / bm_st(a, "mass_per_length") + BM_CG(a) * BM_CG(a);
     rb = bm_st(b, "edge_inertia") / bm_st(b, "mass_per_length") + BM_CG(b) * BM_CG(b);
     cg = BM_CG(o);
 #undef BM_CG
-    if (json_object_set_new(o, "edge_inertia",
-                            json_real(imp_round(mu * (ra + f * (rb - ra)) - mu * cg * cg))))
+    if (json_object_set_new(o, "edge_inertia", bm_real(mu * (ra + f * (rb - ra)) - mu * cg * cg,
+                                                       big)))
         goto fail;
     return o;
 fail:
@@ -507,10 +529,16 @@ static int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *fil
     for (i = 0; i < n; i++) {
         char name[32];
         double x = json_number_value(json_array_get(el_loc, i)), p[3];
-        for (c = 0; c < 3; c++)
+        for (c = 0; c < 3; c++) {
             p[c] = imp_round(json_number_value(json_array_get(root, c)) +
                              x * (json_number_value(json_array_get(tip, c)) -
                                   json_number_value(json_array_get(root, c))));
+            if (!imp_finite(p[c])) {
+                rc = imp_fail(d, file, 0, "bmodes_mesh", "the joint at el_loc %.15g is beyond "
+                              "the largest number a request carries (%s)", x, IMP_MAX_ABS_TEXT);
+                goto done;
+            }
+        }
         if (i == 0 || i + 1 == n)
             snprintf(name, sizeof name, "%s", i == 0 ? "root" : "tip");
         else
@@ -521,9 +549,16 @@ static int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *fil
             continue;
         {
             double x0 = json_number_value(json_array_get(el_loc, i - 1));
-            json_t *mid = bm_sample(sts, 0.5 * (x0 + x)), *m = NULL, *two[2] = {NULL, NULL};
+            int h, big = 0;
+            json_t *mid = bm_sample(sts, 0.5 * (x0 + x), &big), *m = NULL, *two[2] = {NULL, NULL};
             char from[32], id[32];
-            int h;
+            if (big) {
+                json_decref(mid);
+                rc = imp_fail(d, file, 0, "bmodes_mesh", "element e%zu (el_loc %.15g to %.15g): "
+                              "a property sampled at its midpoint is beyond the largest number a "
+                              "request carries (%s)", i, x0, x, IMP_MAX_ABS_TEXT);
+                goto done;
+            }
             snprintf(from, sizeof from, i == 1 ? "root" : "x%zu", i - 1);
             snprintf(id, sizeof id, "e%zu", i);
             for (h = 0; mid && h < 2; h++) { /* the member uniform: two equal stations */

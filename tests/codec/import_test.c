@@ -639,6 +639,26 @@ static void test_overflow_is_invalid(void)
                    "blade_sec_props.dat:8: axial_stff: out of range: 1.7976931348623157e+308 is "
                    "beyond the largest number a request carries (1.79769313486231e+308 in "
                    "magnitude)");
+    /* bmodes_mesh samples the properties at element midpoints: a flap inertia / mass past the
+     * largest double there, or offsets of opposite signs near it (their difference overflows) */
+    {
+        import_file f = {"T.bmi", bmi, strlen(bmi)};
+        import_options o;
+        char *s1 = edit(sec, 9, " 183.905   47.842 ", " 0.5 1e308 ");
+        char *a = edit(sec, 9, "-0.014", "1.7e308"), *s2 = edit(a, 10, "-0.023", "-1.7e308");
+        import_default_options(&o);
+        o.bmodes_mesh = 2;
+        expect_error("4: bmodes_mesh, flp_iner / mass_den overflows at a midpoint",
+                     import_bmodes(&doc, &f, load_sec, s1, &o, &d), &d,
+                     "T.bmi: bmodes_mesh: element e2 (el_loc 0.08 to 0.16): a property sampled "
+                     "at its midpoint is beyond the largest number a request carries "
+                     "(1.79769313486231e+308)");
+        json_decref(doc), doc = NULL;
+        if (import_bmodes(&doc, &f, load_sec, s2, &o, &d) != SM_OK)
+            fail("4: bmodes_mesh, sc_offst +-1.7e308 around a midpoint: %s", d.text);
+        json_decref(doc), doc = NULL;
+        free(s1), free(a), free(s2);
+    }
     expect_error("4: ElastoDyn tip_radius DBL_MAX", elastodyn(&doc, ed, big, 1.5, &d), &d,
                  "blade.dat: tip_radius: out of range: 1.7976931348623157e+308 is beyond the "
                  "largest number a request carries (1.79769313486231e+308 in magnitude)");
