@@ -51,13 +51,13 @@ static const char cli_usage_text[] =
     "usage: spinmodal solve [--csv | --table | --critical-csv] [--pretty] FILE|-\n"
     "       spinmodal validate [--pretty] FILE|-\n"
     "       spinmodal import bmodes|elastodyn|csv FILE [--tip-radius R] [--hub-radius H]\n"
-    "                        [--rpm N] [--pretty] [--full]\n"
+    "                        [--rpm N] [--bmodes-mesh K] [--allow-outside] [--pretty] [--full]\n"
     "       spinmodal export spanwise|bmodes RESULT|-\n"
     "       spinmodal --help | --version\n";
 
 static void cli_help(void)
 {
-    printf("spinmodal %s: modal analysis of spinning planar beam structures\n\n%s\n"
+    printf("spinmodal %s: modal analysis of spinning beam structures (planar and spatial)\n\n%s\n"
            "commands:\n"
            "  solve FILE|-     solve the JSON request in FILE (- = stdin) and print the\n"
            "                   result JSON on stdout\n"
