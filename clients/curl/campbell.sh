@@ -3,9 +3,11 @@
 #
 #   campbell.sh REQUEST.json START:STOP:COUNT      e.g. campbell.sh examples/angled-beam-90.json 0:20:101
 #   campbell.sh REQUEST.json 0,5,10,20             explicit speeds (rad/s)
+#   campbell.sh --rpm REQUEST.json 0:15:16         the same in rev/min
 #
-# Replaces analysis.omega of the request by COUNT evenly spaced speeds from START to STOP (both
-# included), switches mode shapes off (a sweep needs only the frequencies), submits the sweep,
+# Replaces the request's speeds (analysis.omega or analysis.rpm, whichever it has: the
+# importers write rpm) by COUNT evenly spaced speeds from START to STOP (both included), in
+# rad/s (analysis.omega) or with --rpm in rev/min (analysis.rpm), switches mode shapes off (a sweep needs only the frequencies), submits the sweep,
 # waits and prints the frequency CSV (one row per speed and mode; see csv.sh).  The JSON edit
 # uses python3 (jq is not required).
 #
@@ -16,16 +18,18 @@
 # is still printed) or was canceled, 2 invalid request, 3 connection/HTTP error, 64 usage.
 set -euo pipefail
 
-usage() { echo "usage: ${0##*/} REQUEST.json START:STOP:COUNT | REQUEST.json S1,S2,..."; }
+usage() { echo "usage: ${0##*/} [--rpm] REQUEST.json START:STOP:COUNT | [--rpm] REQUEST.json S1,S2,..."; }
 
 case ${1:-} in -h|--help) usage; exit 0 ;; esac
+key=omega
+if [ "${1:-}" = --rpm ]; then key=rpm; shift; fi
 [ $# -eq 2 ] || { usage >&2; exit 64; }
 if [ "$1" != - ] && [ ! -r "$1" ]; then echo "${0##*/}: cannot read $1" >&2; exit 2; fi
 
 # Build the sweep request (exit 64 on a bad range, 2 on a file that is not JSON).
-sweep=$(python3 - "$1" "$2" <<'PY'
+sweep=$(python3 - "$1" "$2" "$key" <<'PY'
 import json, sys
-path, spec = sys.argv[1], sys.argv[2]
+path, spec, key = sys.argv[1], sys.argv[2], sys.argv[3]
 try:
     if ":" in spec:
         start, stop, count = spec.split(":")
@@ -42,7 +46,8 @@ except ValueError:
 try:
     req = json.load(sys.stdin if path == "-" else open(path))
     req.setdefault("analysis", {})
-    req["analysis"]["omega"] = [round(s, 12) + 0.0 for s in speeds]
+    req["analysis"].pop("rpm" if key == "omega" else "omega", None)
+    req["analysis"][key] = [round(s, 12) + 0.0 for s in speeds]
     req["analysis"]["mode_shapes"] = False
 except (ValueError, AttributeError, TypeError) as e:
     print("campbell.sh: %s is not a JSON request: %s" % (path, e), file=sys.stderr)

@@ -21,7 +21,7 @@ Command line (also ``python3 -m spinmodal_client --help``)::
     python3 -m spinmodal_client status ID
     python3 -m spinmodal_client cancel ID
     python3 -m spinmodal_client list [--state S] [--limit N]
-    python3 -m spinmodal_client campbell request.json --speeds 0:20:21 [--hz]
+    python3 -m spinmodal_client campbell request.json --speeds 0:20:21 [--hz]   (or --rpm 0:15:16)
 
 Exit codes: 0 ok, 1 the job failed or was canceled, 2 invalid request (HTTP 400, 413, 415,
 422), 3 connection error, server error or any other HTTP error (401, 404, 409, 429, 503 ...),
@@ -409,17 +409,25 @@ class Client:
                 target += ("&" if path.query else "?") + urllib.parse.urlencode({"state": state})
             _, _, doc = self._call("GET", target)
 
-    def campbell(self, request, speeds=None, timeout=None, retry=True):
+    def campbell(self, request, speeds=None, timeout=None, retry=True, rpm=None):
         """Run a sweep and return its frequency table as a list of rows, one per speed and
         mode in request order: dicts with omega, mode, frequency_rad_s, frequency_hz, status
         and mac_to_previous (mode and the numbers are None for a speed without modes, e.g.
-        no_equilibrium).  ``speeds`` (a list of rad/s) replaces analysis.omega; mode shapes
-        are switched off.  A job that ends failed with a stored result (no equilibrium at
-        some speeds) still returns its rows; otherwise SpinmodalJobError."""
+        no_equilibrium).  ``speeds`` (a list of rad/s) or ``rpm`` (a list of rev/min, not
+        both) replaces the request's speeds, whichever key it used (analysis.omega or
+        analysis.rpm: the importers write rpm); mode shapes are switched off.  A job that
+        ends failed with a stored result (no equilibrium at some speeds) still returns its
+        rows; otherwise SpinmodalJobError."""
+        if speeds is not None and rpm is not None:
+            raise ValueError("campbell(): give speeds (rad/s) or rpm (rev/min), not both")
         req = _request_dict(request)
         analysis = req.setdefault("analysis", {})
         if speeds is not None:
+            analysis.pop("rpm", None)
             analysis["omega"] = [float(s) for s in speeds]
+        elif rpm is not None:
+            analysis.pop("omega", None)
+            analysis["rpm"] = [float(s) for s in rpm]
         analysis["mode_shapes"] = False
         st = self.submit(req, wait=MAX_WAIT if timeout is None else min(MAX_WAIT, timeout), retry=retry)
         if st.get("state") not in FINAL_STATES:
@@ -653,8 +661,12 @@ def _cmd_list(c, a):
 def _cmd_campbell(c, a):
     try:
         speeds = parse_speeds(a.speeds) if a.speeds else None
+        rpm = parse_speeds(a.rpm) if a.rpm else None
     except ValueError as e:
-        print("campbell: --speeds: %s" % e, file=sys.stderr)
+        print("campbell: --%s: %s" % ("speeds" if a.speeds else "rpm", e), file=sys.stderr)
+        return EXIT_USAGE
+    if speeds is not None and rpm is not None:
+        print("campbell: give --speeds (rad/s) or --rpm (rev/min), not both", file=sys.stderr)
         return EXIT_USAGE
     body = _read_request(a.request)
     try:
@@ -662,7 +674,7 @@ def _cmd_campbell(c, a):
     except ValueError as e:
         print("spinmodal: %s is not JSON: %s" % (a.request, e), file=sys.stderr)
         return EXIT_INVALID
-    rows = c.campbell(request, speeds=speeds, timeout=a.timeout)
+    rows = c.campbell(request, speeds=speeds, rpm=rpm, timeout=a.timeout)
     key = "frequency_hz" if a.hz else "frequency_rad_s"
     if a.csv:
         w = _csv.writer(sys.stdout, lineterminator="\n")
@@ -760,8 +772,9 @@ def _parser():
     s = sub.add_parser("campbell", parents=[common],
                        help="sweep speeds and print the frequencies (a Campbell table)")
     s.add_argument("request", help="request JSON file ('-' for stdin)")
-    s.add_argument("--speeds", help="START:STOP:COUNT (e.g. 0:20:21) or a list 0,5,10; "
-                                    "default: the request's analysis.omega")
+    s.add_argument("--speeds", help="rad/s: START:STOP:COUNT (e.g. 0:20:21) or a list 0,5,10; "
+                                    "default: the request's own speeds")
+    s.add_argument("--rpm", help="rev/min instead: START:STOP:COUNT (e.g. 0:15:16) or a list")
     s.add_argument("--hz", action="store_true", help="frequencies in Hz (default rad/s)")
     s.add_argument("--csv", action="store_true", help="CSV rows instead of a table")
     s.add_argument("--timeout", type=float, default=None, help="give up waiting after S seconds")

@@ -292,6 +292,20 @@ def scenario_campbell(d):
     # the daemon's next link (informational: the client adds state= itself if it is missing)
     page = c._call("GET", "/v1/analyses?limit=1&state=done")[2]
     print("     (next with state filter: %r)" % page.get("next"))
+    # the importers write analysis.rpm: speeds in rad/s or in rpm replace it (issue 26: 422 before)
+    blade = load_example("tapered-blade.json")
+    rows_w = c.campbell(blade, speeds=[0, 2 * math.pi])
+    check(sorted(set(r["omega"] for r in rows_w)) == [0.0, 2 * math.pi] and
+          all(r["status"] == "solved" for r in rows_w),
+          "campbell(request with analysis.rpm, speeds=[0, 2 pi]): solved at those speeds (%r)" %
+          sorted(set(r["omega"] for r in rows_w)))
+    rows_r = c.campbell(blade, rpm=[0, 60])
+    check(len(rows_r) == len(rows_w) and all(close(a["frequency_rad_s"], b["frequency_rad_s"], 1e-9)
+                                             for a, b in zip(rows_r, rows_w)) and
+          all(close(r["rpm"], r["omega"] * 60 / (2 * math.pi), 1e-9) for r in rows_r),
+          "campbell(rpm=[0, 60]) = campbell(speeds=[0, 2 pi]) (1e-9), rpm column")
+    check(raises(lambda: c.campbell(blade, speeds=[1], rpm=[1]), ValueError) is not None,
+          "campbell(speeds=, rpm=) together: ValueError")
 
 
 def scenario_errors(d):
@@ -498,6 +512,14 @@ def scenario_python_cli(d):
           "campbell --speeds 0:20:3: exit 0, header + 3 speed lines (%d):\n%s" % (p.returncode, p.stdout))
     p = run_py(["campbell", example("angled-beam-90-sweep.json"), "--speeds", "0:20"], env)
     check(p.returncode == 64, "campbell --speeds 0:20: exit 64 (%d)" % p.returncode)
+    p = run_py(["campbell", example("tapered-blade.json"), "--rpm", "0:60:2", "--csv"], env)
+    rows = p.stdout.strip().split("\n")[1:]
+    om = sorted(set(round(float(r.split(",")[0]), 9) for r in rows)) if p.returncode == 0 else []
+    check(p.returncode == 0 and om == [0.0, round(2 * math.pi, 9)],
+          "campbell --rpm 0:60:2 of a request with analysis.rpm: exit 0 at 0 and 2 pi rad/s (%d %r %s)"
+          % (p.returncode, om, p.stderr[-200:]))
+    p = run_py(["campbell", example("tapered-blade.json"), "--rpm", "0:60:2", "--speeds", "0,1"], env)
+    check(p.returncode == 64, "campbell --rpm with --speeds: exit 64 (%d)" % p.returncode)
     p = run_py([], env)
     check(p.returncode == 64, "no command: exit 64 (%d)" % p.returncode)
     p = run_py(["solve"], env)
@@ -590,6 +612,15 @@ def scenario_curl(d):
           "campbell.sh: omega 0, 6.67, 13.3, 20 ascending (%r)" % sorted(set(om)))
     p = run_sh("campbell.sh", [example("angled-beam-90.json"), "0,10"], env)
     check(p.returncode == 0 and len(p.stdout.strip().split("\n")) == 7, "campbell.sh 0,10: exit 0, 6 rows")
+    p = run_sh("campbell.sh", ["--rpm", example("tapered-blade.json"), "0:60:2"], env)
+    lines = p.stdout.strip().split("\n")
+    om = sorted(set(round(float(x.split(",")[0]), 9) for x in lines[1:]))
+    check(p.returncode == 0 and om == [0.0, round(2 * math.pi, 9)],
+          "campbell.sh --rpm on an imported-style request (analysis.rpm): exit 0, 0 and 60 rpm (%d %r %s)"
+          % (p.returncode, om, p.stderr[-200:]))
+    p = run_sh("campbell.sh", [example("tapered-blade.json"), "0,5"], env)
+    check(p.returncode == 0 and len(p.stdout.strip().split("\n")) == 1 + 2 * 4,
+          "campbell.sh rad/s on a request with analysis.rpm: exit 0, 8 rows (%d %s)" % (p.returncode, p.stderr[-200:]))
     p = run_sh("campbell.sh", [example("angled-beam-90.json"), "0:x:3"], env)
     check(p.returncode == 64, "campbell.sh with a bad range: exit 64 (%d)" % p.returncode)
 
