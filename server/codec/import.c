@@ -51,18 +51,18 @@ int import_format_known(const char *name)
 
 /* ----------------------------------------------------------- encoding */
 
-int imp_encoding(import_diag *d, const import_file *f, size_t *skip)
+int imp_encoding(import_diag *d, const import_file *f, import_file *body)
 {
     const unsigned char *u = (const unsigned char *)f->text;
     const char *nul;
+    size_t skip = 0;
 
-    *skip = 0;
     if (f->len >= 2 && ((u[0] == 0xFF && u[1] == 0xFE) || (u[0] == 0xFE && u[1] == 0xFF)))
         return imp_fail(d, f->name, 1, "encoding", "the file is UTF-16 (byte-order mark %02X "
                         "%02X): save it as UTF-8 (Excel: \"CSV UTF-8\"; Notepad: Save as, "
                         "Encoding UTF-8)", u[0], u[1]);
     if (f->len >= 3 && u[0] == 0xEF && u[1] == 0xBB && u[2] == 0xBF)
-        *skip = 3; /* UTF-8 byte-order mark, as Excel's "CSV UTF-8" writes */
+        skip = 3; /* UTF-8 byte-order mark, as Excel's "CSV UTF-8" writes */
     if ((nul = memchr(f->text, '\0', f->len))) {
         int line = 1;
         const char *p;
@@ -71,6 +71,9 @@ int imp_encoding(import_diag *d, const import_file *f, size_t *skip)
         return imp_fail(d, f->name, line, "encoding", "the file holds NUL bytes: it is UTF-16 "
                         "or binary, not text; save it as UTF-8 (Excel: \"CSV UTF-8\")");
     }
+    *body = *f; /* body may be f */
+    body->text += skip;
+    body->len -= skip;
     return SM_OK;
 }
 

@@ -608,7 +608,6 @@ int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void
     json_t *warn = json_array(), *el_loc = json_array(), *src, *sec;
     import_file sf = {NULL, NULL, 0}, body;
     imp_table t = {NULL, 0, 0, 0};
-    size_t skip;
     imp_blade bl;
     bm_main m;
     bm_in b;
@@ -622,11 +621,8 @@ int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void
         st = SM_NOMEM;
         goto done;
     }
-    if ((st = imp_option(d, bmi->name, "rpm", o->rpm)) || (st = imp_encoding(d, bmi, &skip)))
+    if ((st = imp_option(d, bmi->name, "rpm", o->rpm)) || (st = imp_encoding(d, bmi, &body)))
         goto done;
-    body = *bmi;
-    body.text += skip;
-    body.len -= skip;
     bm_init(&b, &body, d);
     if ((st = bm_general(&b, &m)) || (st = bm_props(&b, &m)) || (st = bm_mesh(&b, &m, el_loc)))
         goto done;
@@ -643,10 +639,8 @@ int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void
         goto done;
     if (!sf.name)
         sf.name = m.sec_file;
-    if ((st = imp_encoding(d, &sf, &skip)))
+    if ((st = imp_encoding(d, &sf, &sf)))
         goto done;
-    sf.text += skip;
-    sf.len -= skip;
     bm_init(&b, &sf, d);
     if ((st = bm_sections(&b, &m, &t)) || (st = bm_blade(&m, o, &bl, warn)))
         goto done;

@@ -313,17 +313,13 @@ int import_csv(json_t **out, const import_file *f, const import_options *o, impo
     imp_blade bl;
     imp_reader r;
     import_file body;
-    size_t skip;
 
     *out = NULL;
     imp_blade_init(&bl);
     if (!warn)
         return SM_NOMEM;
-    if ((st = imp_encoding(d, f, &skip)))
+    if ((st = imp_encoding(d, f, &body)))
         goto done;
-    body = *f;
-    body.text += skip;
-    body.len -= skip;
     imp_reader_init(&r, &body);
     if ((st = csv_header(&r, d, col, &ncol)) || (st = csv_rows(&r, d, col, ncol, &t)))
         goto done;

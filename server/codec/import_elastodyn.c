@@ -262,18 +262,14 @@ int import_elastodyn(json_t **out, const import_file *f, const import_options *o
     ed_params p;
     imp_reader r;
     import_file body;
-    size_t skip;
 
     *out = NULL;
     memset(&p, 0, sizeof(p));
     imp_blade_init(&bl);
     if (!warn)
         return SM_NOMEM;
-    if ((st = imp_encoding(d, f, &skip)))
+    if ((st = imp_encoding(d, f, &body)))
         goto done;
-    body = *f;
-    body.text += skip;
-    body.len -= skip;
     imp_reader_init(&r, &body);
     if ((st = ed_head(&r, d, &p)) || (st = ed_columns(&r, d, col, &ncol, warn)) ||
         (st = ed_rows(&r, d, &p, col, ncol, &t)) ||

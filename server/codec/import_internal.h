@@ -241,10 +241,10 @@ int imp_document_assumed(json_t **out, import_diag *d, const char *file, const i
                          json_t *warnings, json_t *source);
 
 /**
- * The text encoding of f: a UTF-8 byte-order mark is skipped (*skip = 3, else 0); UTF-16 (a
- * byte-order mark FF FE or FE FF, or any NUL byte) is refused, saying to save the file as
- * UTF-8.  SM_OK or SM_INVALID_INPUT (d).
+ * The text encoding of f: *body = the text to read, f without a UTF-8 byte-order mark
+ * (body may be f); UTF-16 (a byte-order mark FF FE or FE FF, or any NUL byte) is refused,
+ * saying to save the file as UTF-8.  SM_OK or SM_INVALID_INPUT (d).
  */
-int imp_encoding(import_diag *d, const import_file *f, size_t *skip);
+int imp_encoding(import_diag *d, const import_file *f, import_file *body);
 
 #endif /* SPINMODAL_IMPORT_INTERNAL_H */
