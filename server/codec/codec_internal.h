@@ -10,8 +10,12 @@
  *   station.c   section properties along a member (stations)         stn_
  *   blade.c     the "blade" form expanded to a structure             blade_
  *   speeds.c    analysis.omega / analysis.rpm: numbers, lists, ranges spd_
- *   warn.c      unit-slip warnings of a valid request                warn_
+ *   warn.c      unit-slip warnings of a valid request: the thresholds,
+ *               the list, single-field checks                        warn_
+ *   plausible.c the dimensionless groups of those warnings (wave speed,
+ *               radius of gyration, tip speed, centrifugal strain)   plaus_
  *   validate.c  the request document walked field by field           val_
+ *   size.c      the size of a request's result, before it is accepted size_
  *   request.c   canonical text, SHA-256, the core's arrays           req_
  *   diag.c      core diagnostics -> pointers, codec_model_new        diag_
  *   result.c    the result document (DESIGN.md section 4)            res_
@@ -309,6 +313,16 @@ json_t *val_request(const json_t *root, const codec_limits *lim, codec_errors *e
  */
 void val_structure(val_ctx *v, const json_t *root, json_t *canon);
 
+/* ========================================================= size.c: size_ */
+
+/**
+ * The size of the result of a request checked so far (canon: its canonical request,
+ * structure: the canonical structure it is built from; both borrowed): the estimated bytes
+ * of the result document against max_result_bytes (0: no limit) and the mode-shape numbers
+ * against max_shape_values, each over its limit one error naming what to reduce.
+ */
+void size_check(val_ctx *v, const json_t *canon, const json_t *structure);
+
 /* ======================================================== blade.c: blade_ */
 
 /**
@@ -342,12 +356,72 @@ void spd_fill(const json_t *an, double *omega, double *rpm);
 
 /* ======================================================== warn.c: warn_ */
 
+/** The plausibility checks (DESIGN.md 8.4), one row of warn_rules each. */
+typedef enum warn_rule_id {
+    WARN_MODULUS,     /* E, G (Pa) */
+    WARN_DENSITY,     /* mass_per_length / A, when A is given (kg/m^3) */
+    WARN_LINE_MASS,   /* mass_per_length without A (kg/m) */
+    WARN_SECOND,      /* I, I_flap, I_edge, J over A^2 */
+    WARN_STIFF_FLOOR, /* EI, GJ on a member longer than 1 m (N m^2) */
+    WARN_WAVE_SPEED,  /* sqrt(EA / mu) of a member, span means (m/s) */
+    WARN_GYRATION,    /* sqrt(EI / EA) over the member's length, each bending direction */
+    WARN_TIP_SPEED,   /* Omega R_max (m/s) */
+    WARN_STRAIN,      /* mu Omega^2 R^2 / EA of a member, R its outer end's radius */
+    WARN_RADIUS,      /* R_max (m): the largest distance of a joint from the spin axis */
+    WARN_ROUND,       /* lo: the step (rad/s) of an omega that reads as a round rpm number */
+    WARN_N_RULES
+} warn_rule_id;
+
+/** One threshold row: a check warns outside [lo, hi] (NAN: no bound). */
+typedef struct warn_rule {
+    const char *name;   /* the checked quantity, for DESIGN.md and tests */
+    double lo, hi;      /* the plausible range, in unit */
+    double typical;     /* where it usually lies: picks the slip (plaus_slip) */
+    const char *unit;   /* "" for a ratio */
+} warn_rule;
+
+/** The thresholds, indexed by warn_rule_id (warn.c). */
+extern const warn_rule warn_rules[WARN_N_RULES];
+
+/** x for a message: "1e6" for a power of ten from 1e4 up or 1e-3 down, else %g; in buf. */
+const char *warn_g(char buf[32], double x);
+
+/** A list of warnings being built (warn_collect, plausible.c). */
+typedef struct warn_list {
+    json_t *arr;   /* [{"pointer", "message"}] */
+    json_t *seen;  /* pointer -> true: one warning per pointer, the first */
+    int blade;     /* 1: pointers into the expanded structure move into /blade */
+    int nomem;     /* an allocation failed */
+} warn_list;
+
 /**
- * Unit-slip warnings (DESIGN.md 8) of a valid canonical structure st
- * (borrowed): a new array [{"pointer", "message"}], empty when none; blade
- * 1 moves the pointers into /blade.  NULL when out of memory.
+ * Append a warning at ptr (borrowed; a pointer into the canonical structure
+ * or into /analysis), message vprintf-style, unless ptr already has one.
+ * NULL ptr or no memory sets w->nomem.
  */
-json_t *warn_collect(const json_t *st, int blade);
+void warn_vadd(warn_list *w, const char *ptr, const char *fmt, va_list ap);
+
+/** warn_vadd, printf-style. */
+void warn_add(warn_list *w, const char *ptr, const char *fmt, ...) CODEC_PRINTF(3, 4);
+
+/**
+ * Unit-slip warnings (DESIGN.md 8.1, 8.4) of a valid request r (its
+ * canonical structure and the core's arrays built from it): a new array
+ * [{"pointer", "message"}], empty when none; pointers into /blade for the
+ * blade form.  NULL when out of memory.
+ */
+json_t *warn_collect(const codec_request *r);
+
+/* ================================================= plausible.c: plaus_ */
+
+/**
+ * The dimensionless checks of r into w (DESIGN.md 8.4): per member the
+ * axial wave speed and the radius of gyration in each bending direction
+ * (span means of the sections and stations), then the tip speed and per
+ * member the centrifugal strain.  They use the core's arrays, so they hold
+ * for every kind of structure and form of section.
+ */
+void plaus_check(warn_list *w, const codec_request *r);
 
 /* ====================================================== request.c: req_ */
 

@@ -608,7 +608,7 @@ static int req_from_json(codec_request **out, const json_t *root, const codec_li
         (rc = req_check_conditioning(r, errs)))
         goto fail;
     rc = SM_NOMEM;
-    if (!(r->warnings = warn_collect(r->structure, r->blade)))
+    if (!(r->warnings = warn_collect(r)))
         goto fail;
     *out = r;
     return SM_OK;
