@@ -100,6 +100,41 @@ static enum MHD_Result http_readyz(struct MHD_Connection *c, http_req *r)
                             &retry, 1);
 }
 
+/*
+ * Append the long-poll budget (http_guard.c) to the metrics text *text
+ * (*len bytes, malloc'd): 0, or -1 when out of memory (*text then freed).
+ */
+static int http_metrics_waiters(http *h, char **text, size_t *len)
+{
+    static const char fmt[] =
+        "# HELP spinmodal_http_waiters Long polls (?wait) waiting now.\n"
+        "# TYPE spinmodal_http_waiters gauge\n"
+        "spinmodal_http_waiters %d\n"
+        "# HELP spinmodal_http_waiters_limit Most long polls waiting at once (--max-waiters).\n"
+        "# TYPE spinmodal_http_waiters_limit gauge\n"
+        "spinmodal_http_waiters_limit %d\n"
+        "# HELP spinmodal_http_waiters_released_total Long polls answered early with the "
+        "job's current state because a newer one came over --max-waiters.\n"
+        "# TYPE spinmodal_http_waiters_released_total counter\n"
+        "spinmodal_http_waiters_released_total %llu\n";
+    unsigned long long released;
+    int waiting, cap, n;
+    char *grown;
+
+    http_waiter_counts(h, &waiting, &cap, &released);
+    n = snprintf(NULL, 0, fmt, waiting, cap, released);
+    grown = n < 0 ? NULL : realloc(*text, *len + (size_t)n + 1);
+    if (!grown) {
+        free(*text);
+        *text = NULL;
+        return -1;
+    }
+    snprintf(grown + *len, (size_t)n + 1, fmt, waiting, cap, released);
+    *text = grown;
+    *len += (size_t)n;
+    return 0;
+}
+
 /* GET /metrics */
 static enum MHD_Result http_metrics(struct MHD_Connection *c, http_req *r)
 {
@@ -123,7 +158,7 @@ static enum MHD_Result http_metrics(struct MHD_Connection *c, http_req *r)
     g.queue_depth = counted ? (int)(counts[STORE_QUEUED] > INT_MAX ? INT_MAX : counts[STORE_QUEUED]) : s.queued;
     g.workers = s.workers;
     g.workers_busy = s.workers_busy;
-    if (metrics_render(r->h->mx, &g, &text, &len))
+    if (metrics_render(r->h->mx, &g, &text, &len) || http_metrics_waiters(r->h, &text, &len))
         return http_send_oom(c, r);
     return http_respond(c, r, MHD_HTTP_OK, "text/plain; version=0.0.4", text, len, 1, NULL, 0);
 }
@@ -469,6 +504,7 @@ void http_default_config(http_config *cfg)
     cfg->limits.max_request_bytes = cfg->max_body;
     cfg->connection_limit = 512;
     cfg->per_client_limit = 64;
+    cfg->max_waiters = 128;
     cfg->connection_timeout = 60;
     cfg->request_deadline = 30.0;
 }
@@ -618,7 +654,7 @@ int http_start(http **out, const http_config *cfg, jobs *j, store *st, metrics *
         rc = HTTP_ADDRESS;
         goto fail;
     }
-    http_guard_set_cap(h, cfg->connection_limit);
+    http_guard_set_caps(h, (int)cfg->connection_limit, (int)cfg->max_waiters);
     rc = http_guard_start(h);
     if (rc == HTTP_OK)
         rc = http_listen(h, cfg, ai);

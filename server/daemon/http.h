@@ -48,6 +48,9 @@ typedef struct http_config {
                                     need it too (probes and static files never do) */
     unsigned connection_limit;   /* concurrent connections (threads), >= 1 */
     unsigned per_client_limit;   /* concurrent connections from one IP address, 0 = no limit */
+    unsigned max_waiters;        /* concurrent ?wait long polls (GET and POST): a new one over
+                                    it answers the oldest at once; 0 = ?wait never blocks;
+                                    at most connection_limit / 2 (larger is cut to it) */
     unsigned connection_timeout; /* s of idleness before a connection is closed */
     double request_deadline;     /* s for a request's head and body to arrive, > 0 */
 } http_config;
@@ -55,7 +58,13 @@ typedef struct http_config {
 /**
  * Defaults: host 127.0.0.1, port 8080, max_body 1 MiB, the codec's default
  * limits, no token, no CORS, 512 connections of which at most 64 from one
- * address, 60 s idle timeout, 30 s request deadline.
+ * address and at most 128 waiting long polls, 60 s idle timeout, 30 s
+ * request deadline.
+ *
+ * Slots: an eighth of connection_limit (at least 16) is kept free for
+ * probes and writes; over the rest a new connection closes the connection
+ * that has waited longest for its request (http_guard.c).  Long polls have
+ * their own budget, max_waiters, within the rest.
  */
 void http_default_config(http_config *cfg);
 

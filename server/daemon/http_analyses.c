@@ -68,17 +68,19 @@ static int http_unfinished(const store_job *jb)
 }
 
 /*
- * Read a job after waiting up to wait seconds for it to finish (in slices,
- * so a stop is never held up); flags as for jobs_get.
+ * The slices of a long poll w: wait in jobs_wait until the job in *out
+ * (unfinished, read without texts) finishes, end (monotonic s) passes, the
+ * daemon stops or w is released; *out is re-read after each slice.
+ * JOBS_OK or the failure of a read.
  */
-static int http_job_wait(http *h, const char *id, double wait, unsigned flags, store_job *out)
+static int http_job_wait_slices(http *h, const char *id, double end, http_waiter *w,
+                                store_job *out)
 {
-    double end = http_mono() + wait, left;
-    int rc = http_job_read(h, id, wait > 0.0 ? 0u : flags, out), wrc;
+    double left;
+    int rc, wrc;
 
-    if (rc != JOBS_OK || wait <= 0.0)
-        return rc;
-    while (http_unfinished(out) && (left = end - http_mono()) > 0.0) {
+    while (http_unfinished(out) && (left = end - http_mono()) > 0.0 &&
+           !http_waiter_released(h, w)) {
         if (http_enter(h))
             break;
         wrc = jobs_wait(h->j, id, left < HTTP_WAIT_SLICE ? left : HTTP_WAIT_SLICE);
@@ -89,6 +91,29 @@ static int http_job_wait(http *h, const char *id, double wait, unsigned flags, s
             return rc;
         if (wrc != JOBS_OK) /* stopping, or the store failed: answer what we have */
             break;
+    }
+    return JOBS_OK;
+}
+
+/*
+ * Read a job after waiting up to wait seconds for it to finish (in slices,
+ * so a stop is never held up); flags as for jobs_get.  The wait is a long
+ * poll of the --max-waiters budget: it ends early, with the job as it is,
+ * when a newer long poll releases it (http_waiter_join).
+ */
+static int http_job_wait(http *h, const char *id, double wait, unsigned flags, store_job *out)
+{
+    double end = http_mono() + wait;
+    int rc = http_job_read(h, id, wait > 0.0 ? 0u : flags, out);
+    http_waiter w;
+
+    if (rc != JOBS_OK || wait <= 0.0)
+        return rc;
+    if (http_unfinished(out) && http_waiter_join(h, &w) == 0) {
+        rc = http_job_wait_slices(h, id, end, &w, out);
+        http_waiter_leave(h, &w);
+        if (rc != JOBS_OK)
+            return rc;
     }
     if (flags && out->has_result) {
         store_job_clear(out);

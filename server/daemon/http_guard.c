@@ -1,6 +1,8 @@
 /*
- * http_guard.c — a deadline for every request: its head and body must have
- * arrived within --request-deadline seconds, however slowly the bytes trickle.
+ * http_guard.c — the budgets of connection slots: a deadline for every
+ * request (its head and body must have arrived within --request-deadline
+ * seconds, however slowly the bytes trickle), slots kept free for probes and
+ * writes, and a cap on waiting long polls (--max-waiters).
  *
  * Why: libmicrohttpd's connection timeout is an idle timeout, which a client
  * sending one byte every few seconds resets forever; 600 such sockets held
@@ -27,12 +29,22 @@
  * over many addresses: 600 of them from 60 addresses held all 512
  * connection slots, and libmicrohttpd refused every other connection
  * (/livez included) until the deadline closed them, when they could come
- * back.  So at most incomplete_cap connections (the limit less an eighth,
- * http_guard_set_cap) may wait for their request; a new connection over
- * that shuts down the incomplete one whose deadline is nearest (the one
- * that has waited longest).  A complete request is answered at once, so
- * the slots kept free always serve it; an idle keep-alive connection counts
- * as incomplete and may be closed under such pressure.
+ * back.  So at most held_cap connections (the limit less an eighth,
+ * http_guard_set_caps) may be held; a new connection over that shuts down
+ * an idle keep-alive connection, or else the incomplete one whose deadline
+ * is nearest (the one that has waited longest).  A complete request is
+ * answered at once, so the slots kept free always serve it.
+ *
+ * Long polls.  A request with ?wait=S is complete, so shedding cannot
+ * close it: 600 GET ?wait=30 from 10 addresses held all 512 slots for 30 s.
+ * So at most max_waiters requests wait at once (a quarter of the limit by
+ * default, never more than half); a new one over that releases the oldest,
+ * which answers at its next slice (HTTP_WAIT_SLICE) with the job's current
+ * state, as if its wait had ended (the client polls again).  Its connection
+ * is then an idle keep-alive one, which shedding may close.  Waiters,
+ * connections being answered and incomplete ones together stay under
+ * held_cap while there are incomplete ones to close, so the slots kept
+ * free stay free for /livez, /readyz, /metrics and writes.
  */
 #include "http_internal.h"
 
@@ -50,37 +62,56 @@ struct http_conn {
     int fd;                  /* the connection's socket */
     double deadline;         /* monotonic s; 0 = none (a request is being answered) */
     int expired;             /* 1 once the guard shut the socket down */
+    int served;              /* 1 once a request on it was answered (idle keep-alive) */
     struct http_conn *prev, *next;
 };
 
-void http_guard_set_cap(http *h, int connection_limit)
+/* 1 when a should be shed before b: idle keep-alive first, then the nearest deadline. */
+static int http_guard_before(const http_conn *a, const http_conn *b)
+{
+    if (a->served != b->served)
+        return a->served;
+    return a->deadline < b->deadline;
+}
+
+void http_guard_set_caps(http *h, int connection_limit, int max_waiters)
 {
     int reserve = connection_limit / 8 > 16 ? connection_limit / 8 : 16;
 
-    h->incomplete_cap = connection_limit - reserve > 1 ? connection_limit - reserve : 1;
+    h->held_cap = connection_limit - reserve > 1 ? connection_limit - reserve : 1;
+    h->max_waiters = max_waiters < connection_limit / 2 ? max_waiters : connection_limit / 2;
+    if (h->max_waiters < 0)
+        h->max_waiters = 0;
 }
 
 /*
- * Called with guard_lock held after a connection was added: when more than
- * incomplete_cap connections wait for their request, shut down the one with
- * the nearest deadline (never `except`, the newcomer).
+ * Called with guard_lock held after a connection was added (except = the
+ * newcomer) or went back to waiting for a request (except NULL): while more
+ * than held_cap connections are open (waiting for their request, being
+ * answered or in a long poll), shut down one waiting for its request, never
+ * `except`: an idle keep-alive connection (already served) first, then the
+ * one with the nearest deadline.  So a new client whose first request is on
+ * its way is not closed for connections that were answered (the long polls
+ * answered early).  The second call matters when libmicrohttpd is at its
+ * limit and accepts nobody: closing idle connections frees slots.
  */
 static void http_guard_shed(http *h, const http_conn *except)
 {
-    http_conn *k, *oldest = NULL;
-    int waiting = 0;
+    http_conn *k, *oldest;
 
-    for (k = h->conns; k; k = k->next)
-        if (!k->expired && k->deadline > 0.0) {
-            waiting++;
-            if (k != except && (!oldest || k->deadline < oldest->deadline))
+    while (h->n_held > h->held_cap) {
+        oldest = NULL;
+        for (k = h->conns; k; k = k->next)
+            if (!k->expired && k->deadline > 0.0 && k != except &&
+                (!oldest || http_guard_before(k, oldest)))
                 oldest = k;
-        }
-    if (waiting <= h->incomplete_cap || !oldest)
-        return;
-    oldest->expired = 1;
-    shutdown(oldest->fd, SHUT_RDWR);
-    h->shed_pending++;
+        if (!oldest)
+            return;
+        oldest->expired = 1;
+        shutdown(oldest->fd, SHUT_RDWR);
+        h->shed_pending++;
+        h->n_held--;
+    }
 }
 
 /* MHD_OPTION_NOTIFY_CONNECTION: track connections from accept to close. */
@@ -105,6 +136,7 @@ void http_guard_notify(void *cls, struct MHD_Connection *c, void **socket_contex
         if (h->conns)
             h->conns->prev = k;
         h->conns = k;
+        h->n_held++;
         http_guard_shed(h, k);
         pthread_mutex_unlock(&h->guard_lock);
         *socket_context = k;
@@ -113,6 +145,8 @@ void http_guard_notify(void *cls, struct MHD_Connection *c, void **socket_contex
     if (!k)
         return;
     pthread_mutex_lock(&h->guard_lock);
+    if (!k->expired)
+        h->n_held--;
     if (k->prev)
         k->prev->next = k->next;
     else
@@ -151,10 +185,87 @@ void http_guard_answered(http *h, struct MHD_Connection *c)
     if (!k)
         return;
     pthread_mutex_lock(&h->guard_lock);
-    if (!k->expired)
+    if (!k->expired) {
         k->deadline = http_mono() + h->request_deadline;
+        k->served = 1;
+        http_guard_shed(h, NULL);
+    }
     pthread_mutex_unlock(&h->guard_lock);
 }
+
+/* ------------------------------------------------------------- long polls */
+
+int http_waiter_join(http *h, http_waiter *w)
+{
+    http_waiter *old;
+
+    memset(w, 0, sizeof(*w));
+    pthread_mutex_lock(&h->guard_lock);
+    if (h->max_waiters <= 0) {
+        pthread_mutex_unlock(&h->guard_lock);
+        return -1;
+    }
+    if (h->n_waiters >= h->max_waiters && (old = h->waiters) != NULL) {
+        h->waiters = old->next; /* release the oldest: it answers at its next slice */
+        if (h->waiters)
+            h->waiters->prev = NULL;
+        else
+            h->waiters_tail = NULL;
+        old->prev = old->next = NULL;
+        old->released = 1;
+        h->n_waiters--;
+        h->released_pending++;
+        h->released_total++;
+    }
+    w->prev = h->waiters_tail;
+    if (h->waiters_tail)
+        h->waiters_tail->next = w;
+    else
+        h->waiters = w;
+    h->waiters_tail = w;
+    h->n_waiters++;
+    pthread_mutex_unlock(&h->guard_lock);
+    return 0;
+}
+
+int http_waiter_released(http *h, http_waiter *w)
+{
+    int released;
+
+    pthread_mutex_lock(&h->guard_lock);
+    released = w->released;
+    pthread_mutex_unlock(&h->guard_lock);
+    return released;
+}
+
+void http_waiter_leave(http *h, http_waiter *w)
+{
+    pthread_mutex_lock(&h->guard_lock);
+    if (!w->released) { /* still in the list */
+        if (w->prev)
+            w->prev->next = w->next;
+        else
+            h->waiters = w->next;
+        if (w->next)
+            w->next->prev = w->prev;
+        else
+            h->waiters_tail = w->prev;
+        h->n_waiters--;
+    }
+    w->prev = w->next = NULL;
+    pthread_mutex_unlock(&h->guard_lock);
+}
+
+void http_waiter_counts(http *h, int *waiting, int *cap, unsigned long long *released)
+{
+    pthread_mutex_lock(&h->guard_lock);
+    *waiting = h->n_waiters;
+    *cap = h->max_waiters;
+    *released = h->released_total;
+    pthread_mutex_unlock(&h->guard_lock);
+}
+
+/* ------------------------------------------------------------- the thread */
 
 /* Shut down the sockets past their deadline; returns how many. */
 static int http_guard_sweep(http *h, double now)
@@ -166,6 +277,7 @@ static int http_guard_sweep(http *h, double now)
         if (!k->expired && k->deadline > 0.0 && now > k->deadline) {
             k->expired = 1;
             shutdown(k->fd, SHUT_RDWR);
+            h->n_held--;
             n++;
         }
     return n;
@@ -176,7 +288,7 @@ static void *http_guard_main(void *arg)
     http *h = arg;
     struct timespec ts;
     char count[16];
-    int n, shed;
+    int n, shed, released;
 
     pthread_mutex_lock(&h->guard_lock);
     while (!h->guard_stop) {
@@ -191,9 +303,19 @@ static void *http_guard_main(void *arg)
             pthread_mutex_unlock(&h->guard_lock);
             snprintf(count, sizeof(count), "%d", shed);
             log_event("warn", "connections_shed", "closed", count, "reason",
-                      "more connections waiting for their request than the slots allow",
+                      "more connections held than the slots kept free allow",
                       (const char *)NULL);
             metrics_shed(h->mx, shed);
+            pthread_mutex_lock(&h->guard_lock);
+        }
+        released = h->released_pending;
+        h->released_pending = 0;
+        if (released > 0) {
+            pthread_mutex_unlock(&h->guard_lock);
+            snprintf(count, sizeof(count), "%d", released);
+            log_event("info", "long_polls_released", "answered", count, "reason",
+                      "more long polls (?wait) than --max-waiters: the oldest answered early",
+                      (const char *)NULL);
             pthread_mutex_lock(&h->guard_lock);
         }
         n = http_guard_sweep(h, http_mono());

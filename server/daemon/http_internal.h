@@ -12,8 +12,9 @@
  *                    the early 413;
  *   http_reply.c     building responses: headers, problem documents, the
  *                    last-resort 503, small parsers of the request line;
- *   http_guard.c     the deadline for a request's head and body (slow
- *                    clients cannot hold connection slots);
+ *   http_guard.c     the budgets of connection slots: the deadline for a
+ *                    request's head and body (slow clients cannot hold
+ *                    slots), the slots kept free, the cap on long polls;
  *   http_import.c    POST /v1/import/{format}: blade files into requests.
  */
 #ifndef SPINMODAL_HTTP_INTERNAL_H
@@ -54,6 +55,12 @@ enum {
 /* A tracked connection (http_guard.c). */
 typedef struct http_conn http_conn;
 
+/* A waiting long poll (?wait=S), on the stack of its request thread (http_guard.c). */
+typedef struct http_waiter {
+    int released;                     /* 1: answer now, a newer long poll took the slot */
+    struct http_waiter *prev, *next;  /* in http->waiters, oldest first */
+} http_waiter;
+
 /* Routes of DAEMON.md. */
 typedef enum http_route {
     R_OTHER = 0,     /* no route: 404 */
@@ -87,13 +94,21 @@ struct http {
     int stopping;            /* http_begin_stop has begun */
     int active;              /* request threads inside a jobs_* call */
     int auth_reads;          /* 1: reads of jobs, /metrics and /v1/validate need the token too */
-    /* request deadlines (http_guard.c) */
+    /* slot budgets (http_guard.c) */
     double request_deadline; /* s for a request's head and body to arrive */
-    pthread_mutex_t guard_lock; /* guards conns and every http_conn, guard_stop */
+    pthread_mutex_t guard_lock; /* guards conns and every http_conn, the waiters,
+                                   the counts below, guard_stop */
     pthread_cond_t guard_cv; /* wakes the guard thread to stop */
     http_conn *conns;        /* open connections, newest first */
-    int incomplete_cap;      /* most connections whose request has not arrived in full */
-    int shed_pending;        /* of those, closed at accept and not yet logged */
+    int n_held;              /* of those, not yet shut down by the guard */
+    int held_cap;            /* most connections held before one waiting for its
+                                request is closed (the rest is kept for newcomers) */
+    int shed_pending;        /* connections closed at accept and not yet logged */
+    http_waiter *waiters, *waiters_tail; /* waiting long polls, oldest first */
+    int n_waiters;           /* in the list */
+    int max_waiters;         /* --max-waiters; 0 = ?wait never blocks */
+    int released_pending;    /* long polls answered early, not yet logged */
+    unsigned long long released_total; /* long polls answered early for a newer one */
     pthread_t guard_thread;
     int guard_started;       /* 1 while the guard thread runs */
     int guard_stop;          /* 1: the guard thread leaves */
@@ -252,8 +267,29 @@ void http_guard_answering(http *h, struct MHD_Connection *c);
 /** The request on c was answered: the next one must arrive within the deadline. */
 void http_guard_answered(http *h, struct MHD_Connection *c);
 
-/** Allow connection_limit less an eighth (at least 16 kept free) incomplete requests. */
-void http_guard_set_cap(http *h, int connection_limit);
+/**
+ * Keep an eighth of connection_limit (at least 16) free: past the rest, a
+ * new connection closes the one waiting longest for its request.  Long
+ * polls may take at most max_waiters of the rest (cut to connection_limit / 2).
+ */
+void http_guard_set_caps(http *h, int connection_limit, int max_waiters);
+
+/**
+ * Join the long polls with w (zeroed by the call): 0, or -1 when
+ * --max-waiters is 0 (answer at once; do not call http_waiter_leave).  At
+ * the cap the oldest waiter is released (answers with the job's current
+ * state at its next slice).  Every 0 is paired with http_waiter_leave.
+ */
+int http_waiter_join(http *h, http_waiter *w);
+
+/** 1 once w was released for a newer long poll: answer now. */
+int http_waiter_released(http *h, http_waiter *w);
+
+/** Leave the long polls (w is no longer referenced). */
+void http_waiter_leave(http *h, http_waiter *w);
+
+/** The waiting long polls, the cap and the total answered early, for /metrics. */
+void http_waiter_counts(http *h, int *waiting, int *cap, unsigned long long *released);
 
 /** Start the guard thread; HTTP_OK or HTTP_NOMEM. */
 int http_guard_start(http *h);

@@ -58,7 +58,9 @@ enum {
     F_TOKEN_FILE,
     F_AUTH_READS,
     F_CORS_ORIGIN,
+    F_MAX_CONNECTIONS,
     F_MAX_CONNECTIONS_PER_CLIENT,
+    F_MAX_WAITERS,
     F_REQUEST_DEADLINE,
     F_RETAIN_AGE,
     F_RETAIN_BYTES,
@@ -98,8 +100,13 @@ static const main_flag main_flags[F_N] = {
      "with a token: reading jobs, /metrics and /v1/validate need it too"},
     {"cors-origin", "SPINMODAL_CORS_ORIGIN", "ORIGIN", "none",
      "the one origin (scheme://host[:port]) allowed to call from browsers"},
+    {"max-connections", "SPINMODAL_MAX_CONNECTIONS", "N", "512",
+     "open connections (one thread each); an eighth (at least 16) is kept for probes and writes"},
     {"max-connections-per-client", "SPINMODAL_MAX_CONNECTIONS_PER_CLIENT", "N", "64",
      "open connections from one IP address (0 = no limit; behind a proxy raise it)"},
+    {"max-waiters", "SPINMODAL_MAX_WAITERS", "N", "a quarter of --max-connections (128)",
+     "long polls (?wait) waiting at once, <= half of --max-connections; over it the oldest "
+     "answers at once with the job's state (0 = ?wait never blocks)"},
     {"request-deadline", "SPINMODAL_REQUEST_DEADLINE", "S", "30",
      "seconds for a request's head and body to arrive, however slowly sent"},
     {"retain-age", "SPINMODAL_RETAIN_AGE", "S", "2592000 (30 days)",
@@ -132,6 +139,8 @@ typedef struct main_opts {
     int auth_reads;          /* 1: reads need the token too */
     const char *cors_origin; /* NULL = no CORS */
     long per_client;         /* connections per IP address, 0 = no limit */
+    long max_connections;    /* open connections, >= 32 */
+    long max_waiters;        /* waiting long polls, <= max_connections / 2; -1 = a quarter */
     double request_deadline; /* s, > 0 */
     log_format format;
 } main_opts;
@@ -311,6 +320,12 @@ static int main_set(main_opts *o, int f, const char *v, const char **want)
                 "(scheme, host and port only; no '*', path or list)";
         o->cors_origin = v;
         return main_origin(v) ? 0 : -1;
+    case F_MAX_CONNECTIONS:
+        *want = "an integer from 32 to 65536";
+        return main_long(v, 32, 65536, &o->max_connections);
+    case F_MAX_WAITERS:
+        *want = "an integer from 0 to 32768 (at most half of --max-connections)";
+        return main_long(v, 0, 32768, &o->max_waiters);
     case F_MAX_CONNECTIONS_PER_CLIENT:
         *want = "an integer from 0 (no limit) to 100000";
         return main_long(v, 0, 100000, &o->per_client);
@@ -364,6 +379,8 @@ static void main_defaults(main_opts *o)
     o->max_frame_dofs = 1200;
     o->job_timeout = 300.0;
     o->per_client = 64;
+    o->max_connections = 512;
+    o->max_waiters = -1;
     o->request_deadline = 30.0;
     o->shutdown_grace = 10.0;
     o->retain_age = 2592000.0;
@@ -416,6 +433,25 @@ static int main_scan(int argc, char **argv, const char *given[F_N], int *action)
     return 0;
 }
 
+/*
+ * --max-waiters against --max-connections: a quarter of it when not given,
+ * refused above half (long polls must leave slots for everything else).
+ * Returns 0 or EXIT_USAGE.
+ */
+static int main_waiters(main_opts *o)
+{
+    if (o->max_waiters < 0) {
+        o->max_waiters = o->max_connections / 4;
+        return 0;
+    }
+    if (o->max_waiters <= o->max_connections / 2)
+        return 0;
+    fprintf(stderr, "spinmodald: --max-waiters needs at most half of --max-connections (%ld), "
+                    "not '%ld'.\nTry 'spinmodald --help'.\n",
+            o->max_connections / 2, o->max_waiters);
+    return EXIT_USAGE;
+}
+
 /* Parse argv and the environment into o.  Returns 0, EXIT_USAGE, or -1 after --help/--version. */
 static int main_parse(int argc, char **argv, main_opts *o)
 {
@@ -449,7 +485,7 @@ static int main_parse(int argc, char **argv, main_opts *o)
             return EXIT_USAGE;
         }
     }
-    return 0;
+    return main_waiters(o);
 }
 
 /*
@@ -618,6 +654,8 @@ static int main_serve(const main_opts *o, const char *token, main_daemon *d)
     hc.auth_reads = o->auth_reads;
     hc.cors_origin = o->cors_origin;
     hc.per_client_limit = (unsigned)o->per_client;
+    hc.connection_limit = (unsigned)o->max_connections;
+    hc.max_waiters = (unsigned)o->max_waiters;
     hc.request_deadline = o->request_deadline;
     jc.workers = (int)o->workers;
     jc.queue_max = (int)o->queue_max;
