@@ -60,6 +60,13 @@ From issue 23:
                 BModes el_loc out of order or outside [0, 1] (item 5); CSV with a
                 UTF-8 byte-order mark, UTF-16, radii near 1e308 or 2e-16 apart
                 (item 6).
+  long_polls    600 GET ?wait from 10 addresses (under the per-client limit) held all
+                512 slots and /livez, /readyz, /metrics and POST were refused at connect
+                (item 2): with default flags at most 128 long polls wait, a newer one
+                answers the oldest early with the job's state (200, queued), and the
+                probes and a POST answer meanwhile; a POST ?wait is a waiter too
+                (released oldest first on a daemon with --max-waiters 4); --max-waiters
+                above half of --max-connections is refused at start.
 The db_faults scenario also starts the second daemon through a symlink and a
 hard link to the database (both used to run beside the first), and full_disk
 checks /readyz is 503 as soon as the job is failed (the small write recording
@@ -647,6 +654,271 @@ def scenario_import_extremes(exe, tmp):
           "CSV with a UTF-8 byte-order mark: the same 200 as without (got %s: %s)"
           % (bom.status, bom.text()))
     check(d.get("/livez").status == 200, "/livez answers")
+    check(d.stop() == 0, "daemon stops cleanly")
+
+
+def long_sweep(first=0.0):
+    """1001 speeds of the angled beam with 32 + 32 elements, no shapes: ~12 s of one core
+    unloaded (e2e_test.py's long_sweep); `first` makes distinct requests."""
+    import json
+    with open(EXAMPLE) as f:
+        req = json.load(f)
+    for m in req["structure"]["members"]:
+        m["elements"] = 32
+    req["analysis"]["omega"] = [first + 20.0 * i / 1000 for i in range(1001)]
+    req["analysis"]["mode_shapes"] = False
+    return json.dumps(req).encode()
+
+
+class RawExchange:
+    """One request sent on its own socket from a loopback address; its answer is read later
+    without blocking (pump), so hundreds can wait at once."""
+
+    def __init__(self, source, port, data):
+        self.s = connect_from(source, port)
+        self.s.sendall(data)
+        self.buf = b""
+        self.eof = False
+
+    def pump(self):
+        """Read what has arrived; True once a whole answer is in."""
+        if not self.eof and not self.done():
+            self.s.setblocking(False)
+            try:
+                while True:
+                    data = self.s.recv(65536)
+                    if not data:
+                        self.eof = True
+                        break
+                    self.buf += data
+            except BlockingIOError:
+                pass
+            except OSError:
+                self.eof = True
+        return self.done()
+
+    def parts(self):
+        """(status, headers dict, body) once whole, else None."""
+        end = self.buf.find(b"\r\n\r\n")
+        if end < 0:
+            return None
+        lines = self.buf[:end].decode("latin-1").split("\r\n")
+        hdrs = {}
+        for l in lines[1:]:
+            k, _, v = l.partition(":")
+            hdrs[k.strip().lower()] = v.strip()
+        body = self.buf[end + 4:]
+        if len(body) < int(hdrs.get("content-length", "0")):
+            return None
+        return int(lines[0].split()[1]), hdrs, body
+
+    def done(self):
+        return self.parts() is not None
+
+    def doc(self):
+        import json
+        p = self.parts()
+        try:
+            return json.loads(p[2]) if p else {}
+        except ValueError:
+            return {}
+
+    def close(self):
+        self.s.close()
+
+
+def probe(d, method, path, body=None):
+    """The status of one request from 127.0.0.1, or what went wrong (a refused or unanswered
+    connection); never raises."""
+    try:
+        return d.request(method, path, body=body, timeout=10,
+                         headers={"Content-Type": "application/json"} if body else None).status
+    except Exception as e:  # noqa: BLE001 (refused, reset, timed out: all a failure here)
+        return repr(e)
+
+
+def waiter_metrics(d):
+    """(waiting, limit, released) of /metrics as ints, None for each one missing (or when
+    /metrics does not answer)."""
+    try:
+        text = d.get("/metrics", timeout=10).body.decode("utf-8", "replace")
+    except Exception:  # noqa: BLE001 (refused, reset, timed out)
+        return (None, None, None)
+    vals = dict(line.split(" ", 1) for line in text.splitlines()
+                if line.startswith("spinmodal_http_waiters") and " " in line)
+    return tuple(int(float(vals[k])) if k in vals else None for k in
+                 ("spinmodal_http_waiters", "spinmodal_http_waiters_limit",
+                  "spinmodal_http_waiters_released_total"))
+
+
+def queue_behind_sweeps(d, n_sweeps, first):
+    """n_sweeps long sweeps (the first running) and then a small job queued behind them, so
+    that the small one stays unfinished while the test runs; (sweep ids, small job id)."""
+    sweeps = []
+    for k in range(n_sweeps):
+        r = d.request("POST", "/v1/analyses", body=long_sweep(first + 100.0 * k),
+                      headers={"Content-Type": "application/json"})
+        sweeps.append((r.json() or {}).get("id"))
+    wait_until(lambda: job_state(d, sweeps[0]).get("state") == "running", 30)
+    r = d.request("POST", "/v1/analyses", body=angled_sweep(1, first + 7.0),
+                  headers={"Content-Type": "application/json"})
+    small = (r.json() or {}).get("id", "0" * 64)
+    check(r.status == 202 and job_state(d, small).get("state") == "queued",
+          "a small job queued behind %d long sweeps to wait on (%s)" % (n_sweeps, r.status))
+    return sweeps, small
+
+
+def long_poll_flood(d, job, n, sources, batch):
+    """n GET ?wait=60 of job from `sources` addresses (127.0.0.2 ...), opened in batches; after
+    each batch, until the daemon counts them all (waiting + released; skipped when /metrics
+    does not answer or lacks the counts), so that batches register in order.  The opened
+    exchanges, oldest first, and how many connects failed."""
+    req = ("GET /v1/analyses/%s?wait=60 HTTP/1.1\r\nHost: x\r\n\r\n" % job).encode()
+    polls, refused, counted = [], 0, True
+    for i in range(n):
+        try:
+            polls.append(RawExchange("127.0.0.%d" % (2 + i % sources), d.port, req))
+        except OSError:
+            refused += 1
+        if counted and (len(polls) % batch == 0 or i == n - 1):
+            w, _, rel = waiter_metrics(d)
+            counted = w is not None and rel is not None
+            k = len(polls)
+            if counted:
+                wait_until(lambda: (lambda w: w[0] is not None and w[2] is not None and
+                                    w[0] + w[2] >= k)(waiter_metrics(d)), 10)
+    return polls, refused
+
+
+def scenario_long_polls(exe, tmp):
+    """Issue 23 item 2: 600 GET ?wait=30 from 10 addresses (60 each, under the per-client
+    limit) held all 512 connection slots, and /livez, /readyz, /metrics and POST were refused
+    at connect for 30 s.  Long polls now have their own budget (--max-waiters, a quarter of
+    --max-connections by default: 128 of 512): a new one over it answers the oldest at once
+    with the job's current state (200, queued), and the slots kept free (an eighth) serve
+    probes and writes.  Then, on a small daemon, a POST ?wait (submit and wait) is a waiter
+    too and is released in turn, oldest first."""
+    # the flags are checked against each other at start
+    for args in (["--max-waiters", "257"], ["--max-connections", "64", "--max-waiters", "33"]):
+        p = subprocess.run([exe, "--listen", "127.0.0.1:0", "--db", os.path.join(tmp, "x.db")]
+                           + args, capture_output=True, text=True, timeout=timescale.budget(30))
+        check(p.returncode == 64 and "half of --max-connections" in p.stderr,
+              "%s refused at start: long polls may take at most half of the connections "
+              "(exit %d: %s)" % (" ".join(args), p.returncode, p.stderr.strip()[:120]))
+    flood_defaults(exe, os.path.join(tmp, "defaults"))
+    if "--max-waiters" not in subprocess.run([exe, "--help"], capture_output=True,
+                                             text=True, timeout=30).stdout:
+        check(False, "spinmodald knows --max-waiters")
+        return
+    post_waiter(exe, os.path.join(tmp, "small"))
+
+
+def flood_defaults(exe, tmp):
+    """The issue's flood against default flags (512 connections, 64 per address)."""
+    os.makedirs(tmp)
+    n, sources, batch = 600, 10, 50
+    d = Daemon(exe, tmp, ["--workers", "1"])
+    d.start()
+    sweeps, job = queue_behind_sweeps(d, 2, 0.0)
+    polls, refused = long_poll_flood(d, job, n, sources, batch)
+    try:
+        for method, path, body, want in (
+                ("GET", "/livez", None, 200), ("GET", "/readyz", None, 200),
+                ("GET", "/metrics", None, 200),
+                ("POST", "/v1/validate", open(EXAMPLE, "rb").read(), 200),
+                ("POST", "/v1/analyses", angled_sweep(1, 3.0), 202)):
+            got = probe(d, method, path, body)
+            check(got == want, "%s %s answers %d while %d long polls from %d addresses wait "
+                  "(got %s)" % (method, path, want, len(polls), sources, got))
+        waiting, limit, released = waiter_metrics(d)
+        check(limit == 128 and waiting == 128,
+              "by default at most 128 long polls wait (a quarter of the 512 connections): "
+              "%s waiting, limit %s" % (waiting, limit))
+        m = len(polls)
+        early = m - (waiting or 0)  # on 0.7.0 every one still waits: none early
+        wait_until(lambda: sum(p.pump() for p in polls) >= early, 10)
+        answered = [i for i, p in enumerate(polls) if p.pump()]
+        check(refused == 0 and released == early and len(answered) == early,
+              "of %d long polls (%d refused at connect), the %d over the limit were answered "
+              "early: %d answers, spinmodal_http_waiters_released_total %s"
+              % (n, refused, early, len(answered), released))
+        docs = [(polls[i].parts()[0], polls[i].doc()) for i in answered]
+        bad = [(s, doc.get("state")) for s, doc in docs
+               if s != 200 or doc.get("state") not in ("queued", "running") or
+               doc.get("id") != job]
+        check(bool(docs) and not bad, "each early answer is a 200 with the job's current state "
+              "(queued) for the client to poll again (%d, not so: %s)" % (len(docs), bad[:3]))
+        older = (early // batch) * batch            # batches registered before the newest
+        newer = -(-early // batch) * batch           # 128 began
+        first_missing = next((i for i in range(older) if not polls[i].done()), None)
+        late_answered = [i for i in range(newer, m) if polls[i].done()]
+        check(first_missing is None and not late_answered,
+              "the oldest were answered: all of the first %d, none of the last %d (unanswered "
+              "old: %s%s, answered new: %s)" % (older, m - newer, first_missing,
+                                                 "" if first_missing is None else
+                                                 " closed" if polls[first_missing].eof else
+                                                 " open", late_answered[:5]))
+        if first_missing is not None:
+            print("\n".join(l for l in d.log_lines() if "event=request " not in l)[-3000:])
+        check(wait_until(lambda: any("long_polls_released" in l for l in d.log_lines()), 5),
+              "the early answers are logged (event=long_polls_released)")
+    finally:
+        for p in polls:
+            p.close()
+    for s in sweeps:
+        probe(d, "DELETE", "/v1/analyses/%s" % s)
+    check(d.stop() == 0, "daemon stops cleanly")
+
+
+def post_waiter(exe, tmp):
+    """--max-connections 64 --max-waiters 4: four GET waiters, then a POST ?wait=60 of a new
+    job releases the oldest GET; four more GETs release the other three and then the POST,
+    which answers 202 with its job queued."""
+    os.makedirs(tmp)
+    d = Daemon(exe, tmp, ["--workers", "1", "--max-connections", "64", "--max-waiters", "4"])
+    d.start()
+    sweeps, job = queue_behind_sweeps(d, 1, 50.0)
+    get = ("GET /v1/analyses/%s?wait=60 HTTP/1.1\r\nHost: x\r\n\r\n" % job).encode()
+    body = angled_sweep(1, 9.0)
+    post = (b"POST /v1/analyses?wait=60 HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+            b"Content-Length: %d\r\n\r\n" % len(body)) + body
+    order = []
+
+    def add(data):
+        order.append(RawExchange("127.0.0.2", d.port, data))
+        k = len(order)
+        return wait_until(lambda: (lambda w: w[0] is not None and w[0] + w[2] >= k)(
+            waiter_metrics(d)), 10)
+    try:
+        for _ in range(4):
+            add(get)
+        add(post)
+        wait_until(lambda: order[0].pump(), 10)
+        check([p.pump() for p in order] == [True, False, False, False, False],
+              "a POST ?wait over --max-waiters 4 answers the oldest GET ?wait early (answered: "
+              "%s)" % [p.done() for p in order])
+        for _ in range(4):
+            add(get)
+        wait_until(lambda: all([p.pump() for p in order[:5]]), 10)
+        check([p.pump() for p in order] == [True] * 5 + [False] * 4,
+              "four more GETs release the three older GETs and then the POST, oldest first "
+              "(answered: %s)" % [p.done() for p in order])
+        st, hdrs, _ = order[4].parts() or (None, {}, b"")
+        doc = order[4].doc()
+        check(st == 202 and doc.get("state") == "queued" and
+              hdrs.get("location") == "/v1/analyses/%s" % doc.get("id"),
+              "the released POST ?wait answers 202 with its job queued and Location (got %s "
+              "%s)" % (st, doc.get("state")))
+        waiting, limit, released = waiter_metrics(d)
+        check((waiting, limit, released) == (4, 4, 5),
+              "4 waiting of 4, 5 released (got %s, %s, %s)" % (waiting, limit, released))
+        check(probe(d, "GET", "/livez") == 200, "/livez answers")
+    finally:
+        for p in order:
+            p.close()
+    for s in sweeps + [(order[4].doc() if order else {}).get("id")]:
+        if s:
+            probe(d, "DELETE", "/v1/analyses/%s" % s)
     check(d.stop() == 0, "daemon stops cleanly")
 
 
