@@ -352,7 +352,8 @@ static int jobs_finish_retrying(jobs *j, const char *id, const jobs_outcome_rec 
         rc = store_finish(j->st, id, rec->state, log_now(), rec->speeds_done, rec->error,
                           rec->result, rec->result ? strlen(rec->result) : 0, rec->csv,
                           rec->csv_len);
-        if ((rc != STORE_UNAVAILABLE && rc != STORE_BUSY) || spent >= JOBS_FINISH_RETRY)
+        if ((rc != STORE_UNAVAILABLE && rc != STORE_BUSY && rc != STORE_TIMEOUT) ||
+            spent >= JOBS_FINISH_RETRY)
             return rc;
         until = jobs_deadline(wait);
         pthread_mutex_lock(&j->lock);

@@ -76,6 +76,7 @@ int store_is_db_error(int rc)
     case STORE_IN_USE:
     case STORE_GONE:
     case STORE_UNAVAILABLE:
+    case STORE_TIMEOUT:
         return 1;
     default:
         return 0;
@@ -202,6 +203,8 @@ void store_default_settings(store_settings *set)
 {
     memset(set, 0, sizeof *set);
     set->busy_timeout_ms = 5000;
+    set->timeout_ms = 5000;
+    set->probe_timeout_ms = 500;
     set->quick_check = 1;
     set->lease_s = 30;
 }
@@ -272,6 +275,9 @@ int store_open_with(store **out, const store_settings *set, int *requeued, char 
     }
     s->be = is_pg_uri(set->path) ? &store_pg_backend : &store_sqlite_backend;
     s->lease_s = set->lease_s > 0 ? set->lease_s : 30;
+    s->timeout_ms = set->timeout_ms > 0 ? set->timeout_ms : 5000;
+    s->probe_ms = set->probe_timeout_ms > 0 ? set->probe_timeout_ms : 500;
+    s->retain_bytes = set->retain_bytes > 0 ? set->retain_bytes : 0;
     rc = make_owner(s, set->owner) == 0 ? STORE_OK : STORE_INVALID;
     if (rc != STORE_OK) {
         if (err && errlen > 0)
@@ -289,6 +295,8 @@ int store_open_with(store **out, const store_settings *set, int *requeued, char 
     /* the callback sees failures from here on; open failures are in err */
     s->on_error = set->on_error;
     s->on_error_ctx = set->on_error_ctx;
+    s->on_pruned = set->on_pruned;
+    s->on_pruned_ctx = set->on_pruned_ctx;
     *out = s;
     return STORE_OK;
 }
@@ -472,6 +480,20 @@ int store_size(store *s, long long *live_bytes, long long *file_bytes)
     *live_bytes = 0;
     *file_bytes = 0;
     return s->be->size(s, live_bytes, file_bytes);
+}
+
+double store_mono(void)
+{
+    struct timespec ts;
+
+    (void)clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+void store_note_pruned(store *s, long long n)
+{
+    if (n > 0 && s->on_pruned)
+        s->on_pruned(s->on_pruned_ctx, n);
 }
 
 void store_seterr(char *err, size_t errlen, const char *fmt, ...)

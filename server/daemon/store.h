@@ -25,6 +25,23 @@
  * failures < 0); a failure of the database also leaves the backend's own
  * words (SQLite's message, libpq's text and SQLSTATE) in store_last_error
  * and the settings' on_error callback.
+ *
+ * Deadlines (DESIGN.md §F: every database round trip has one).  No call
+ * waits longer than settings' timeout_ms for anything (probe_timeout_ms
+ * for the probes: store_check_writable, store_health, store_count,
+ * store_size), whatever the database does: a PostgreSQL server that is
+ * stopped (SIGSTOP), or a network that swallows packets, still accepts
+ * bytes into the kernel's buffers and never answers, and neither TCP nor
+ * statement_timeout ends that.  The PostgreSQL backend therefore drives
+ * libpq asynchronously (connect, send, read) with poll() on the session's
+ * socket and closes a session whose deadline passed (its statement may
+ * still run when the server wakes: the caller hears STORE_TIMEOUT, as for
+ * a lost connection it cannot tell whether it committed).  A call that
+ * timed out at its full deadline marks the server stalled: for the next
+ * second every call fails at once with STORE_TIMEOUT, then one call tries
+ * again (as for an unreachable server).  SQLite waits for its own writer
+ * and for another process's lock (busy timeout) within the same deadline
+ * and then fails with STORE_BUSY.
  */
 #ifndef SPINMODAL_STORE_H
 #define SPINMODAL_STORE_H
@@ -44,7 +61,9 @@ extern "C" {
  * (READONLY), look at the disk (IOERR), stop the other daemon (IN_USE),
  * find who deleted the file (GONE), bring the database server or the
  * network back (UNAVAILABLE: PostgreSQL only, the store reconnects by
- * itself).  STORE_NOMEM stays apart from them.
+ * itself), find what stalls the server (TIMEOUT: a call's deadline,
+ * store_settings.timeout_ms, passed without an answer).  STORE_NOMEM
+ * stays apart from them.
  * X(name, value, token for logs and metric labels, sentence)
  */
 #define STORE_RC_MAP(X)                                                                        \
@@ -63,14 +82,16 @@ extern "C" {
     X(GONE, -11, "gone", "the database file was deleted or replaced while the store had it open") \
     X(INVALID, -12, "invalid", "invalid argument (a caller's mistake)")                      \
     X(UNAVAILABLE, -13, "unavailable",                                                         \
-      "the database server cannot be reached (down, restarting, or the network); retried")
+      "the database server cannot be reached (down, restarting, or the network); retried")    \
+    X(TIMEOUT, -14, "db_timeout",                                                             \
+      "the database did not answer within its deadline (stalled server or network); retried")
 
 /** Return codes of the store (STORE_RC_MAP). */
 typedef enum store_rc {
 #define STORE_RC_ENUM(name, value, token, text) STORE_##name = value,
     STORE_RC_MAP(STORE_RC_ENUM)
 #undef STORE_RC_ENUM
-    STORE_RC_MIN = -13      /* the lowest code, for tables indexed by -rc */
+    STORE_RC_MIN = -14      /* the lowest code, for tables indexed by -rc */
 } store_rc;
 
 /** A sentence for rc ("the database or its disk is full"); never NULL. */
@@ -79,14 +100,14 @@ const char *store_strerror(int rc);
 /**
  * A short token for rc, for log fields and metric labels: "ok",
  * "not_found", "conflict", "nomem", "error", "full", "busy", "corrupt",
- * "readonly", "ioerr", "in_use", "gone", "invalid", "unavailable";
- * "unknown" otherwise.
+ * "readonly", "ioerr", "in_use", "gone", "invalid", "unavailable",
+ * "db_timeout"; "unknown" otherwise.
  */
 const char *store_rc_name(int rc);
 
 /**
  * 1 when rc is a database failure (STORE_ERROR, FULL, BUSY, CORRUPT,
- * READONLY, IOERR, IN_USE, GONE, UNAVAILABLE): the kinds a caller that only needs
+ * READONLY, IOERR, IN_USE, GONE, UNAVAILABLE, TIMEOUT): the kinds a caller that only needs
  * "the database failed" (a 503, readiness) treats alike.  0 for
  * STORE_OK, NOT_FOUND, CONFLICT, NOMEM and INVALID.
  */
@@ -176,13 +197,37 @@ typedef struct store store;  /* opaque */
  */
 typedef void (*store_error_cb)(void *ctx, const store_error *e);
 
+/**
+ * Called by the store after it deleted n finished jobs on its own (the
+ * byte budget on insert, store_settings.retain_bytes), on the thread that
+ * inserted; quick, must not call the store.  Not called by store_prune
+ * (its caller has the count).
+ */
+typedef void (*store_pruned_cb)(void *ctx, long long n);
+
 /** How to open a store; fill with store_default_settings, then change fields. */
 typedef struct store_settings {
     const char *path;          /* required: a SQLite database file (not ":memory:"), or a
                                 * PostgreSQL URI "postgresql://…" / "postgres://…" (libpq
                                 * syntax; its parameters, e.g. connect_timeout, apply) */
     int busy_timeout_ms;       /* SQLite: wait this long for another process's lock;
-                                * PostgreSQL: lock_timeout of a row lock; 5000 */
+                                * PostgreSQL: lock_timeout of a row lock; 5000.  Never
+                                * more than timeout_ms */
+    int timeout_ms;            /* deadline of one call, everything it waits for included:
+                                * a free connection, a lock (this process's or another's),
+                                * each round trip to the server (PostgreSQL: plus 1 s per
+                                * 4 MiB a statement sends; the sessions' statement_timeout
+                                * unless the URI's options set one).  Past it the call
+                                * fails with STORE_TIMEOUT (BUSY for a SQLite lock); 5000 */
+    int probe_timeout_ms;      /* the same for store_check_writable, store_health,
+                                * store_count and store_size (readiness, metrics); 500 */
+    long long retain_bytes;    /* > 0: prune on insert.  After a submission or a finish
+                                * stores its texts, while the live data (store_prune)
+                                * exceeds this, the oldest finished jobs other than the
+                                * one just written are deleted, so the store stays within
+                                * it plus about one job.  0: only store_prune deletes */
+    store_pruned_cb on_pruned; /* may be NULL */
+    void *on_pruned_ctx;       /* passed to on_pruned */
     int quick_check;           /* SQLite: 1: PRAGMA quick_check at open, refuse a corrupt
                                 * file (reads the whole file once: ~0.3 s per GB cached);
                                 * 0: skip.  PostgreSQL: unused */
@@ -195,8 +240,8 @@ typedef struct store_settings {
                                 * (store_renew_lease); 30.  SQLite: unused */
 } store_settings;
 
-/** Defaults: no path, busy_timeout_ms 5000, quick_check 1, no callback, owner
- *  NULL (generated), lease_s 30. */
+/** Defaults: no path, busy_timeout_ms 5000, timeout_ms 5000, probe_timeout_ms 500,
+ *  retain_bytes 0, quick_check 1, no callbacks, owner NULL (generated), lease_s 30. */
 void store_default_settings(store_settings *set);
 
 /**
@@ -241,7 +286,13 @@ void store_default_settings(store_settings *set);
  * the tables); STORE_ERROR; STORE_NOMEM.  Later, while the server cannot
  * be reached, every call fails with STORE_UNAVAILABLE at once (after at
  * most one connect_timeout, 2 s by default, per second) and the store
- * reconnects by itself when it can: the handle stays usable.
+ * reconnects by itself when it can: the handle stays usable; while it
+ * does not answer, likewise with STORE_TIMEOUT.  Session defaults, each
+ * unless the URI sets it: connect_timeout 2, keepalives_idle 10,
+ * keepalives_interval 5, keepalives_count 3, tcp_user_timeout 15000,
+ * application_name spinmodald; statement_timeout = timeout_ms and
+ * lock_timeout = busy_timeout_ms unless the URI's options (or PGOPTIONS)
+ * name them.
  */
 int store_open_with(store **out, const store_settings *set, int *requeued, char *err,
                     size_t errlen);
@@ -399,7 +450,7 @@ int store_list(store *s, long long before, int filter, int max, store_job *out, 
 
 /**
  * Number of jobs per state into counts[STORE_N_STATES] (all 0 on failure).
- * Returns STORE_OK, STORE_NOMEM or a database kind.
+ * Within probe_timeout_ms.  Returns STORE_OK, STORE_NOMEM or a database kind.
  */
 int store_count(store *s, long long counts[STORE_N_STATES]);
 
@@ -407,8 +458,10 @@ int store_count(store *s, long long counts[STORE_N_STATES]);
  * Light readiness probe: STORE_OK when the database grants a write
  * transaction (SQLite: BEGIN IMMEDIATE; ROLLBACK; PostgreSQL: the session
  * is not read-only, e.g. not a standby), else the kind of the failure
- * (STORE_BUSY, STORE_READONLY, STORE_GONE, STORE_UNAVAILABLE, … or
- * STORE_NOMEM).  Writes nothing; store_health is the deeper check.
+ * (STORE_BUSY, STORE_READONLY, STORE_GONE, STORE_UNAVAILABLE, STORE_TIMEOUT,
+ * … or STORE_NOMEM).  Writes nothing; store_health is the deeper check.
+ * Within probe_timeout_ms; PostgreSQL probes have a session of their own,
+ * so a pool busy with jobs does not delay them.
  */
 int store_check_writable(store *s);
 
@@ -424,7 +477,8 @@ int store_check_writable(store *s);
  * Returns STORE_OK, STORE_GONE, STORE_READONLY, STORE_FULL, STORE_IOERR,
  * STORE_BUSY, STORE_CORRUPT, STORE_NOMEM or STORE_ERROR.
  * PostgreSQL: a real write commits (the schema version rewritten
- * unchanged); STORE_UNAVAILABLE while the server cannot be reached, and
+ * unchanged); STORE_UNAVAILABLE while the server cannot be reached,
+ * STORE_TIMEOUT while it does not answer within probe_timeout_ms, and
  * STORE_OK again by itself once it can (no reopen).
  */
 int store_health(store *s);
@@ -460,7 +514,9 @@ int store_prune(store *s, double now, double max_age_s, long long max_bytes,
 /**
  * Live data and file size in bytes (see store_prune), for a gauge.
  * PostgreSQL: live as in store_prune, file = pg_total_relation_size of
- * the jobs table (with its TOAST and indexes).
+ * the jobs table (with its TOAST and indexes).  Within probe_timeout_ms
+ * (SQLite reads it on a reader connection: another process's write lock
+ * does not delay it).
  * Returns STORE_OK, STORE_NOMEM or a database kind (*live, *file 0).
  */
 int store_size(store *s, long long *live_bytes, long long *file_bytes);

@@ -65,7 +65,18 @@ struct store {
     store_error last;           /* the most recent failure */
     char owner[64];             /* store_owner: settings' owner or generated */
     double lease_s;             /* settings' lease_s (> 0) */
+    int timeout_ms;             /* settings' timeout_ms (> 0): a call's deadline */
+    int probe_ms;               /* settings' probe_timeout_ms (> 0): a probe's */
+    long long retain_bytes;     /* settings' retain_bytes: prune on insert above it; 0 none */
+    store_pruned_cb on_pruned;  /* may be NULL */
+    void *on_pruned_ctx;
 };
+
+/* Monotonic clock, seconds: the deadlines' time base. */
+double store_mono(void);
+
+/* n > 0 finished jobs deleted by the budget on insert: tell on_pruned. */
+void store_note_pruned(store *s, long long n);
 
 /*
  * Record a failure of operation op (a static string) with the backend's

@@ -25,7 +25,8 @@
  * does): seq stays dense, as on SQLite.  A failed/canceled job is
  * resubmitted with a new seq (nextval), so it queues last.
  *
- * Connections.  STORE_PG_CONNS sessions at most, opened on demand, each
+ * Connections.  STORE_PG_CONNS sessions at most (and one more of the
+ * probes' own: readiness, counts, size), opened on demand, each
  * used by one thread at a time and with its prepared statements (prepared
  * on first use).  Before a pooled session is reused, input the server
  * sent while it was idle is read: a session the server closed (restart,
@@ -141,11 +142,12 @@ const char *const store_pg_sql[PG_N] = {
     /* PG_PRUNE_AGE: one batch of the jobs that ended before $1 */
     "DELETE FROM jobs WHERE " PG_FINISHED " AND seq IN (SELECT seq FROM jobs WHERE "
     PG_FINISHED " AND finished_at < $1::float8 ORDER BY finished_at, seq LIMIT $2::int)",
-    /* PG_PRUNE_SIZE: the oldest finished jobs that free $1 bytes, one batch */
+    /* PG_PRUNE_SIZE: the oldest finished jobs (other than job $3; NULL: any)
+     * that free $1 bytes, one batch */
     "DELETE FROM jobs WHERE " PG_FINISHED " AND seq IN (SELECT seq FROM (SELECT seq,"
     " finished_at, sum(" PG_ROW_BYTES ") OVER (ORDER BY finished_at, seq) - " PG_ROW_BYTES
-    " AS before FROM jobs WHERE " PG_FINISHED ") b WHERE before < $1::int8"
-    " ORDER BY finished_at, seq LIMIT $2::int)",
+    " AS before FROM jobs WHERE " PG_FINISHED " AND id IS DISTINCT FROM $3::text) b"
+    " WHERE before < $1::int8 ORDER BY finished_at, seq LIMIT $2::int)",
 };
 
 /* ---- rows ----------------------------------------------------------------- */
@@ -342,6 +344,8 @@ static int pg_submit(store *s, const char *id, const char *request, size_t reque
     if (status != STORE_OK)
         return status;
     status = pg_submit_tx(c, id, request, request_len, speeds_total, now, &result, job);
+    if (status == STORE_OK && result != 0)
+        (void)store_pg_trim(s, c, (long long)request_len + 120, id);   /* recorded */
     store_pg_release(s, c);
     if (status == STORE_OK && outcome)
         *outcome = result;
@@ -403,6 +407,9 @@ static int pg_finish(store *s, const char *id, store_state state, double now, in
     status = conn_update(c, PG_FINISH, 8, v, lens, fmts, &changed);
     if (status == STORE_OK && changed == 0)
         status = no_change_status(c, id);
+    if (status == STORE_OK)   /* the budget on insert; a failure is recorded, the end kept */
+        (void)store_pg_trim(s, c, (long long)(result_len + csv_len + (error ? strlen(error) : 0)),
+                            id);
     store_pg_release(s, c);
     return status;
 }
@@ -500,7 +507,7 @@ static int pg_count(store *s, long long counts[STORE_N_STATES])
     PGresult *r;
     pg_conn *c;
     store_state state;
-    int status = store_pg_acquire(s, "count", &c);
+    int status = store_pg_acquire_probe(s, "count", &c);
 
     if (status != STORE_OK)
         return status;

@@ -29,7 +29,9 @@
  * the server) are the last columns.
  *
  * Retention.  Rows are deleted in batches of PRUNE_BATCH, each its own
- * transaction; the server's autovacuum makes their space reusable (the
+ * transaction (store_prune; and store_pg_trim, the budget on insert, after
+ * a submission or a finish when this store's estimate of the live data
+ * passes the budget or a second after its last measure); the server's autovacuum makes their space reusable (the
  * files do not shrink without VACUUM FULL, which locks the table: an
  * operator's decision, not the daemon's).  Live data is measured from the
  * stored sizes of the texts (pg_column_size, no detoasting): a scan of the
@@ -44,6 +46,7 @@
 #include <time.h>
 
 enum { PRUNE_BATCH = 256 };
+#define STORE_PG_OPEN_TEXT "60000"   /* STORE_PG_OPEN_MS, for SQL */
 
 /* The migrations: store_pg_migrations[k] brings schema version k to k + 1. */
 static const char *const store_pg_migrations[] = {
@@ -108,14 +111,12 @@ static const char *last_text(store *s, store_error *e)
 /* One-row, one-column query on c into buf; STORE_OK, or the recorded kind. */
 static int query_text(pg_conn *c, const char *sql, char *buf, size_t len)
 {
-    PGresult *r = PQexec(c->conn, sql);
-    int status = STORE_OK;
+    PGresult *r = NULL;
+    int status = store_pg_query(c, sql, &r);
 
     buf[0] = '\0';
-    if (PQresultStatus(r) != PGRES_TUPLES_OK) {
-        PQclear(r);
-        return store_pg_exec(c, sql);   /* runs it again to record libpq's words */
-    }
+    if (status != STORE_OK)
+        return status;
     if (PQntuples(r) > 0 && !PQgetisnull(r, 0, 0))
         snprintf(buf, len, "%s", PQgetvalue(r, 0, 0));
     PQclear(r);
@@ -173,8 +174,8 @@ static int pg_migrate_one(pg_conn *c, int k)
         rc = store_pg_exec(c, sql);
     if (rc == STORE_OK)
         rc = store_pg_exec(c, "COMMIT");
-    if (rc != STORE_OK && PQtransactionStatus(c->conn) != PQTRANS_IDLE)
-        PQclear(PQexec(c->conn, "ROLLBACK"));
+    if (rc != STORE_OK)
+        store_pg_rollback(c);
     return rc;
 }
 
@@ -243,11 +244,18 @@ static int pool_init(store *s, store_pg *q)
 {
     if (pthread_mutex_init(&q->pool_lock, NULL) != 0)
         return -1;
+    if (pthread_mutex_init(&q->probe_lock, NULL) != 0) {
+        (void)pthread_mutex_destroy(&q->pool_lock);
+        return -1;
+    }
     if (pthread_cond_init(&q->pool_cond, NULL) != 0) {
+        (void)pthread_mutex_destroy(&q->probe_lock);
         (void)pthread_mutex_destroy(&q->pool_lock);
         return -1;
     }
     q->locks_ready = 1;
+    q->probe_conn.owner = s;
+    q->probe_conn.probe = 1;
     for (int i = STORE_PG_CONNS - 1; i >= 0; i--) {
         q->conns[i].owner = s;
         q->conns[i].next = q->free_conns;
@@ -268,9 +276,20 @@ static int pg_open_db(store *s, const char *where, int *requeued, char *err, siz
                last_text(s, &e));
         return rc;
     }
-    rc = pg_migrate(s->impl, c, where, err, errlen);
+    /* the migrations (and the wait for another replica's) get a longer
+     * deadline than a call; the session is closed after, so the pool's
+     * sessions all have the call's statement_timeout */
+    c->deadline = store_mono() + STORE_PG_OPEN_MS / 1000.0;
+    c->budget_ms = STORE_PG_OPEN_MS;
+    rc = store_pg_exec(c, "SET statement_timeout = " STORE_PG_OPEN_TEXT);
+    if (rc != STORE_OK)
+        store_seterr(err, errlen, "cannot set up a session of PostgreSQL database %s: %s",
+                     where, last_text(s, &e));
+    if (rc == STORE_OK)
+        rc = pg_migrate(s->impl, c, where, err, errlen);
     if (rc == STORE_OK)
         rc = pg_recover(s, c, where, requeued, err, errlen);
+    store_pg_disconnect(c);
     store_pg_release(s, c);
     return rc;
 }
@@ -300,6 +319,8 @@ int store_pg_open(store *s, const store_settings *set, int *requeued, char *err,
         return STORE_NOMEM;
     }
     q->lock_timeout_ms = set->busy_timeout_ms > 0 ? set->busy_timeout_ms : 1;
+    if (q->lock_timeout_ms > s->timeout_ms)   /* a lock wait inside a call's deadline */
+        q->lock_timeout_ms = s->timeout_ms;
     s->impl = q;
     if (pool_init(s, q) != 0) {
         store_seterr(err, errlen, "cannot create the connection pool's locks");
@@ -323,8 +344,10 @@ void store_pg_close(store *s)
         return;
     for (int i = 0; i < STORE_PG_CONNS; i++)
         store_pg_disconnect(&q->conns[i]);
+    store_pg_disconnect(&q->probe_conn);
     if (q->locks_ready) {
         (void)pthread_cond_destroy(&q->pool_cond);
+        (void)pthread_mutex_destroy(&q->probe_lock);
         (void)pthread_mutex_destroy(&q->pool_lock);
     }
     free(q->dsn);
@@ -345,7 +368,7 @@ int store_pg_check_writable(store *s)
 {
     PGresult *r;
     pg_conn *c;
-    int status = store_pg_acquire(s, "check_writable", &c);
+    int status = store_pg_acquire_probe(s, "check_writable", &c);
 
     if (status != STORE_OK)
         return status;
@@ -365,7 +388,7 @@ int store_pg_health(store *s)
     long long changed;
     PGresult *r;
     pg_conn *c;
-    int status = store_pg_acquire(s, "health", &c);
+    int status = store_pg_acquire_probe(s, "health", &c);
 
     if (status != STORE_OK)
         return status;
@@ -400,7 +423,7 @@ static int conn_size(pg_conn *c, long long *live, long long *file)
 int store_pg_size(store *s, long long *live_bytes, long long *file_bytes)
 {
     pg_conn *c;
-    int status = store_pg_acquire(s, "size", &c);
+    int status = store_pg_acquire_probe(s, "size", &c);
 
     if (status != STORE_OK)
         return status;
@@ -415,13 +438,15 @@ int store_pg_size(store *s, long long *live_bytes, long long *file_bytes)
 
 /* Delete batches of at most PRUNE_BATCH finished jobs, each its own
  * transaction: by_age, those that ended before cutoff, until a batch comes
- * back short; else the oldest, until the live data fits max_bytes (or
- * only unfinished jobs are left).  Returns a store_rc; *removed counts. */
+ * back short; else the oldest other than keep_id (NULL: any), until the
+ * live data fits max_bytes (or only unfinished jobs are left; *live, may
+ * be NULL, receives the last measure).  Returns a store_rc; *removed
+ * counts. */
 static int prune_loop(pg_conn *c, int by_age, double cutoff, long long max_bytes,
-                      long long *removed)
+                      const char *keep_id, long long *removed, long long *live_out)
 {
     char bound[32], batch[16];
-    const char *v[2] = {bound, batch};
+    const char *v[3] = {bound, batch, keep_id};
     long long changed, live = 0;
     PGresult *r;
     int status;
@@ -432,11 +457,14 @@ static int prune_loop(pg_conn *c, int by_age, double cutoff, long long max_bytes
     for (;;) {
         if (!by_age) {
             status = conn_size(c, &live, NULL);
+            if (live_out)
+                *live_out = live;
             if (status != STORE_OK || live <= max_bytes)
                 return status;
             snprintf(bound, sizeof bound, "%lld", live - max_bytes);
         }
-        status = store_pg_run(c, by_age ? PG_PRUNE_AGE : PG_PRUNE_SIZE, 2, v, NULL, NULL, &r);
+        status = store_pg_run(c, by_age ? PG_PRUNE_AGE : PG_PRUNE_SIZE, by_age ? 2 : 3, v, NULL,
+                              NULL, &r);
         if (status != STORE_OK)
             return status;
         changed = store_pg_changed(r);
@@ -455,9 +483,39 @@ int store_pg_prune(store *s, int by_age, double cutoff, long long max_bytes, lon
     if (status != STORE_OK)
         return status;
     if (by_age)
-        status = prune_loop(c, 1, cutoff, 0, removed);
+        status = prune_loop(c, 1, cutoff, 0, NULL, removed, NULL);
     if (status == STORE_OK && max_bytes > 0)
-        status = prune_loop(c, 0, 0, max_bytes, removed);
+        status = prune_loop(c, 0, 0, max_bytes, NULL, removed, NULL);
     store_pg_release(s, c);
+    return status;
+}
+
+int store_pg_trim(store *s, pg_conn *c, long long added, const char *keep_id)
+{
+    store_pg *q = s->impl;
+    long long live = 0, removed = 0;
+    const char *op = c->op;
+    double now = store_mono();
+    int need, status;
+
+    if (s->retain_bytes <= 0)
+        return STORE_OK;
+    (void)pthread_mutex_lock(&q->pool_lock);
+    q->live_est += added;
+    /* what this store wrote is counted (uncompressed: more than it takes);
+     * other replicas' writes show at the next measure, a second at most */
+    need = q->live_est > s->retain_bytes || now - q->measured_at >= 1.0;
+    (void)pthread_mutex_unlock(&q->pool_lock);
+    if (!need)
+        return STORE_OK;
+    c->op = "prune";
+    c->deadline = now + s->timeout_ms / 1000.0;
+    status = prune_loop(c, 0, 0, s->retain_bytes, keep_id, &removed, &live);
+    c->op = op;
+    (void)pthread_mutex_lock(&q->pool_lock);
+    q->live_est = status == STORE_OK ? live : s->retain_bytes + 1;   /* unknown: measure next */
+    q->measured_at = status == STORE_OK ? now : 0.0;
+    (void)pthread_mutex_unlock(&q->pool_lock);
+    store_note_pruned(s, removed);
     return status;
 }

@@ -48,6 +48,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 
 /* Columns every job read selects, in the order job_from_row expects
  * (0 … 11); the three large texts follow as columns 12, 13, 14.
@@ -105,8 +106,10 @@ const char *const store_sqlite_sql[STMT_N] = {
     /* STMT_PRUNE_AGE: one batch of the jobs that ended before ?1 */
     "DELETE FROM jobs WHERE seq IN (SELECT seq FROM jobs WHERE " JOB_FINISHED
     " AND finished_at < ?1 ORDER BY finished_at, seq LIMIT ?2)",
-    /* STMT_PRUNE_OLDEST: the next batch of candidates for the size bound */
-    "SELECT seq FROM jobs WHERE " JOB_FINISHED " ORDER BY finished_at, seq LIMIT ?1",
+    /* STMT_PRUNE_OLDEST: the next batch of candidates for the size bound,
+     * other than job ?2 (NULL: none kept) */
+    "SELECT seq FROM jobs WHERE " JOB_FINISHED " AND id IS NOT ?2 ORDER BY finished_at, seq"
+    " LIMIT ?1",
     /* STMT_PRUNE_ONE: the state test again, in case the job was resubmitted */
     "DELETE FROM jobs WHERE seq = ?1 AND " JOB_FINISHED,
     /* STMT_CANCEL_FLAG */ "SELECT cancel_requested FROM jobs WHERE id = ?1",
@@ -331,32 +334,57 @@ static int job_from_row(store_conn *c, sqlite3_stmt *st, int with_large, store_j
 
 /* ---- the pool ------------------------------------------------------------- */
 
-/* Take a reader connection for operation op, waiting while all are in use;
- * NULL (recorded as STORE_ERROR) when the pool's lock fails. */
-static store_conn *reader_acquire(store *s, const char *op)
+/* The wall-clock time ms milliseconds from now, for the timed waits
+ * (their condition variable and mutex use CLOCK_REALTIME). */
+static struct timespec wall_in(int ms)
 {
-    store_sqlite *q = s->impl;
-    store_conn *c;
+    struct timespec t;
 
-    if (pthread_mutex_lock(&q->pool_lock) != 0)
-        goto fail;
-    while (q->free_readers == NULL) {
-        if (pthread_cond_wait(&q->pool_cond, &q->pool_lock) != 0) {
-            (void)pthread_mutex_unlock(&q->pool_lock);
-            goto fail;
-        }
+    (void)clock_gettime(CLOCK_REALTIME, &t);
+    t.tv_sec += ms / 1000;
+    t.tv_nsec += (long)(ms % 1000) * 1000000L;
+    if (t.tv_nsec >= 1000000000L) {
+        t.tv_sec++;
+        t.tv_nsec -= 1000000000L;
     }
-    c = q->free_readers;
-    q->free_readers = c->next;
-    (void)pthread_mutex_unlock(&q->pool_lock);
-    c->op = op;
-    return c;
-fail:
-    (void)store_note_error(s, STORE_ERROR, 0, 0, op, "cannot take a reader connection");
-    return NULL;
+    return t;
 }
 
-static void reader_release(store *s, store_conn *c)
+int store_sqlite_reader_acquire(store *s, const char *op, int ms, store_conn **out)
+{
+    store_sqlite *q = s->impl;
+    struct timespec until = wall_in(ms);
+    char text[128];
+    int e = 0;
+
+    *out = NULL;
+    if (pthread_mutex_lock(&q->pool_lock) != 0)
+        return store_note_error(s, STORE_ERROR, 0, 0, op, "cannot take a reader connection");
+    while (q->free_readers == NULL && e == 0)
+        e = pthread_cond_timedwait(&q->pool_cond, &q->pool_lock, &until);
+    if (q->free_readers == NULL) {
+        (void)pthread_mutex_unlock(&q->pool_lock);
+        snprintf(text, sizeof text, "every reader connection stayed in use for %d ms", ms);
+        return store_note_error(s, e == ETIMEDOUT ? STORE_BUSY : STORE_ERROR, 0, 0, op, text);
+    }
+    *out = q->free_readers;
+    q->free_readers = (*out)->next;
+    (void)pthread_mutex_unlock(&q->pool_lock);
+    (*out)->op = op;
+    return STORE_OK;
+}
+
+/* A reader for op within the store's deadline; NULL on failure, with
+ * the recorded kind in *status. */
+static store_conn *reader_acquire(store *s, const char *op, int *status)
+{
+    store_conn *c = NULL;
+
+    *status = store_sqlite_reader_acquire(s, op, s->timeout_ms, &c);
+    return c;
+}
+
+void store_sqlite_reader_release(store *s, store_conn *c)
 {
     store_sqlite *q = s->impl;
 
@@ -384,13 +412,43 @@ static void writer_restore(store_sqlite *q)
  * and a cancel are always durable (on disk before the HTTP answer). */
 int store_sqlite_writer_begin(store *s, store_conn **out, int durable, const char *op)
 {
+    return store_sqlite_writer_begin_within(s, out, durable, op, s->timeout_ms);
+}
+
+/* The writer's mutex within ms (this process's other writers); STORE_OK
+ * or the recorded STORE_BUSY / STORE_ERROR. */
+static int writer_lock(store *s, const char *op, int ms)
+{
     store_sqlite *q = s->impl;
-    int rc;
+    struct timespec until = wall_in(ms);
+    char text[160];
+    int e = pthread_mutex_timedlock(&q->write_lock, &until);
+
+    if (e == 0)
+        return STORE_OK;
+    if (e != ETIMEDOUT)
+        return store_note_error(s, STORE_ERROR, 0, e, op, "cannot take the writer's lock");
+    snprintf(text, sizeof text, "the database's writer stayed in use for %d ms (another write "
+             "waits for a lock held by another process, or is slow)", ms);
+    return store_note_error(s, STORE_BUSY, SQLITE_BUSY, 0, op, text);
+}
+
+int store_sqlite_writer_begin_within(store *s, store_conn **out, int durable, const char *op,
+                                     int ms)
+{
+    store_sqlite *q = s->impl;
+    double deadline = store_mono() + ms / 1000.0;
+    int rc, left;
 
     *out = NULL;
-    if (pthread_mutex_lock(&q->write_lock) != 0)
-        return store_note_error(s, STORE_ERROR, 0, 0, op, "cannot take the writer's lock");
+    rc = writer_lock(s, op, ms);
+    if (rc != STORE_OK)
+        return rc;
     q->writer.op = op;
+    /* another process's lock: SQLite's busy wait, within what is left */
+    left = (int)((deadline - store_mono()) * 1000.0);
+    left = left < 0 ? 0 : left > q->busy_ms ? q->busy_ms : left;
+    (void)sqlite3_busy_timeout(q->writer.db, left);
     /* a commit to a deleted or replaced file would be lost at the next
      * start (SQLite in WAL mode does not notice): one stat(2), ~1 µs */
     rc = store_sqlite_same_file(s, q->path, q->db_dev, q->db_ino, "database file", op);
@@ -500,6 +558,22 @@ static int stmt_fail(store_conn *c, sqlite3_stmt *st, int rc)
     return kind;
 }
 
+/* Commit the writer's open transaction after the budget on insert
+ * (store_sqlite_trim, keeping job id) made room for what it wrote; tell
+ * on_pruned what the committed transaction deleted.  Returns a store_rc. */
+static int writer_commit_trimmed(store *s, store_conn *c, const char *id)
+{
+    long long removed = 0;
+    int status = store_sqlite_trim(s, c, id, &removed);
+
+    if (status != STORE_OK)
+        return store_sqlite_writer_end(s, status, 0);
+    status = store_sqlite_writer_end(s, STORE_OK, 1);
+    if (status == STORE_OK)
+        store_note_pruned(s, removed);
+    return status;
+}
+
 static int sq_submit(store *s, const char *id, const char *request, size_t request_len,
                      int speeds_total, double now, int *outcome, store_job *job)
 {
@@ -541,7 +615,7 @@ static int sq_submit(store *s, const char *id, const char *request, size_t reque
         if (status != STORE_OK)
             goto fail;
     }
-    status = store_sqlite_writer_end(s, STORE_OK, 1);
+    status = result ? writer_commit_trimmed(s, c, id) : store_sqlite_writer_end(s, STORE_OK, 1);
     if (status != STORE_OK) {
         store_job_clear(job);
         return status;
@@ -607,9 +681,10 @@ static int no_change_status(store_conn *c, const char *id)
 }
 
 /* Run the bound update st of the writer's open transaction on job id and end
- * the transaction: committed when a row changed; else rolled back with
- * STORE_NOT_FOUND or STORE_CONFLICT (no_change_status). */
-static int writer_update_one(store *s, store_conn *c, sqlite3_stmt *st, const char *id)
+ * the transaction: committed when a row changed (trim: after the budget on
+ * insert made room); else rolled back with STORE_NOT_FOUND or
+ * STORE_CONFLICT (no_change_status). */
+static int writer_update_one(store *s, store_conn *c, sqlite3_stmt *st, const char *id, int trim)
 {
     int changes = 0, status = conn_update(c, st, &changes);
 
@@ -617,6 +692,8 @@ static int writer_update_one(store *s, store_conn *c, sqlite3_stmt *st, const ch
         return store_sqlite_writer_end(s, status, 0);
     if (changes == 0)
         return store_sqlite_writer_end(s, no_change_status(c, id), 0);
+    if (trim)
+        return writer_commit_trimmed(s, c, id);
     return store_sqlite_writer_end(s, STORE_OK, 1);
 }
 
@@ -641,7 +718,7 @@ static int sq_finish(store *s, const char *id, store_state state, double now, in
         (rc = bind_text(st, 6, result, result_len)) != SQLITE_OK ||
         (rc = bind_text(st, 7, csv, csv_len)) != SQLITE_OK)
         return store_sqlite_writer_end(s, stmt_fail(c, st, rc), 0);
-    return writer_update_one(s, c, st, id);
+    return writer_update_one(s, c, st, id, 1);
 }
 
 static int sq_requeue(store *s, const char *id)
@@ -656,7 +733,7 @@ static int sq_requeue(store *s, const char *id)
     st = store_sqlite_stmt(c, STMT_REQUEUE, &rc);
     if (st == NULL || (rc = bind_text(st, 1, id, strlen(id))) != SQLITE_OK)
         return store_sqlite_writer_end(s, stmt_fail(c, st, rc), 0);
-    return writer_update_one(s, c, st, id);
+    return writer_update_one(s, c, st, id, 0);
 }
 
 static int sq_cancel(store *s, const char *id, double now, store_state *state)
@@ -697,13 +774,14 @@ static int sq_cancel(store *s, const char *id, double now, store_state *state)
 
 static int sq_get(store *s, const char *id, unsigned flags, store_job *out)
 {
-    store_conn *c = reader_acquire(s, "get");
+    store_conn *c;
     int status;
 
+    c = reader_acquire(s, "get", &status);
     if (c == NULL)
-        return STORE_ERROR;
+        return status;
     status = conn_get(c, id, flags, out);
-    reader_release(s, c);
+    store_sqlite_reader_release(s, c);
     return status;
 }
 
@@ -731,12 +809,13 @@ static int list_rows(store_conn *c, sqlite3_stmt *st, int max, store_job *out, i
 static int sq_list(store *s, long long before, int filter, int max, store_job *out, int *n,
                    int *more)
 {
-    store_conn *c = reader_acquire(s, "list");
+    store_conn *c;
     sqlite3_stmt *st;
     int rc, status;
 
+    c = reader_acquire(s, "list", &status);
     if (c == NULL)
-        return STORE_ERROR;
+        return status;
     st = store_sqlite_stmt(c, filter >= 0 ? STMT_LIST_STATE : STMT_LIST_ALL, &rc);
     if (st == NULL) {
         status = store_sqlite_fail(c, rc);
@@ -755,7 +834,7 @@ static int sq_list(store *s, long long before, int filter, int max, store_job *o
         status = list_rows(c, st, max, out, n, more);
     store_sqlite_stmt_done(st);
 done:
-    reader_release(s, c);
+    store_sqlite_reader_release(s, c);
     if (status != STORE_OK) {
         for (int i = 0; i < *n; i++)
             store_job_clear(&out[i]);
@@ -767,17 +846,17 @@ done:
 
 static int sq_count(store *s, long long counts[STORE_N_STATES])
 {
-    store_conn *c = reader_acquire(s, "count");
+    store_conn *c = NULL;
     sqlite3_stmt *st;
     store_state state;
-    int rc, status = STORE_OK;
+    int rc, status = store_sqlite_reader_acquire(s, "count", s->probe_ms, &c);
 
-    if (c == NULL)
-        return STORE_ERROR;
+    if (status != STORE_OK)
+        return status;
     st = store_sqlite_stmt(c, STMT_COUNT, &rc);
     if (st == NULL) {
         status = store_sqlite_fail(c, rc);
-        reader_release(s, c);
+        store_sqlite_reader_release(s, c);
         return status;
     }
     while ((rc = sqlite3_step(st)) == SQLITE_ROW) {
@@ -789,7 +868,7 @@ static int sq_count(store *s, long long counts[STORE_N_STATES])
     if (status == STORE_OK && rc != SQLITE_DONE)
         status = store_sqlite_fail(c, rc);
     store_sqlite_stmt_done(st);
-    reader_release(s, c);
+    store_sqlite_reader_release(s, c);
     if (status != STORE_OK) {
         for (int i = 0; i < STORE_N_STATES; i++)
             counts[i] = 0;
@@ -804,14 +883,15 @@ static int sq_count(store *s, long long counts[STORE_N_STATES])
 static int sq_renew_lease(store *s, const char *id, const char *owner, double now,
                           double lease_s)
 {
-    store_conn *c = reader_acquire(s, "renew_lease");
+    store_conn *c;
     store_state state = STORE_QUEUED;
     int status;
 
+    c = reader_acquire(s, "renew_lease", &status);
     if (c == NULL)
-        return STORE_ERROR;
+        return status;
     status = conn_state(c, id, &state);
-    reader_release(s, c);
+    store_sqlite_reader_release(s, c);
     if (status == STORE_OK && state != STORE_RUNNING)
         status = STORE_CONFLICT;
     return status;
@@ -827,12 +907,13 @@ static int sq_requeue_expired(store *s, double now, int max_attempts, int *reque
 
 static int sq_cancel_requested(store *s, const char *id, int *flag)
 {
-    store_conn *c = reader_acquire(s, "cancel_requested");
+    store_conn *c;
     sqlite3_stmt *st;
     int rc, status;
 
+    c = reader_acquire(s, "cancel_requested", &status);
     if (c == NULL)
-        return STORE_ERROR;
+        return status;
     st = store_sqlite_stmt(c, STMT_CANCEL_FLAG, &rc);
     if (st == NULL) {
         status = store_sqlite_fail(c, rc);
@@ -849,19 +930,20 @@ static int sq_cancel_requested(store *s, const char *id, int *flag)
     }
     store_sqlite_stmt_done(st);
 done:
-    reader_release(s, c);
+    store_sqlite_reader_release(s, c);
     return status;
 }
 
 static int sq_state_of(store *s, const char *id, store_state *state)
 {
-    store_conn *c = reader_acquire(s, "state_of");
+    store_conn *c;
     int status;
 
+    c = reader_acquire(s, "state_of", &status);
     if (c == NULL)
-        return STORE_ERROR;
+        return status;
     status = conn_state(c, id, state);
-    reader_release(s, c);
+    store_sqlite_reader_release(s, c);
     return status;
 }
 

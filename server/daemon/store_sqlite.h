@@ -124,6 +124,25 @@ void store_sqlite_conn_close(store_conn *c);
  * must call store_sqlite_writer_end.  Returns a store_rc. */
 int store_sqlite_writer_begin(store *s, store_conn **out, int durable, const char *op);
 
+/* store_sqlite_writer_begin with a deadline of ms (the probes' budget)
+ * instead of the store's timeout_ms: the writer's mutex and another
+ * process's lock are both waited for within it (then STORE_BUSY). */
+int store_sqlite_writer_begin_within(store *s, store_conn **out, int durable, const char *op,
+                                     int ms);
+
+/* Take a reader connection for op, waiting at most ms while all are in
+ * use (then STORE_BUSY, recorded).  Give it back with
+ * store_sqlite_reader_release. */
+int store_sqlite_reader_acquire(store *s, const char *op, int ms, store_conn **out);
+void store_sqlite_reader_release(store *s, store_conn *c);
+
+/* The budget on insert (store_settings.retain_bytes), inside the writer's
+ * open transaction c: while the live data exceeds it, delete the oldest
+ * finished job other than keep_id (one batch at most); *removed counts the
+ * deletions (they commit with the transaction).  Nothing without a
+ * budget.  Returns a store_rc (recorded). */
+int store_sqlite_trim(store *s, store_conn *c, const char *keep_id, long long *removed);
+
 /* End the write transaction: commit when commit is 1, else roll back;
  * give the writer back.  Returns status, or the kind of a failed commit. */
 int store_sqlite_writer_end(store *s, int status, int commit);

@@ -32,6 +32,12 @@
  * of 20 000 jobs with 20 KB results deleted by age in 0.3 s without and
  * 6 s with the vacuum (200 MB freed at the start of a 412 MB file).  A
  * periodic prune that deletes a few jobs moves a few pages.
+ * The budget on insert (store_settings.retain_bytes, store_sqlite_trim)
+ * runs the same size bound inside the transaction of a submission or a
+ * finish, before it commits, keeping the job just written: the live data
+ * never exceeds the budget by more than that one job.  It leaves the freed
+ * pages on the free list, where the next result reuses them (no vacuum on
+ * that path: moving pages costs as much as the data moved).
  * Neither query has an index on finished_at: each batch scans the table's
  * small columns (the large texts are not read), which is fine at the
  * intended scale (a scan of 100 000 jobs is milliseconds).
@@ -54,7 +60,7 @@ enum {
 int store_sqlite_check_writable(store *s)
 {
     store_conn *c = NULL;
-    int status = store_sqlite_writer_begin(s, &c, 1, "check_writable");
+    int status = store_sqlite_writer_begin_within(s, &c, 1, "check_writable", s->probe_ms);
 
     if (status != STORE_OK)
         return status;
@@ -92,7 +98,7 @@ int store_sqlite_health(store *s)
     }
     (void)pthread_mutex_unlock(&q->pool_lock);
     /* a real write: the schema version, rewritten unchanged, is one page */
-    status = store_sqlite_writer_begin(s, &c, 0, "health");
+    status = store_sqlite_writer_begin_within(s, &c, 0, "health", s->probe_ms);
     if (status == STORE_OK) {
         snprintf(sql, sizeof sql, "PRAGMA user_version = %d", q->version);
         rc = sqlite3_exec(c->db, sql, NULL, NULL, NULL);
@@ -134,13 +140,14 @@ static int conn_pages(store_conn *c, long long *live, long long *file)
 int store_sqlite_size(store *s, long long *live_bytes, long long *file_bytes)
 {
     store_conn *c = NULL;
-    int status = store_sqlite_writer_begin(s, &c, 0, "size");
+    int status = store_sqlite_reader_acquire(s, "size", s->probe_ms, &c);
 
-    /* on the writer: the readers are for jobs, and this is rare */
+    /* on a reader (one statement, its own read transaction): the writer may
+     * wait for another process's lock, and /metrics must not */
     if (status != STORE_OK)
         return status;
     status = conn_pages(c, live_bytes, file_bytes);
-    status = store_sqlite_writer_end(s, status, 0);
+    store_sqlite_reader_release(s, c);
     if (status != STORE_OK) {
         *live_bytes = 0;
         *file_bytes = 0;
@@ -181,14 +188,18 @@ static int prune_age(store *s, double cutoff, long long *removed)
     }
 }
 
-/* The seq of the next (at most PRUNE_BATCH) oldest finished jobs into seqs. */
-static int prune_candidates(store_conn *c, long long seqs[PRUNE_BATCH], int *n)
+/* The seq of the next (at most PRUNE_BATCH) oldest finished jobs other than
+ * keep_id (NULL: any) into seqs. */
+static int prune_candidates(store_conn *c, const char *keep_id, long long seqs[PRUNE_BATCH],
+                            int *n)
 {
     int rc;
     sqlite3_stmt *st = store_sqlite_stmt(c, STMT_PRUNE_OLDEST, &rc);
 
     *n = 0;
-    if (st == NULL || (rc = sqlite3_bind_int(st, 1, PRUNE_BATCH)) != SQLITE_OK) {
+    if (st != NULL && (rc = sqlite3_bind_int(st, 1, PRUNE_BATCH)) == SQLITE_OK && keep_id)
+        rc = sqlite3_bind_text(st, 2, keep_id, -1, SQLITE_STATIC);
+    if (st == NULL || rc != SQLITE_OK) {
         rc = store_sqlite_fail(c, rc);
         store_sqlite_stmt_done(st);
         return rc;
@@ -204,24 +215,21 @@ static int prune_candidates(store_conn *c, long long seqs[PRUNE_BATCH], int *n)
     return STORE_OK;
 }
 
-/* One transaction of the size bound: delete the oldest finished jobs one
- * at a time until the live data is at most max_bytes or the batch is
- * used up.  *deleted: rows deleted (committed when this returns STORE_OK);
- * *done: 1 when under the bound or nothing finished is left. */
-static int prune_size_batch(store *s, long long max_bytes, int *deleted, int *done)
+/* In the writer's open transaction c: delete the oldest finished jobs
+ * other than keep_id (NULL: any) one at a time, at most one batch, until
+ * the live data is at most max_bytes.  *deleted: rows deleted; *done: 1
+ * when under the bound or nothing finished is left.  Returns a store_rc. */
+static int delete_oldest(store_conn *c, long long max_bytes, const char *keep_id, int *deleted,
+                         int *done)
 {
     long long seqs[PRUNE_BATCH], live = 0;
-    store_conn *c = NULL;
     sqlite3_stmt *st;
-    int rc, n = 0, status = store_sqlite_writer_begin(s, &c, 0, "prune");
+    int rc, n = 0, status = conn_pages(c, &live, NULL);
 
     *deleted = 0;
     *done = 1;
-    if (status != STORE_OK)
-        return status;
-    status = conn_pages(c, &live, NULL);
     if (status == STORE_OK && live > max_bytes)
-        status = prune_candidates(c, seqs, &n);
+        status = prune_candidates(c, keep_id, seqs, &n);
     for (int i = 0; status == STORE_OK && live > max_bytes && i < n; i++) {
         st = store_sqlite_stmt(c, STMT_PRUNE_ONE, &rc);
         if (st != NULL && (rc = sqlite3_bind_int64(st, 1, seqs[i])) == SQLITE_OK)
@@ -234,11 +242,40 @@ static int prune_size_batch(store *s, long long max_bytes, int *deleted, int *do
             status = conn_pages(c, &live, NULL);
         }
     }
+    *done = live <= max_bytes || n < PRUNE_BATCH;
+    return status;
+}
+
+int store_sqlite_trim(store *s, store_conn *c, const char *keep_id, long long *removed)
+{
+    int deleted = 0, done = 0, status;
+
+    *removed = 0;
+    if (s->retain_bytes <= 0)
+        return STORE_OK;
+    status = delete_oldest(c, s->retain_bytes, keep_id, &deleted, &done);
+    if (status == STORE_OK)
+        *removed = deleted;
+    return status;
+}
+
+/* One transaction of the size bound (delete_oldest, no job kept).
+ * *deleted: rows deleted (committed when this returns STORE_OK); *done: 1
+ * when under the bound or nothing finished is left. */
+static int prune_size_batch(store *s, long long max_bytes, int *deleted, int *done)
+{
+    store_conn *c = NULL;
+    int status = store_sqlite_writer_begin(s, &c, 0, "prune");
+
+    *deleted = 0;
+    *done = 1;
+    if (status != STORE_OK)
+        return status;
+    status = delete_oldest(c, max_bytes, NULL, deleted, done);
     if (status != STORE_OK) {
         *deleted = 0;
         return store_sqlite_writer_end(s, status, 0);
     }
-    *done = live <= max_bytes || n < PRUNE_BATCH;
     status = store_sqlite_writer_end(s, STORE_OK, *deleted > 0);
     if (status != STORE_OK)
         *deleted = 0;

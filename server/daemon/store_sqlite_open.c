@@ -586,6 +586,8 @@ int store_sqlite_open(store *s, const store_settings *set, int *requeued, char *
     q->lock.fd = -1;
     q->lock.dbfd = -1;
     q->busy_ms = set->busy_timeout_ms > 0 ? set->busy_timeout_ms : 0;
+    if (q->busy_ms > s->timeout_ms)   /* no wait outlasts a call's deadline */
+        q->busy_ms = s->timeout_ms;
     s->impl = q;
     if (locks_init(q) != 0) {
         store_seterr(err, errlen, "cannot create the database locks");

@@ -136,7 +136,8 @@ static void test_names(void)
              {STORE_BUSY, "busy", 1},      {STORE_CORRUPT, "corrupt", 1},
              {STORE_READONLY, "readonly", 1}, {STORE_IOERR, "ioerr", 1},
              {STORE_IN_USE, "in_use", 1},  {STORE_GONE, "gone", 1},
-             {STORE_INVALID, "invalid", 0}, {STORE_UNAVAILABLE, "unavailable", 1}};
+             {STORE_INVALID, "invalid", 0}, {STORE_UNAVAILABLE, "unavailable", 1},
+             {STORE_TIMEOUT, "db_timeout", 1}};
 
     for (size_t i = 0; i < sizeof t / sizeof t[0]; i++) {
         CHECK(!strcmp(store_rc_name(t[i].rc), t[i].token), "token of %d: %s", t[i].rc,
@@ -144,7 +145,7 @@ static void test_names(void)
         CHECK(store_is_db_error(t[i].rc) == t[i].db, "is_db_error(%s)", t[i].token);
         CHECK(store_strerror(t[i].rc)[0] != '\0', "sentence of %s", t[i].token);
     }
-    CHECK(STORE_RC_MIN == STORE_UNAVAILABLE, "STORE_RC_MIN is the lowest code");
+    CHECK(STORE_RC_MIN == STORE_TIMEOUT, "STORE_RC_MIN is the lowest code");
     CHECK(!strcmp(store_rc_name(1), "unknown") && !strcmp(store_rc_name(-99), "unknown"),
           "unknown token");
     CHECK(!strcmp(store_strerror(-99), "unknown store error"), "unknown sentence");
