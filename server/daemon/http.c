@@ -53,8 +53,10 @@
  * file is still the one opened, a WAL frame can be written), the last write
  * of a job did not fail, every worker runs and the daemon is not stopping.
  * checks.database is "ok" or the kind of the failure (store_rc_name:
- * "full", "readonly", "gone", "corrupt", ...; "write_failed" when the probe
- * passes but a job's result could not be stored).
+ * "full", "readonly", "gone", "corrupt", "busy", "db_timeout" ...;
+ * "write_failed" when the probe passes but a job's result could not be
+ * stored).  The probe has its own budget (store_settings.probe_timeout_ms,
+ * 0.5 s): a stalled database answers 503 "db_timeout", never a hang.
  */
 static enum MHD_Result http_readyz(struct MHD_Connection *c, http_req *r)
 {
@@ -82,6 +84,9 @@ static enum MHD_Result http_readyz(struct MHD_Connection *c, http_req *r)
     }
     if (stopping)
         snprintf(detail, sizeof(detail), "The daemon is stopping.");
+    else if (db_rc == STORE_TIMEOUT)   /* the probe's own budget passed (DESIGN §F) */
+        snprintf(detail, sizeof(detail), "The database did not answer the readiness probe "
+                                         "in time: %s.", store_strerror(db_rc));
     else if (db_rc != STORE_OK)
         snprintf(detail, sizeof(detail), "The database is not writable: %s.",
                  store_strerror(db_rc));

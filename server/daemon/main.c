@@ -66,6 +66,7 @@ enum {
     F_RETAIN_BYTES,
     F_REPLICA_ID,
     F_LEASE,
+    F_DB_TIMEOUT,
     F_SHUTDOWN_GRACE,
     F_LOG_FORMAT,
     F_N
@@ -117,6 +118,9 @@ static const main_flag main_flags[F_N] = {
      "PostgreSQL: the owner id this replica stamps on the jobs it claims (unique per replica)"},
     {"lease", "SPINMODAL_LEASE", "S", "30",
      "PostgreSQL: seconds a claimed job stays this replica's without a heartbeat"},
+    {"db-timeout", "SPINMODAL_DB_TIMEOUT", "S", "5",
+     "deadline of one database call (locks, connection, each round trip); past it 503 with "
+     "Retry-After. Probes (/readyz, /metrics) wait at most 0.5 s"},
     {"shutdown-grace", "SPINMODAL_SHUTDOWN_GRACE", "S", "10",
      "seconds running jobs get to finish on SIGTERM"},
     {"log-format", "SPINMODAL_LOG_FORMAT", "text|json", "text", "log lines on stderr"},
@@ -134,6 +138,7 @@ typedef struct main_opts {
     double retain_age;       /* s, 0 = no age bound */
     const char *replica_id;  /* NULL = generated */
     double lease;            /* s, PostgreSQL claims */
+    double db_timeout;       /* s, deadline of one store call */
     long long retain_bytes;  /* bytes, 0 = no size bound */
     const char *token_file;  /* NULL = no auth */
     int auth_reads;          /* 1: reads need the token too */
@@ -339,6 +344,9 @@ static int main_set(main_opts *o, int f, const char *v, const char **want)
     case F_LEASE:
         *want = "a number of seconds from 3 to 3600";
         return main_seconds(v, 3.0, 3600.0, &o->lease);
+    case F_DB_TIMEOUT:
+        *want = "a number of seconds from 0.5 to 600";
+        return main_seconds(v, 0.5, 600.0, &o->db_timeout);
     case F_RETAIN_AGE:
         *want = "a number of seconds from 0 (keep) to 3153600000 (100 years)";
         return main_seconds(v, 0.0, 3153600000.0, &o->retain_age);
@@ -385,6 +393,7 @@ static void main_defaults(main_opts *o)
     o->shutdown_grace = 10.0;
     o->retain_age = 2592000.0;
     o->lease = 30.0;
+    o->db_timeout = 5.0;
     o->retain_bytes = 1073741824LL;
     o->format = LOG_TEXT;
 }
@@ -580,6 +589,12 @@ static void main_store_error(void *ctx, const store_error *e)
     metrics_store_error(ctx, e->rc);
 }
 
+/* The store's prune-on-insert callback: count what --retain-bytes removed. */
+static void main_store_pruned(void *ctx, long long n)
+{
+    metrics_store_pruned(ctx, n);
+}
+
 static int main_open(const main_opts *o, main_daemon *d)
 {
     store_settings set;
@@ -598,6 +613,10 @@ static int main_open(const main_opts *o, main_daemon *d)
     set.lease_s = o->lease;
     set.on_error = main_store_error;
     set.on_error_ctx = d->mx;
+    set.timeout_ms = (int)(o->db_timeout * 1000.0);
+    set.retain_bytes = o->retain_bytes;   /* pruned on insert too, not only periodically */
+    set.on_pruned = main_store_pruned;
+    set.on_pruned_ctx = d->mx;
     rc = store_open_with(&d->st, &set, &requeued, err, sizeof(err));
     if (rc != STORE_OK) {
         /* err names the file, or host:port/database of a URI (never its password) */
@@ -615,6 +634,8 @@ static int main_open(const main_opts *o, main_daemon *d)
 /*
  * Retention: remove the oldest finished jobs beyond --retain-age and
  * --retain-bytes (queued and running jobs are never removed); count and log.
+ * The store also keeps --retain-bytes on every insert (set.retain_bytes):
+ * this periodic pass catches up the age bound and what other replicas wrote.
  */
 static void main_prune(const main_opts *o, main_daemon *d)
 {

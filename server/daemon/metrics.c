@@ -5,6 +5,12 @@
  * The HTTP counters are a small fixed table of (route, method, code) series
  * searched linearly: there are a dozen routes, a few methods and codes, so
  * the table stays tiny and a lookup costs less than the request itself.
+ *
+ * Store gauges.  The caller reads the job counts and sizes from the store
+ * within the probes' budget (DESIGN.md §F: /metrics never waits on the
+ * database); when that read fails (a stalled or locked database), the last
+ * values read are served again and spinmodal_store_stats_stale says so,
+ * with spinmodal_store_stats_age_seconds their age.
  */
 #include "metrics.h"
 
@@ -13,6 +19,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #define METRICS_MAX_SERIES 256
 #define METRICS_LABEL 64
@@ -43,6 +50,9 @@ struct metrics {
     unsigned long long store_pruned;    /* finished jobs removed by retention */
     unsigned long long lease_requeued, lease_failed; /* jobs of dead replicas */
     unsigned long long finished[STORE_N_STATES];
+    long long last_jobs[STORE_N_STATES]; /* the last job counts read; -1 before */
+    long long last_live, last_file;     /* the last sizes read; -1 before */
+    double jobs_at, size_at;            /* monotonic s of those reads, 0 = never */
 };
 
 metrics *metrics_new(void)
@@ -55,6 +65,9 @@ metrics *metrics_new(void)
         free(m);
         return NULL;
     }
+    for (int i = 0; i < STORE_N_STATES; i++)
+        m->last_jobs[i] = -1;
+    m->last_live = m->last_file = -1;
     return m;
 }
 
@@ -289,10 +302,59 @@ static void metrics_render_locked(const metrics *m, metrics_buf *b)
                        store_state_name((store_state)i), m->finished[i]);
 }
 
-int metrics_render(metrics *m, const metrics_gauges *g, char **out, size_t *len)
+/* Monotonic seconds, for the age of the store gauges. */
+static double metrics_mono(void)
+{
+    struct timespec ts;
+
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/*
+ * The store gauges of in, into out: fresh ones are remembered; unknown ones
+ * (-1: the store did not answer within the probes' budget) are replaced by
+ * the last known.  *age: s since the oldest of the values served was read
+ * (0 when all are fresh, -1 when none was ever read).  Returns 1 when a
+ * value is not fresh.  Caller holds the lock.
+ */
+static int metrics_store_gauges(metrics *m, const metrics_gauges *in, metrics_gauges *out,
+                                double *age)
+{
+    double now = metrics_mono(), oldest = now;
+    int i, stale = 0;
+
+    *out = *in;
+    if (in->jobs[0] >= 0) {
+        for (i = 0; i < STORE_N_STATES; i++)
+            m->last_jobs[i] = in->jobs[i];
+        m->jobs_at = now;
+    } else {
+        for (i = 0; i < STORE_N_STATES; i++)
+            out->jobs[i] = m->last_jobs[i];
+        stale = 1;
+        oldest = m->jobs_at;
+    }
+    if (in->store_live_bytes >= 0) {
+        m->last_live = in->store_live_bytes;
+        m->last_file = in->store_file_bytes;
+        m->size_at = now;
+    } else {
+        out->store_live_bytes = m->last_live;
+        out->store_file_bytes = m->last_file;
+        stale = 1;
+        oldest = m->size_at < oldest ? m->size_at : oldest;
+    }
+    *age = oldest > 0.0 ? now - oldest : -1.0;
+    return stale;
+}
+
+int metrics_render(metrics *m, const metrics_gauges *given, char **out, size_t *len)
 {
     metrics_buf b = {NULL, 0, 0, 0};
-    int i;
+    metrics_gauges gs, *g = &gs;
+    double age = 0.0;
+    int i, stale;
 
     *out = NULL;
     b.cap = 4096;
@@ -302,7 +364,18 @@ int metrics_render(metrics *m, const metrics_gauges *g, char **out, size_t *len)
     b.s[0] = '\0';
     pthread_mutex_lock(&m->lock);
     metrics_render_locked(m, &b);
+    stale = metrics_store_gauges(m, given, &gs, &age);
     pthread_mutex_unlock(&m->lock);
+    metrics_printf(&b, "# HELP spinmodal_store_stats_stale 1 when the store did not answer "
+                       "within the probes' budget and the store gauges below are the last "
+                       "values read.\n"
+                       "# TYPE spinmodal_store_stats_stale gauge\n"
+                       "spinmodal_store_stats_stale %d\n"
+                       "# HELP spinmodal_store_stats_age_seconds Age of the store gauges "
+                       "(0 when read now; -1 when never read).\n"
+                       "# TYPE spinmodal_store_stats_age_seconds gauge\n"
+                       "spinmodal_store_stats_age_seconds %.3f\n",
+                   stale, age);
     metrics_printf(&b, "# HELP spinmodal_jobs Jobs in the store, by state.\n"
                        "# TYPE spinmodal_jobs gauge\n");
     for (i = 0; i < STORE_N_STATES; i++)
