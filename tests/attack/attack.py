@@ -25,6 +25,9 @@ per category, and runs:
               a symlink and a hard link) while the first is under load, a full
               disk (a 3 MB tmpfs; skipped when this process may not mount)
               (faults.py);
+  polls       600 long polls (GET and POST ?wait=60) from 10 addresses, each
+              polling again once answered, while /livez, /readyz, /metrics and
+              POST must answer and at most --max-waiters wait (polls.py);
   imports     hostile blade files to POST /v1/import/{format} (imports.py):
               extreme numbers, el_loc out of order, UTF-16, degenerate radii:
               each a 422 with its line and field, never a 5xx; and a .bmi
@@ -36,7 +39,8 @@ per category, and runs:
               RSS start/end/max, database bytes per job (load.py).
 
 --quick: a subset of bodies and abuses, one kill -9, the database faults
-without load, no trickle from many addresses, no load figure, no soak (the
+without load, no trickle from many addresses, 300 long polls from 5 addresses
+for 2 s, no load figure, no soak (the
 meson test e2e-attack-quick).  Every wait polls for its condition and gives up
 after a budget scaled to the machine (tests/e2e/timescale.py), so no check
 passes or fails by speed.
@@ -62,9 +66,11 @@ import bodies  # noqa: E402
 import durability  # noqa: E402
 import faults  # noqa: E402
 import imports  # noqa: E402
+import polls  # noqa: E402
 import load  # noqa: E402
 
-CATEGORIES = ["bodies", "http", "trickle", "imports", "durability", "faults", "load", "soak"]
+CATEGORIES = ["bodies", "http", "trickle", "polls", "imports", "durability", "faults", "load",
+              "soak"]
 
 
 def done_job(d):
@@ -119,6 +125,16 @@ def cat_trickle(exe, tmp, tally, args):
         crash_free(d, tally, "trickle")
     finally:
         finish(d, tally, "trickle")
+
+
+def cat_polls(exe, tmp, tally, args):
+    d = Daemon(exe, tmp, ["--workers", "1"], name="polls")   # default connection flags
+    d.start()
+    try:
+        polls.run(d, tally, quick=args.quick)
+        crash_free(d, tally, "polls")
+    finally:
+        finish(d, tally, "polls")
 
 
 def cat_imports(exe, tmp, tally, args):
@@ -194,7 +210,8 @@ def main():
     tally = Tally(verbose=args.verbose)
     tmp = tempfile.mkdtemp(prefix="spinmodal-attack-")
     t0 = time.monotonic()
-    funcs = {"bodies": cat_bodies, "http": cat_http, "trickle": cat_trickle, "imports": cat_imports,
+    funcs = {"bodies": cat_bodies, "http": cat_http, "trickle": cat_trickle, "polls": cat_polls,
+             "imports": cat_imports,
              "durability": durability.category, "faults": faults.category,
              "load": load.category_load, "soak": load.category_soak}
     try:
