@@ -24,7 +24,9 @@ per category, and runs:
               corrupt at start, a second daemon on the same file (also through
               a symlink and a hard link) while the first is under load, a full
               disk (a 3 MB tmpfs; skipped when this process may not mount)
-              (faults.py);
+              (faults.py); a SQLite write lock held by another process and
+              PostgreSQL paused with SIGSTOP under load (stall.py; the
+              PostgreSQL part skipped without its server binaries);
   polls       600 long polls (GET and POST ?wait=60) from 10 addresses, each
               polling again once answered, while /livez, /readyz, /metrics and
               POST must answer and at most --max-waiters wait (polls.py);

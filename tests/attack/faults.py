@@ -20,6 +20,9 @@
   full disk     a 3 MB tmpfs filled up: the job whose result does not fit ends
                 failed (store_error) or back in the queue, never running
                 without a worker; /readyz 503 and back; needs mount.
+  stalls        a SQLite write lock held by another process, and PostgreSQL
+                paused with SIGSTOP under load: every answer within the
+                deadlines, nothing lost or run twice (stall.py; issue 23 item 3).
 """
 import os
 import sqlite3
@@ -29,6 +32,7 @@ import threading
 from common import (Daemon, db_bytes, small_request, start_or_refuse, sweep_request,
                     timescale, wait_until)
 from daemon import listening_addr
+import stall
 
 JS = {"Content-Type": "application/json"}
 
@@ -452,4 +456,5 @@ def category(exe, tmp, tally, args, name="faults"):
     if not args.quick:
         read_only(exe, tmp, tally)
         full_disk(exe, tmp, tally)
+    stall.category(exe, tmp, tally, args.quick)
     tally.figure("faults: database after the two-daemon run, bytes", db_bytes(good))

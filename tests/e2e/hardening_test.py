@@ -67,6 +67,18 @@ From issue 23:
                 probes and a POST answer meanwhile; a POST ?wait is a waiter too
                 (released oldest first on a daemon with --max-waiters 4); --max-waiters
                 above half of --max-connections is refused at start.
+  db_stall      PostgreSQL paused (SIGSTOP of the postmaster and its backends) held
+                /readyz, /metrics and POST as long as it lasted, /readyz then 200 (item 3):
+                /readyz is 503 "db_timeout" within its budget, /metrics serves the last
+                store values marked stale, POST is 503 + Retry-After within --db-timeout;
+                after SIGCONT every acknowledged job ends done.  Skipped without
+                PostgreSQL server binaries.
+  sqlite_busy   another process holding the SQLite write lock: 12 concurrent POSTs are
+                each 503 + Retry-After within --db-timeout (they queued behind one another,
+                5 s each), /readyz 503 "busy" within its budget, reads answer (item 3).
+  retention_budget  --retain-bytes was kept every 10 minutes (3 MB budget, 40.9 MB live
+                after 10 s of load): under load the live data now stays within the budget
+                plus one job, SQLite and PostgreSQL (item 9).
 The db_faults scenario also starts the second daemon through a symlink and a
 hard link to the database (both used to run beside the first), and full_disk
 checks /readyz is 503 as soon as the job is failed (the small write recording
@@ -920,6 +932,278 @@ def post_waiter(exe, tmp):
         if s:
             probe(d, "DELETE", "/v1/analyses/%s" % s)
     check(d.stop() == 0, "daemon stops cleanly")
+
+
+def timed(fn):
+    """(fn()'s value or the exception it raised, seconds it took)."""
+    t0 = time.monotonic()
+    try:
+        v = fn()
+    except Exception as e:  # noqa: BLE001 - a hang shows as a timeout here
+        v = e
+    return v, time.monotonic() - t0
+
+
+def status_of(r):
+    return r.status if hasattr(r, "status") else "%s: %s" % (type(r).__name__, r)
+
+
+def pg_processes(pg):
+    """The postmaster's pid and its children's (backends, background workers)."""
+    with open(os.path.join(pg.data, "postmaster.pid")) as f:
+        pm = int(f.readline())
+    kids = []
+    for d in os.listdir("/proc"):
+        if not d.isdigit():
+            continue
+        try:
+            with open("/proc/%s/stat" % d) as f:
+                ppid = int(f.read().rsplit(")", 1)[1].split()[1])
+        except (OSError, ValueError, IndexError):
+            continue
+        if ppid == pm:
+            kids.append(int(d))
+    return pm, kids
+
+
+def scenario_db_stall(exe, tmp):
+    """Issue 23 item 3: PostgreSQL paused (SIGSTOP of the postmaster and every backend) held
+    /readyz, /metrics and POST for as long as it lasted, and /readyz then said 200.  Now
+    /readyz answers 503 checks.database "db_timeout" within its own budget (0.5 s), /metrics
+    answers with the last store values marked stale, POST answers 503 + Retry-After within
+    --db-timeout (default 5 s); after SIGCONT everything recovers and every job acknowledged
+    before the stall ends done.  Skipped (77) without PostgreSQL server binaries."""
+    import signal
+    from replicas_test import Postgres
+    pg = Postgres(tmp)
+    if pg.bindir is None:
+        print("SKIP: no PostgreSQL server binaries (initdb, pg_ctl); set PG_BINDIR")
+        sys.exit(SKIP)
+    js = {"Content-Type": "application/json"}
+    d, stopped = None, []
+    pg.start()
+    try:
+        d = Daemon(exe, tmp, ["--workers", "2"], db=pg.dsn(), name="stall")
+        d.start()
+        check(d.get("/readyz").status == 200, "ready on PostgreSQL")
+        acked = []
+        for i in range(6):
+            r = d.request("POST", "/v1/analyses", body=angled_sweep(4, 10.0 + i), headers=js)
+            if r.status in (200, 202):
+                acked.append(r.json()["id"])
+        check(len(acked) == 6, "6 jobs acknowledged before the stall (%d)" % len(acked))
+        check(metric(d, "spinmodal_store_stats_stale") == 0, "/metrics: store gauges fresh")
+        pm, kids = pg_processes(pg)
+        for pid in [pm] + kids:
+            os.kill(pid, signal.SIGSTOP)
+            stopped.append(pid)
+        print("stopped the postmaster %d and %d children" % (pm, len(kids)))
+        r, took = timed(lambda: d.get("/readyz", timeout=15))
+        db = ((r.json() or {}).get("checks") or {}).get("database") if hasattr(r, "json") else None
+        check(status_of(r) == 503 and db == "db_timeout" and "Retry-After" in r.headers,
+              "/readyz 503 database db_timeout + Retry-After while PostgreSQL is stopped "
+              "(%s %r)" % (status_of(r), db))
+        check(took <= timescale.scaled(2.0), "/readyz answered in %.2f s (its budget 0.5 s; "
+              "bound %.1f s)" % (took, timescale.scaled(2.0)))
+        r, took = timed(lambda: d.get("/metrics", timeout=15))
+        text = r.body.decode("utf-8", "replace") if hasattr(r, "body") else ""
+        check(status_of(r) == 200 and "spinmodal_store_stats_stale 1" in text and
+              "spinmodal_jobs{state=" in text,
+              "/metrics 200 with the last store values marked stale (%s)" % status_of(r))
+        check(took <= timescale.scaled(2.0), "/metrics answered in %.2f s (bound %.1f s)"
+              % (took, timescale.scaled(2.0)))
+        worst = 0.0
+        for i in range(3):
+            r, took = timed(lambda: d.request("POST", "/v1/analyses",
+                                              body=angled_sweep(4, 50.0 + i), headers=js,
+                                              timeout=20))
+            worst = max(worst, took)
+            check(status_of(r) == 503 and "Retry-After" in r.headers,
+                  "POST %d answers 503 + Retry-After, not a hang (%s in %.2f s)"
+                  % (i + 1, status_of(r), took))
+        check(worst <= timescale.scaled(8.0), "each POST answered within --db-timeout 5 s "
+              "and a margin (worst %.2f s, bound %.1f s)" % (worst, timescale.scaled(8.0)))
+        r, took = timed(lambda: d.get("/v1/analyses/" + acked[0], timeout=20))
+        check(status_of(r) == 503 and took <= timescale.scaled(8.0),
+              "GET of a job answers 503 while stalled (%s in %.2f s)" % (status_of(r), took))
+        r, took = timed(lambda: d.get("/readyz", timeout=15))
+        check(status_of(r) == 503 and took <= timescale.scaled(2.0),
+              "/readyz still answers quickly (%s in %.2f s)" % (status_of(r), took))
+        for pid in stopped:
+            os.kill(pid, signal.SIGCONT)
+        stopped = []
+        check(wait_until(lambda: d.get("/readyz").status == 200, 30),
+              "/readyz 200 again after SIGCONT")
+
+        def all_done():
+            states = [job_state(d, j).get("state") for j in acked]
+            return states if all(s == "done" for s in states) else None
+        states = wait_until(all_done, 120)
+        check(states is not None, "no job lost: the 6 acknowledged jobs end done (%s)"
+              % [job_state(d, j).get("state") for j in acked])
+        r = d.request("POST", "/v1/analyses?wait=30", body=angled_sweep(4, 90.0), headers=js)
+        check(r.status in (200, 202), "a new job is accepted after the stall (%s)" % r.status)
+        check(any("db_timeout" in line for line in d.log_lines()),
+              "the stall is logged (event=store_error kind=db_timeout)")
+        check(metric(d, "spinmodal_store_stats_stale") == 0, "/metrics: store gauges fresh again")
+        check(d.stop() == 0, "daemon stops cleanly")
+        d = None
+    finally:
+        for pid in stopped:
+            try:
+                os.kill(pid, signal.SIGCONT)
+            except OSError:
+                pass
+        if d is not None:
+            d.kill()
+        pg.remove()
+
+
+def scenario_sqlite_busy(exe, tmp):
+    """Issue 23 item 3, SQLite: another process holding the database's write lock made every
+    write wait the busy timeout one after another behind the writer (the twelfth POST ~60 s)
+    and /readyz wait behind them.  Now each POST answers 503 + Retry-After within --db-timeout
+    (5 s) whatever the queue, /readyz answers within its budget (503 "busy"), /metrics and a
+    GET of a job answer (readers do not wait), and all recovers once the lock is let go."""
+    import sqlite3
+    import threading
+    js = {"Content-Type": "application/json"}
+    d = Daemon(exe, tmp, ["--workers", "1"], name="busy")
+    d.start()
+    r = d.request("POST", "/v1/analyses?wait=30", body=angled_sweep(2, 1.0), headers=js)
+    check(r.status == 200, "a job runs before the lock (%s)" % r.status)
+    done_id = r.json()["id"]
+    con = sqlite3.connect(d.db, timeout=0, isolation_level=None)
+    con.execute("BEGIN IMMEDIATE")   # the write lock, held by this process
+    results = []
+
+    def post(i):
+        results.append(timed(lambda: d.request("POST", "/v1/analyses", headers=js,
+                                               body=angled_sweep(2, 20.0 + i), timeout=120)))
+    threads = [threading.Thread(target=post, args=(i,)) for i in range(12)]
+    for t in threads:
+        t.start()
+    time.sleep(0.3)
+    r, took = timed(lambda: d.get("/readyz", timeout=60))
+    db = ((r.json() or {}).get("checks") or {}).get("database") if hasattr(r, "json") else None
+    check(status_of(r) == 503 and db == "busy", "/readyz 503 database busy while another "
+          "process holds the write lock (%s %r)" % (status_of(r), db))
+    check(took <= timescale.scaled(2.0), "/readyz answered in %.2f s behind 12 waiting POSTs "
+          "(bound %.1f s)" % (took, timescale.scaled(2.0)))
+    r, took = timed(lambda: d.get("/metrics", timeout=60))
+    check(status_of(r) == 200 and took <= timescale.scaled(2.0),
+          "/metrics answers (%s in %.2f s)" % (status_of(r), took))
+    r, took = timed(lambda: d.get("/v1/analyses/" + done_id, timeout=60))
+    check(status_of(r) == 200, "a GET of a finished job answers (%s in %.2f s)"
+          % (status_of(r), took))
+    for t in threads:
+        t.join(timescale.budget(150))
+    codes = sorted(set(str(status_of(v)) for v, _ in results))
+    check(len(results) == 12 and all(status_of(v) == 503 and "Retry-After" in v.headers
+                                     for v, _ in results),
+          "12 concurrent POSTs answer 503 + Retry-After (%s)" % codes)
+    worst = max((t for _, t in results), default=0.0)
+    check(worst <= timescale.scaled(8.0), "the slowest POST answered in %.2f s: --db-timeout "
+          "5 s bounds the wait for the writer and the lock together (bound %.1f s)"
+          % (worst, timescale.scaled(8.0)))
+    con.rollback()
+    con.close()
+    check(wait_until(lambda: d.get("/readyz").status == 200, 10), "/readyz 200 once the lock "
+          "is let go")
+    r = d.request("POST", "/v1/analyses?wait=30", body=angled_sweep(2, 20.0), headers=js)
+    check(r.status == 200 and r.json().get("state") == "done",
+          "the same request runs now (%s)" % r.status)
+    check(d.stop() == 0, "daemon stops cleanly")
+
+
+def job_bytes(d, job):
+    """What one job stores: its request, result and CSV texts."""
+    n = 0
+    for path in ("/request", "/result", "/result?format=csv"):
+        r = d.get("/v1/analyses/" + job + path)
+        n += len(r.body) if r.status == 200 else 0
+    return n
+
+
+def retention_run(d, budget, n_jobs, first):
+    """n_jobs distinct sweeps from 3 client threads while a sampler reads the live size;
+    (largest live size seen, largest job stored, jobs done)."""
+    import threading
+    js = {"Content-Type": "application/json"}
+    seen, ids, stop = [0], [], threading.Event()
+
+    def sample():
+        while not stop.is_set():
+            v = metric(d, "spinmodal_store_live_bytes")
+            if v is not None:
+                seen[0] = max(seen[0], int(v))
+            time.sleep(0.05)
+
+    def client(k):
+        for i in range(k, n_jobs, 3):
+            r = d.request("POST", "/v1/analyses?wait=%g" % timescale.wait_param(30),
+                          body=angled_sweep(2, first + 0.01 * i), headers=js)
+            if r.status == 200 and r.json().get("state") == "done":
+                ids.append(r.json()["id"])
+            else:
+                print("job %d: %s %s" % (i, r.status, r.text(200)))
+    sampler = threading.Thread(target=sample)
+    sampler.start()
+    clients = [threading.Thread(target=client, args=(k,)) for k in range(3)]
+    for t in clients:
+        t.start()
+    for t in clients:
+        t.join(timescale.budget(300))
+    stop.set()
+    sampler.join()
+    v = metric(d, "spinmodal_store_live_bytes")
+    seen[0] = max(seen[0], int(v or 0))
+    biggest = max((job_bytes(d, j) for j in ids[-3:]), default=0)
+    return seen[0], biggest, len(ids)
+
+
+def scenario_retention_budget(exe, tmp):
+    """Issue 23 item 9 (pruning): with --retain-bytes 3000000, 10 s of load left 40.9 MB live
+    (the bound ran every 10 minutes).  Now every submission and finish prunes the oldest
+    finished jobs when over the budget: under load from 3 clients the live data never
+    exceeds the budget by more than one job (plus 64 KiB of pages), on SQLite and (when its
+    server binaries are there) PostgreSQL."""
+    budget = 400000
+    args = ["--workers", "2", "--retain-bytes", str(budget), "--retain-age", "0"]
+    d = Daemon(exe, tmp, args, name="retain")
+    d.start()
+    live, one, n = retention_run(d, budget, 45, 1.0)
+    print("sqlite: %d jobs, one job stores %d bytes, live at most %d (budget %d)"
+          % (n, one, live, budget))
+    check(n == 45, "45 jobs done (%d)" % n)
+    check(one * 10 > budget, "the jobs overflow the budget several times (%d bytes each)" % one)
+    check(live <= budget + one + 65536, "SQLite: live data at most budget + one job + 64 KiB: "
+          "%d <= %d" % (live, budget + one + 65536))
+    check(metric(d, "spinmodal_store_pruned_jobs_total") >= 20,
+          "the pruned jobs are counted (%s)" % metric(d, "spinmodal_store_pruned_jobs_total"))
+    check(d.stop() == 0, "daemon stops cleanly")
+    from replicas_test import Postgres
+    pg = Postgres(tmp)
+    if pg.bindir is None:
+        print("no PostgreSQL server binaries: the PostgreSQL half is not run")
+        return
+    pg.start()
+    d = None
+    try:
+        d = Daemon(exe, tmp, args, db=pg.dsn(), name="retain-pg")
+        d.start()
+        live, one, n = retention_run(d, budget, 45, 2.0)
+        print("postgresql: %d jobs, one job stores %d bytes, live at most %d (budget %d)"
+              % (n, one, live, budget))
+        check(n == 45, "PostgreSQL: 45 jobs done (%d)" % n)
+        check(live <= budget + one + 65536, "PostgreSQL: live data at most budget + one job + "
+              "64 KiB: %d <= %d" % (live, budget + one + 65536))
+        check(d.stop() == 0, "daemon stops cleanly")
+        d = None
+    finally:
+        if d is not None:
+            d.kill()
+        pg.remove()
 
 
 def main():
