@@ -42,9 +42,13 @@ typedef struct codec_limits {
     int max_elements;         /* FE elements summed over all members, default 2000 */
     int max_speeds;           /* entries of analysis.omega, default 1001 */
     int max_modes;            /* analysis.modes, default 200 */
-    long max_shape_values;    /* numbers in the mode shapes of a result (speeds x modes x
-                                 nodes x 3, 6 for a spatial request, x 2 with Coriolis),
-                                 default 4e6 (~90 MB JSON) */
+    long max_shape_values;    /* numbers in the mode shapes the solver holds for a result
+                                 (speeds x modes x nodes x 3, 6 for a spatial request, x 2
+                                 with Coriolis; 8 bytes each), default 4e6 (32 MB) */
+    size_t max_result_bytes;  /* bytes of the result document (JSON), estimated from the
+                                 request's counts before it is accepted (size.c: mode
+                                 shapes, equilibria, modes, critical speeds), default
+                                 50 000 000; 0 = no limit */
     int max_coordinates;      /* modal coordinates of a model solved by the dense path (cost
                                  ~ n^3; models the tree-structured path takes are bounded by
                                  max_elements only), default 4000 */
@@ -225,6 +229,18 @@ const char *codec_case_status_name(sm_case_status s);
  */
 int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
                         const sm_result *res);
+
+/** The dump flags of a stored result document: compact, reals with 17 significant digits. */
+#define CODEC_RESULT_DUMP (JSON_COMPACT | JSON_REAL_PRECISION(17))
+
+/**
+ * codec_result_encode's document as text, the bytes of json_dumps(document,
+ * CODEC_RESULT_DUMP), written one case at a time so that no tree of the whole
+ * document is held beside the text.  *out receives a malloc'd NUL-terminated
+ * string (free), *len its length (len may be NULL).  Returns SM_OK or SM_NOMEM.
+ */
+int codec_result_text(char **out, size_t *len, const codec_request *r, const sm_model *m,
+                      const sm_result *res);
 
 /**
  * Encode the frequency table as CSV (header omega,mode,frequency_rad_s,

@@ -2,8 +2,8 @@
  * limits.c — the default size limits of a request (codec_limits).
  *
  * How it fits: validate.c checks every count in a request (joints,
- * elements, speeds, modes, output size) against a codec_limits before
- * anything is allocated from it; request.c checks the text length.  The
+ * elements, speeds, modes, the size of the result) against a codec_limits
+ * before anything is allocated from it; request.c checks the text length.  The
  * daemon starts from these defaults and overrides them from its
  * configuration; the CLI uses them as they are.
  */
@@ -20,6 +20,7 @@ void codec_default_limits(codec_limits *lim)
     lim->max_speeds = 1001;
     lim->max_modes = 200;
     lim->max_shape_values = 4000000;
+    lim->max_result_bytes = 50000000;
     lim->max_coordinates = 4000;
     lim->max_frame_dofs = 1200;
 }

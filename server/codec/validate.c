@@ -9,7 +9,8 @@
  * analysis) and never stops at the first error: each field is checked
  * (type, range, references, unknown keys) with the readers of field.c, and
  * each error carries the JSON pointer of its field.  The limits of
- * codec_limits are checked before anything is built from a count.
+ * codec_limits are checked before anything is built from a count; the
+ * size of the result last, from all the counts (size.c).
  *
  * Planar or spatial (DESIGN.md 7.3): the sections decide (section.c tells
  * the form of each).  They must all be of one kind; the spatial fields of
@@ -746,28 +747,6 @@ static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
 }
 
 /*
- * Size of the mode shapes in the result: speeds x modes x nodes x 3
- * (6 for a spatial request; x 2 with Coriolis: complex shapes) against
- * max_shape_values.
- */
-static void val_output_size(val_ctx *v, const json_t *canon)
-{
-    const json_t *an = json_object_get(canon, "analysis");
-    double speeds = (double)spd_count(an);
-    double modes = (double)json_integer_value(json_object_get(an, "modes"));
-    double nodes = (double)v->total_elements + 1; /* a tree of elements */
-    double values = speeds * modes * nodes * (v->spatial == 1 ? 6 : 3) *
-                    (json_is_true(json_object_get(an, "coriolis")) ? 2 : 1);
-
-    if (!json_is_true(json_object_get(an, "mode_shapes")) || !(values > v->lim->max_shape_values))
-        return;
-    field_error(v, "/analysis/mode_shapes",
-                "mode shapes for %.0f speeds x %.0f modes x %.0f nodes "
-                "would be %.0f numbers: the limit is %ld; set mode_shapes to false or ask for "
-                "fewer speeds or modes", speeds, modes, nodes, values, v->lim->max_shape_values);
-}
-
-/*
  * Validate root; returns the canonical request (new) or NULL, and in
  * *structure the canonical structure the core's arrays come from (new, or
  * NULL): the request's, or the one its "blade" stands for (blade.c).
@@ -798,7 +777,7 @@ static json_t *val_document(val_ctx *v, const json_t *root, json_t **structure)
     val_frames(v, root, canon);
     val_analysis(v, root, canon);
     if (json_object_get(canon, "analysis") && *structure)
-        val_output_size(v, canon);
+        size_check(v, canon, *structure); /* the result's size (size.c) */
     return canon;
 }
 
