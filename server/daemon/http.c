@@ -353,7 +353,8 @@ static enum MHD_Result http_first(struct MHD_Connection *c, http_req *r)
     }
     if (http_has_body(c))
         return http_answer(c, r);
-    return MHD_YES;
+    /* complete: not a connection to shed; one shed already is not served (http_guard.c) */
+    return http_guard_answering(r->h, c) ? MHD_NO : MHD_YES;
 }
 
 static http_req *http_req_new(http *h, const char *url, const char *method)
@@ -394,7 +395,8 @@ static enum MHD_Result http_handler(void *cls, struct MHD_Connection *c, const c
             return http_early_too_large(c, r);
         return MHD_YES;
     }
-    http_guard_answering(h, c);
+    if (http_guard_answering(h, c))
+        return MHD_NO;
     if (r->collect && r->route == R_IMPORT)
         return http_import_end(c, r);
     return r->collect ? http_post_end(c, r) : http_answer(c, r);
@@ -496,6 +498,10 @@ static void http_mhd_log(void *cls, const char *fmt, va_list ap)
     n = strlen(msg);
     while (n > 0 && (msg[n - 1] == '\n' || msg[n - 1] == '\r'))
         msg[--n] = '\0';
+    /* our own MHD_NO (a connection the guard shed, a raw 413) is not an error; those are
+       counted and logged where they happen */
+    if (strncmp(msg, "Application reported internal error", 35) == 0)
+        return;
     log_event("warn", "http_error", "message", msg, (const char *)NULL);
 }
 

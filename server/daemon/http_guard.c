@@ -45,6 +45,14 @@
  * connections being answered and incomplete ones together stay under
  * held_cap while there are incomplete ones to close, so the slots kept
  * free stay free for /livez, /readyz, /metrics and writes.
+ *
+ * Under a flood that polls again at once and reopens what is closed (the
+ * attack tool's 'polls'), three things ate the slots kept free: released
+ * long polls still finishing their slice (at most max_waiters / 2 now, see
+ * http_waiter_make_room), connections shut down but not yet closed by
+ * their starved threads (counted in n_dying and shed for), and shed
+ * connections whose request had been read meanwhile (not served:
+ * http_guard_answering says so).
  */
 #include "http_internal.h"
 
@@ -52,6 +60,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/ioctl.h>
 #include <sys/socket.h>
 #include <time.h>
 
@@ -63,8 +72,11 @@ struct http_conn {
     double deadline;         /* monotonic s; 0 = none (a request is being answered) */
     int expired;             /* 1 once the guard shut the socket down */
     int served;              /* 1 once a request on it was answered (idle keep-alive) */
+    unsigned spared;         /* the shed round that found its request arriving */
     struct http_conn *prev, *next;
 };
+
+#define HTTP_SHED_SPARE 16 /* most connections with a request arriving spared per shed */
 
 /* 1 when a should be shed before b: idle keep-alive first, then the nearest deadline. */
 static int http_guard_before(const http_conn *a, const http_conn *b)
@@ -88,29 +100,46 @@ void http_guard_set_caps(http *h, int connection_limit, int max_waiters)
  * Called with guard_lock held after a connection was added (except = the
  * newcomer) or went back to waiting for a request (except NULL): while more
  * than held_cap connections are open (waiting for their request, being
- * answered or in a long poll), shut down one waiting for its request, never
+ * answered or in a long poll; or shut down and not yet closed: those hold a
+ * slot of libmicrohttpd's too), shut down one waiting for its request, never
  * `except`: an idle keep-alive connection (already served) first, then the
  * one with the nearest deadline.  So a new client whose first request is on
  * its way is not closed for connections that were answered (the long polls
  * answered early).  The second call matters when libmicrohttpd is at its
  * limit and accepts nobody: closing idle connections frees slots.
+ *
+ * A candidate whose socket holds unread bytes has a request arriving (a
+ * probe whose thread has not run yet, under load): it is spared, up to
+ * HTTP_SHED_SPARE of them per call, so a flood that reopens connections as
+ * fast as they close cannot make a probe the oldest and have it closed.
+ * Tricklers are read as their bytes come, so their sockets are empty.
  */
 static void http_guard_shed(http *h, const http_conn *except)
 {
     http_conn *k, *oldest;
+    unsigned round = ++h->shed_round;
+    int spared = 0, n, excess = h->n_held + h->n_dying - h->held_cap;
 
-    while (h->n_held > h->held_cap) {
+    while (excess > 0) {
         oldest = NULL;
         for (k = h->conns; k; k = k->next)
-            if (!k->expired && k->deadline > 0.0 && k != except &&
+            if (!k->expired && k->deadline > 0.0 && k != except && k->spared != round &&
                 (!oldest || http_guard_before(k, oldest)))
                 oldest = k;
         if (!oldest)
             return;
+        n = 0;
+        if (spared < HTTP_SHED_SPARE && ioctl(oldest->fd, FIONREAD, &n) == 0 && n > 0) {
+            oldest->spared = round;
+            spared++;
+            continue;
+        }
         oldest->expired = 1;
         shutdown(oldest->fd, SHUT_RDWR);
         h->shed_pending++;
         h->n_held--;
+        h->n_dying++;
+        excess--;
     }
 }
 
@@ -147,6 +176,8 @@ void http_guard_notify(void *cls, struct MHD_Connection *c, void **socket_contex
     pthread_mutex_lock(&h->guard_lock);
     if (!k->expired)
         h->n_held--;
+    else
+        h->n_dying--;
     if (k->prev)
         k->prev->next = k->next;
     else
@@ -167,15 +198,18 @@ static http_conn *http_guard_of(struct MHD_Connection *c)
     return ci ? ci->socket_context : NULL;
 }
 
-void http_guard_answering(http *h, struct MHD_Connection *c)
+int http_guard_answering(http *h, struct MHD_Connection *c)
 {
     http_conn *k = http_guard_of(c);
+    int expired;
 
     if (!k)
-        return;
+        return 0;
     pthread_mutex_lock(&h->guard_lock);
     k->deadline = 0.0;
+    expired = k->expired;
     pthread_mutex_unlock(&h->guard_lock);
+    return expired;
 }
 
 void http_guard_answered(http *h, struct MHD_Connection *c)
@@ -195,27 +229,46 @@ void http_guard_answered(http *h, struct MHD_Connection *c)
 
 /* ------------------------------------------------------------- long polls */
 
-int http_waiter_join(http *h, http_waiter *w)
+/*
+ * Over the cap, a newcomer releases the oldest waiter, which answers at the
+ * end of its slice (up to HTTP_WAIT_SLICE later) and holds its slot until
+ * then.  A flood that polls again at once could keep hundreds of them so
+ * (the connection limit reached, probes refused): at most half as many
+ * as max_waiters (at least one) may be finishing at a time; past that the
+ * newcomer is the one answered at once.  Both count as answered early.
+ * Called with guard_lock held; 0 = join, -1 = answer at once.
+ */
+static int http_waiter_make_room(http *h)
 {
     http_waiter *old;
+    int releasing_cap = h->max_waiters / 2 > 1 ? h->max_waiters / 2 : 1;
 
+    if (h->n_waiters < h->max_waiters)
+        return 0;
+    h->released_pending++;
+    h->released_total++;
+    old = h->waiters;
+    if (!old || h->n_releasing >= releasing_cap)
+        return -1;
+    h->waiters = old->next;
+    if (h->waiters)
+        h->waiters->prev = NULL;
+    else
+        h->waiters_tail = NULL;
+    old->prev = old->next = NULL;
+    old->released = 1;
+    h->n_waiters--;
+    h->n_releasing++;
+    return 0;
+}
+
+int http_waiter_join(http *h, http_waiter *w)
+{
     memset(w, 0, sizeof(*w));
     pthread_mutex_lock(&h->guard_lock);
-    if (h->max_waiters <= 0) {
+    if (h->max_waiters <= 0 || http_waiter_make_room(h)) {
         pthread_mutex_unlock(&h->guard_lock);
         return -1;
-    }
-    if (h->n_waiters >= h->max_waiters && (old = h->waiters) != NULL) {
-        h->waiters = old->next; /* release the oldest: it answers at its next slice */
-        if (h->waiters)
-            h->waiters->prev = NULL;
-        else
-            h->waiters_tail = NULL;
-        old->prev = old->next = NULL;
-        old->released = 1;
-        h->n_waiters--;
-        h->released_pending++;
-        h->released_total++;
     }
     w->prev = h->waiters_tail;
     if (h->waiters_tail)
@@ -251,6 +304,8 @@ void http_waiter_leave(http *h, http_waiter *w)
         else
             h->waiters_tail = w->prev;
         h->n_waiters--;
+    } else {
+        h->n_releasing--;
     }
     w->prev = w->next = NULL;
     pthread_mutex_unlock(&h->guard_lock);
@@ -278,6 +333,7 @@ static int http_guard_sweep(http *h, double now)
             k->expired = 1;
             shutdown(k->fd, SHUT_RDWR);
             h->n_held--;
+            h->n_dying++;
             n++;
         }
     return n;

@@ -101,11 +101,14 @@ struct http {
     pthread_cond_t guard_cv; /* wakes the guard thread to stop */
     http_conn *conns;        /* open connections, newest first */
     int n_held;              /* of those, not yet shut down by the guard */
+    int n_dying;             /* shut down, not yet closed by libmicrohttpd */
     int held_cap;            /* most connections held before one waiting for its
                                 request is closed (the rest is kept for newcomers) */
     int shed_pending;        /* connections closed at accept and not yet logged */
+    unsigned shed_round;     /* counts the calls of http_guard_shed (its spared marks) */
     http_waiter *waiters, *waiters_tail; /* waiting long polls, oldest first */
     int n_waiters;           /* in the list */
+    int n_releasing;         /* released from it, not yet answered */
     int max_waiters;         /* --max-waiters; 0 = ?wait never blocks */
     int released_pending;    /* long polls answered early, not yet logged */
     unsigned long long released_total; /* long polls answered early for a newer one */
@@ -261,8 +264,13 @@ enum MHD_Result http_import_end(struct MHD_Connection *c, http_req *r);
 void http_guard_notify(void *cls, struct MHD_Connection *c, void **socket_context,
                        enum MHD_ConnectionNotificationCode code);
 
-/** The request on c is complete and being answered: no deadline until it is answered. */
-void http_guard_answering(http *h, struct MHD_Connection *c);
+/**
+ * The request on c is complete and being answered: no deadline until it is
+ * answered.  Returns 1 when the guard has already shut the connection down
+ * (shed, or past its deadline, while its request was read): close it
+ * without serving it (a long poll would hold the slot for nothing).
+ */
+int http_guard_answering(http *h, struct MHD_Connection *c);
 
 /** The request on c was answered: the next one must arrive within the deadline. */
 void http_guard_answered(http *h, struct MHD_Connection *c);
