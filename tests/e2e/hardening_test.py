@@ -783,8 +783,10 @@ def queue_behind_sweeps(d, n_sweeps, first):
 def long_poll_flood(d, job, n, sources, batch):
     """n GET ?wait=60 of job from `sources` addresses (127.0.0.2 ...), opened in batches; after
     each batch, until the daemon counts them all (waiting + released; skipped when /metrics
-    does not answer or lacks the counts), so that batches register in order.  The opened
-    exchanges, oldest first, and how many connects failed."""
+    does not answer or lacks the counts) and the released ones have answered, so that batches
+    register in order (in a burst, a released poll still finishing its slice makes room for
+    at most max_waiters / 2 newer ones; past that a newcomer is answered at once).  The
+    opened exchanges, oldest first, and how many connects failed."""
     req = ("GET /v1/analyses/%s?wait=60 HTTP/1.1\r\nHost: x\r\n\r\n" % job).encode()
     polls, refused, counted = [], 0, True
     for i in range(n):
@@ -799,6 +801,8 @@ def long_poll_flood(d, job, n, sources, batch):
             if counted:
                 wait_until(lambda: (lambda w: w[0] is not None and w[2] is not None and
                                     w[0] + w[2] >= k)(waiter_metrics(d)), 10)
+                rel = waiter_metrics(d)[2] or 0
+                wait_until(lambda: sum(p.pump() for p in polls) >= rel, 10)
     return polls, refused
 
 
@@ -897,10 +901,13 @@ def post_waiter(exe, tmp):
     order = []
 
     def add(data):
+        """One more long poll, once the daemon counts it and the ones it released answered."""
         order.append(RawExchange("127.0.0.2", d.port, data))
         k = len(order)
-        return wait_until(lambda: (lambda w: w[0] is not None and w[0] + w[2] >= k)(
+        wait_until(lambda: (lambda w: w[0] is not None and w[0] + w[2] >= k)(
             waiter_metrics(d)), 10)
+        rel = waiter_metrics(d)[2] or 0
+        wait_until(lambda: sum(p.pump() for p in order) >= rel, 10)
     try:
         for _ in range(4):
             add(get)
