@@ -330,7 +330,7 @@ static int plaus_round(double x)
 {
     double n = x / warn_rules[WARN_ROUND].lo;
 
-    return x > 0 && fabs(n - nearbyint(n)) <= 1e-6 * fmax(1.0, n);
+    return x > 0 && fabs(n - nearbyint(n)) <= 1e-9 * fmax(1.0, n); /* decimal to binary */
 }
 
 /*
