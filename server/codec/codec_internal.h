@@ -15,6 +15,7 @@
  *   plausible.c the dimensionless groups of those warnings (wave speed,
  *               radius of gyration, tip speed, centrifugal strain)   plaus_
  *   validate.c  the request document walked field by field           val_
+ *   size.c      the size of a request's result, before it is accepted size_
  *   request.c   canonical text, SHA-256, the core's arrays           req_
  *   diag.c      core diagnostics -> pointers, codec_model_new        diag_
  *   result.c    the result document (DESIGN.md section 4)            res_
@@ -311,6 +312,16 @@ json_t *val_request(const json_t *root, const codec_limits *lim, codec_errors *e
  * walk of validate.c; blade.c checks its expanded structure with it).
  */
 void val_structure(val_ctx *v, const json_t *root, json_t *canon);
+
+/* ========================================================= size.c: size_ */
+
+/**
+ * The size of the result of a request checked so far (canon: its canonical request,
+ * structure: the canonical structure it is built from; both borrowed): the estimated bytes
+ * of the result document against max_result_bytes (0: no limit) and the mode-shape numbers
+ * against max_shape_values, each over its limit one error naming what to reduce.
+ */
+void size_check(val_ctx *v, const json_t *canon, const json_t *structure);
 
 /* ======================================================== blade.c: blade_ */
 
