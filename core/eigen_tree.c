@@ -29,6 +29,13 @@
  * carries ~cond(K*) eps and the frequencies wander by ~2e-9 between bases), the noise-limited
  * acceptance: residual below 1e-7 and frequencies steady to 1e-8. */
 #define EIG_TREE_LATE 48
+/* From ~40 modes on, the Ritz vectors of the highest modes stall at relative residuals of 1e-7 to
+ * 3e-5 (their error lies along stiff directions that shift-invert at zero resolves last, and the
+ * residual weighs it by K) while every frequency is steady to 1e-11: 48, 64 and 100 modes of a
+ * 150-element spatial blade agree with the dense path within 2e-10 (test_tree3_solve; issue 23:
+ * they fell back to the dense path, 7 s a speed there, 4 min at 666 elements).  Accepted below EIG_TREE_SHAPE_FLOOR once the frequencies
+ * are steady to EIG_TREE_STALL between two bases. */
+#define EIG_TREE_SHAPE_FLOOR 1e-4
 #define EIG_TREE_MAX_BASIS 240
 #define EIG_TREE_STEP 8
 
@@ -304,7 +311,8 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, sm_ei
             have_prev = 1;
         }
         if (res <= EIG_TREE_TOL || (res <= EIG_TREE_FLOOR && moved <= EIG_TREE_STALL) ||
-            (p >= EIG_TREE_LATE && res <= 1e-7 && moved <= 1e-8)) {
+            (p >= EIG_TREE_LATE && res <= 1e-7 && moved <= 1e-8) ||
+            (res <= EIG_TREE_SHAPE_FLOOR && moved <= EIG_TREE_STALL)) {
             out->negative = t->neg;
             *fallback = 0;
             break;

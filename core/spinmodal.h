@@ -184,8 +184,19 @@ typedef enum sm_basis {
 /** Most engine orders one solve looks for (sm_options.engine_orders, DESIGN.md 9.1). */
 #define SM_MAX_ENGINE_ORDERS 16
 
-/** Default of sm_options.max_dense_coordinates (the daemon's --max-coordinates default). */
-#define SM_DENSE_MAX_DEFAULT 4000
+/** Default of sm_options.max_dense_coordinates (the daemon's --max-coordinates default): one
+ * dense eigen-analysis with Coriolis at 1000 coordinates is ~5.6 s and ~200 MB (issue 23: 4000
+ * was 100 s to 6 min and 2.3 GB a speed). */
+#define SM_DENSE_MAX_DEFAULT 1000
+
+/** Most modes the structured (tree) eigen-analysis is asked for: its Krylov basis is at most 240
+ * vectors, about 3.5 a mode; more modes take the dense path (issue 23). */
+#define SM_TREE_MAX_MODES 64
+
+/** Estimated seconds of one dense eigen-analysis of n coordinates on one core (measured: 0.15 s
+ * at 300, 1.0 s at 600, 9.6 s at 1200 with Coriolis; a sixth of that without): what the daemon's
+ * request check weighs against its job time limit.  A rough bound, not a promise. */
+double sm_dense_seconds(int n, int coriolis);
 
 /** Analysis options; fill with sm_default_options first. */
 typedef struct sm_options {
@@ -406,6 +417,8 @@ typedef struct sm_case {
     double *shape_im;         /* same, NULL without Coriolis or mode shapes */
     /* timing, ms */
     double t_equilibrium, t_linearize, t_eigen;
+    int dense_fallback;       /* 1 when the structured (tree) eigen-analysis gave way to the dense
+                                 one at this speed (K* indefinite or singular, no convergence) */
     /* error estimate (sm_estimate; NULL until it ran): n_modes each, NaN where none */
     double *error_estimate;   /* estimated |frequency - converged beam-model frequency|, rad/s */
     double *error_order;      /* convergence order used: observed, or SM_ESTIMATE_ORDER */
@@ -483,6 +496,9 @@ typedef struct sm_result {
     sm_critical *critical;    /* n_critical, by order then speed, or NULL */
     int n_divergence;         /* divergence speeds found in the sweep */
     sm_divergence *divergence; /* n_divergence, ascending, or NULL */
+    int refine_stopped;       /* 1 when cb asked to stop after every speed was solved: the
+                                 critical and divergence speeds were not (all) refined, and
+                                 those lists may be incomplete; the cases are whole */
 } sm_result;
 
 /** The text of a label: "1st flap", "2nd edge", "3rd torsion", "1st axial", "1st bending",
@@ -502,6 +518,8 @@ const char *sm_mode_kind_name(int kind);
  * Returns SM_OK (every case has a status), SM_CANCELED, SM_NOMEM,
  * SM_INVALID_INPUT (bad speeds) or SM_LAPACK_FAILED.  *out is set only on
  * SM_OK and is owned by the caller (sm_result_free).  cb and diag may be NULL.
+ * A stop asked by cb once every speed is solved never discards them: the
+ * result is SM_OK with refine_stopped set (issue 23).
  */
 int sm_solve(const sm_model *m, const double *omegas, int n_omegas,
              sm_progress_fn cb, void *user, sm_result **out, sm_diag *diag);

@@ -298,7 +298,8 @@ static int sweep_eigen(const sm_model *m, const double *q, sweep_lin *L, sweep_l
             else
                 snprintf(c->message, sizeof c->message,
                          "the structured eigen-analysis cannot give these modes (K* singular, too few "
-                         "coordinates for the modes asked, or no convergence), and the dense one is "
+                         "coordinates for the modes asked, or no convergence: many equal frequencies), "
+                         "and the dense one is "
                          "limited to %d coordinates (this model has %d)",
                          dmax, m->n);
             return SM_LIMIT;
@@ -306,6 +307,7 @@ static int sweep_eigen(const sm_model *m, const double *q, sweep_lin *L, sweep_l
         if ((rc = sweep_lin_alloc(m, D, 0)) < 0) /* the dense path decides */
             return rc;
         *use = D;
+        c->dense_fallback = 1;
         t0 = sweep_ms();
     }
     sweep_linearize(m, q, c->omega, *use);
@@ -489,7 +491,8 @@ static int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_p
             from_rest = 0;
         }
         pr.done = t + 1;
-        if (cb && cb(user, pr.done, pr.total)) {
+        /* after the last speed a stop request leaves the finished cases alone */
+        if (cb && cb(user, pr.done, pr.total) && pr.done < pr.total) {
             rc = SM_CANCELED;
             goto fail;
         }
@@ -570,9 +573,19 @@ static int sweep_trust(const sm_model *m, sm_result *r, const double *omegas, in
             goto done;
     if ((rc = track_sweep(r, ord, n)) < 0)
         goto done;
-    if ((rc = crit_find(m, r, ord, n, cb, user)) < 0)
+    /* the refinements are extra solves: a stop (cancel, time limit, shutdown) ends them and keeps
+     * what the sweep found */
+    if ((rc = crit_find(m, r, ord, n, cb, user)) == SM_CANCELED) {
+        r->refine_stopped = 1;
+        rc = SM_OK;
         goto done;
-    rc = div_find(m, r, ord, n, cb, user);
+    }
+    if (rc < 0)
+        goto done;
+    if ((rc = div_find(m, r, ord, n, cb, user)) == SM_CANCELED) {
+        r->refine_stopped = 1;
+        rc = SM_OK;
+    }
 done:
     free(ord);
     return rc;

@@ -80,7 +80,7 @@ int tree_choose(int solver, int n, int max_m, int modes)
         return 0;
     if (solver == SM_SOLVER_TREE)
         return 1;
-    return n >= TREE_AUTO_MIN_N && max_m <= TREE_MAX_FRAME_M && 8 * modes <= n;
+    return n >= TREE_AUTO_MIN_N && max_m <= TREE_MAX_FRAME_M && 8 * modes <= n && modes <= SM_TREE_MAX_MODES;
 }
 
 int tree_use(const sm_model *m)

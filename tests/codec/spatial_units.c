@@ -162,7 +162,7 @@ static void unit_encode(test_case *tc, const codec_request *req, const sm_model 
     double freq = 3, er = 0, ei = 3, mac = -1;
     int prev = -1, k;
     sm_case c;
-    sm_result res = {1, &c, 0, NULL, 0, NULL};
+    sm_result res = {1, &c, 0, NULL, 0, NULL, 0};
     json_t *doc = NULL, *model, *eq, *shape;
     const char *what = dof == 6 ? "spatial result" : "planar result";
 

@@ -13,6 +13,8 @@
 #include "testutil.h"
 
 static double tu_max_freq = 0, tu_max_eq = 0, tu_max_shape = 0;
+/* 1: the tree path must find the modes itself (no case may fall back to the dense eigen-analysis) */
+static int pc_tree_eigen = 0;
 
 static double reldiff(const double *a, const double *b, int n)
 {
@@ -77,6 +79,8 @@ static void compare(const char *name, const sm_structure *st, sm_options *o, con
         }
         tu_max_eq = fmax(tu_max_eq, de);
         TU_CHECK(de <= 1e-9, "%s W=%g: equilibrium differs by %.2e", name, om[i], de);
+        TU_CHECK(!pc_tree_eigen || !b->dense_fallback, "%s W=%g: the tree path fell back to the dense one",
+                 name, om[i]);
         TU_CHECK(a->n_modes == b->n_modes, "%s W=%g: modes %d/%d", name, om[i], a->n_modes, b->n_modes);
         int k = a->n_modes < b->n_modes ? a->n_modes : b->n_modes;
         double df = 0, ds = 0;

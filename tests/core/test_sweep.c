@@ -3,13 +3,22 @@
  * independent solves, results come back in input order for unsorted speeds,
  * modes are tracked by MAC (adjacent speeds: MAC near 1, index matched),
  * mode shapes are normalised (largest translation 1, clamp at rest), the
- * progress callback sees every speed and can cancel.
+ * progress callback sees every speed and can cancel, but a stop after the last speed
+ * keeps the solved cases (refine_stopped when it cut a refinement short).
  */
 #include "testutil.h"
 
 typedef struct prog {
     int calls, last_done, cancel_at;
 } prog;
+
+/* A stop that arrives with the last speed (a time limit, issue 23): returns 1 from done == total on. */
+static int stop_at_end(void *user, int done, int total)
+{
+    int *calls = user;
+    ++*calls;
+    return done >= total;
+}
 
 static int on_progress(void *user, int done, int total)
 {
@@ -76,6 +85,31 @@ int main(void)
     r = NULL;
     TU_CHECK(sm_solve(m, om, 6, on_progress, &p, &r, &d) == SM_CANCELED && r == NULL, "cancel returns SM_CANCELED");
     TU_CHECK(p.calls == 3, "no progress after cancel (%d calls)", p.calls);
+    /* a stop after every speed is solved keeps them (issue 23: a finished job was recorded
+     * "timeout" and its result thrown away) */
+    int calls = 0;
+    r = NULL;
+    TU_CHECK(sm_solve(m, om, 6, stop_at_end, &calls, &r, &d) == SM_OK && r, "a stop after the last speed: SM_OK");
+    for (int i = 0; r && i < 6; i++)
+        TU_CHECK(r->cases[i].status == SM_CASE_SOLVED && r->cases[i].n_modes == 3, "kept case %d", i);
+    TU_CHECK(r && !r->refine_stopped, "nothing to refine: refine_stopped 0");
+    sm_result_free(r);
+    /* ... and during the refinement of critical speeds: the cases stay, refine_stopped says so */
+    sm_model_free(m);
+    o.n_engine_orders = 1;
+    o.engine_orders[0] = 1;
+    TU_CHECK(sm_model_new(&m, &a.st, &o, &d) == SM_OK, "model with engine order 1");
+    r = NULL;
+    TU_CHECK(sm_solve(m, om, 6, NULL, NULL, &r, &d) == SM_OK && r && r->n_critical > 0 && !r->refine_stopped,
+             "without a stop the 1P crossing is refined (%d)", r ? r->n_critical : -1);
+    sm_result_free(r);
+    r = NULL;
+    calls = 0;
+    TU_CHECK(sm_solve(m, om, 6, stop_at_end, &calls, &r, &d) == SM_OK && r, "a stop during refinement: SM_OK");
+    TU_CHECK(r && r->refine_stopped && r->n_critical == 0, "refine_stopped 1, no unrefined critical speed");
+    for (int i = 0; r && i < 6; i++)
+        TU_CHECK(r->cases[i].status == SM_CASE_SOLVED && r->cases[i].n_modes == 3, "kept case %d", i);
+    sm_result_free(r);
     /* invalid speeds */
     double bad[2] = {1, -1};
     TU_CHECK(sm_solve(m, bad, 2, NULL, NULL, &r, &d) == SM_INVALID_INPUT && d.item_index == 1,
