@@ -28,6 +28,12 @@
  * "energy", "tracked_index", "tracking_flag", "tracking_partner", and the
  * document with "critical_speeds" when the request gives engine_orders;
  * appended likewise (frequencies and shapes are unchanged).
+ *
+ * Large results (issue 23 item 9): the daemon stores the text of the
+ * document, so codec_result_text writes it one case at a time (each case's
+ * tree is built, dumped and freed) instead of building the whole tree and
+ * dumping it: the text is the only whole copy held, with the same bytes as
+ * json_dumps(codec_result_encode's document, CODEC_RESULT_DUMP).
  */
 #include "codec_internal.h"
 
@@ -421,50 +427,159 @@ static int res_divergence_speeds(json_t *doc, const sm_result *res)
     return 0;
 }
 
-int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
-                        const sm_result *res)
+/* The document's members before "cases": "solver" and "model"; a new object, or NULL. */
+static json_t *res_head(const codec_request *r, const sm_model *m)
 {
-    json_t *doc = NULL, *cases;
-    const json_t *warnings = codec_request_input_warnings(r);
-    const double *rpm;
+    json_t *doc = json_object();
     sm_model_info info;
-    double te = 0, tl = 0, tg = 0;
-    int i, n_rpm;
 
-    *out = NULL;
     sm_model_get_info(m, &info);
-    doc = json_object();
-    if (!doc)
-        goto fail;
-    if (json_object_set_new(doc, "solver",
-                            json_pack("{s:s, s:s, s:s}", "name", "spinmodal", "version",
-                                      SM_VERSION, "request_sha256", codec_request_sha256(r))) ||
-        json_object_set_new(doc, "model", res_model(r, m, &info)))
-        goto fail;
-    cases = json_array();
-    if (json_object_set_new(doc, "cases", cases))
-        goto fail;
-    rpm = codec_request_rpm(r, &n_rpm);
+    if (doc && (json_object_set_new(doc, "solver",
+                                    json_pack("{s:s, s:s, s:s}", "name", "spinmodal", "version",
+                                              SM_VERSION, "request_sha256",
+                                              codec_request_sha256(r))) ||
+                json_object_set_new(doc, "model", res_model(r, m, &info)))) {
+        json_decref(doc);
+        return NULL;
+    }
+    return doc;
+}
+
+/*
+ * The document's members after "cases", set on doc: "timing_ms", "input_warnings",
+ * "refinement_stopped", "critical_speeds", "divergence_speeds".  Returns 0, or -1 out of memory.
+ */
+static int res_tail(json_t *doc, const codec_request *r, const sm_result *res)
+{
+    const json_t *warnings = codec_request_input_warnings(r);
+    double te = 0, tl = 0, tg = 0;
+    int i;
+
     for (i = 0; i < res->n_cases; i++) {
-        const sm_case *c = &res->cases[i];
-        if (json_array_append_new(cases, res_case(r, m, c, i < n_rpm ? rpm[i] : NAN)))
-            goto fail;
-        te += c->t_equilibrium;
-        tl += c->t_linearize;
-        tg += c->t_eigen;
+        te += res->cases[i].t_equilibrium;
+        tl += res->cases[i].t_linearize;
+        tg += res->cases[i].t_eigen;
     }
     if (json_object_set_new(doc, "timing_ms",
                             json_pack("{s:o, s:o, s:o}", "equilibrium", res_real(te),
                                       "linearize", res_real(tl), "eigen", res_real(tg))))
-        goto fail;
+        return -1;
     if (json_array_size(warnings) &&
         json_object_set_new(doc, "input_warnings", json_deep_copy(warnings)))
+        return -1;
+    if (res->refine_stopped &&
+        json_object_set_new(doc, "refinement_stopped",
+                            json_string("a stop (the job time limit, a cancel or a shutdown) came "
+                                        "after every speed was solved: the cases are whole, but "
+                                        "critical_speeds and divergence_speeds may be unrefined "
+                                        "or missing, and an error estimate asked for was not "
+                                        "made")))
+        return -1;
+    return res_critical_speeds(doc, r, res) || res_divergence_speeds(doc, res) ? -1 : 0;
+}
+
+/* Case i of res, with its rpm (as the request gave it, else from omega). */
+static json_t *res_case_at(const codec_request *r, const sm_model *m, const sm_result *res,
+                           int i)
+{
+    int n_rpm;
+    const double *rpm = codec_request_rpm(r, &n_rpm);
+
+    return res_case(r, m, &res->cases[i], i < n_rpm ? rpm[i] : NAN);
+}
+
+int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
+                        const sm_result *res)
+{
+    json_t *doc = res_head(r, m), *cases;
+    int i;
+
+    *out = NULL;
+    cases = json_array();
+    if (!doc || json_object_set_new(doc, "cases", cases))
         goto fail;
-    if (res_critical_speeds(doc, r, res) || res_divergence_speeds(doc, res))
+    for (i = 0; i < res->n_cases; i++)
+        if (json_array_append_new(cases, res_case_at(r, m, res, i)))
+            goto fail;
+    if (res_tail(doc, r, res))
         goto fail;
     *out = doc;
     return SM_OK;
 fail:
     json_decref(doc);
     return SM_NOMEM;
+}
+
+/* json_dump_callback into a codec_text (data); -1 stops the dump when out of memory. */
+static int res_put(const char *buffer, size_t size, void *data)
+{
+    codec_text *t = data;
+
+    codec_text_put(t, buffer, size);
+    return t->nomem ? -1 : 0;
+}
+
+/* Append x (stolen; NULL is out of memory) to t as CODEC_RESULT_DUMP text; 0 or -1. */
+static int res_dump(codec_text *t, json_t *x)
+{
+    int rc = x ? json_dump_callback(x, res_put, t, CODEC_RESULT_DUMP) : -1;
+
+    json_decref(x);
+    return rc || t->nomem ? -1 : 0;
+}
+
+/*
+ * The document as text, one case at a time: {head members, "cases": [case, case, ...], tail
+ * members}.  A compact dump writes an object as "{" members joined by "," "}", so the head
+ * without its "}", the cases and the tail with its "{" turned into "," are the bytes of the
+ * whole document's dump.
+ */
+static int res_text(codec_text *t, const codec_request *r, const sm_model *m,
+                    const sm_result *res)
+{
+    json_t *tail;
+    size_t at;
+    int i;
+
+    if (res_dump(t, res_head(r, m)))
+        return -1;
+    t->len--; /* the head's "}" */
+    codec_text_puts(t, ",\"cases\":[");
+    for (i = 0; i < res->n_cases; i++) {
+        if (i > 0)
+            codec_text_puts(t, ",");
+        if (res_dump(t, res_case_at(r, m, res, i)))
+            return -1;
+    }
+    codec_text_puts(t, "]");
+    tail = json_object();
+    if (!tail || res_tail(tail, r, res)) {
+        json_decref(tail);
+        return -1;
+    }
+    at = t->len;
+    if (res_dump(t, tail))
+        return -1;
+    t->p[at] = ','; /* the tail's "{" */
+    return 0;
+}
+
+int codec_result_text(char **out, size_t *len, const codec_request *r, const sm_model *m,
+                      const sm_result *res)
+{
+    codec_text t = {NULL, 0, 0, 0};
+    char *p;
+
+    *out = NULL;
+    if (len)
+        *len = 0;
+    if (res_text(&t, r, m, res) || t.nomem) {
+        codec_text_free(&t);
+        return SM_NOMEM;
+    }
+    p = realloc(t.p, t.len + 1); /* give back what the doubling left unused */
+    *out = p ? p : t.p;
+    if (len)
+        *len = t.len;
+    return SM_OK;
 }

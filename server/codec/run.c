@@ -120,13 +120,19 @@ static int run_outcome_of(const sm_result *res, codec_run_out *out)
     return out->error ? SM_OK : SM_NOMEM;
 }
 
-/* The documents of want for a solved result; SM_OK or SM_NOMEM. */
+/*
+ * The documents of want for a solved result; SM_OK or SM_NOMEM.  The CSV (small) first, so
+ * the text of a large result is the last thing allocated while the solver's numbers are held.
+ */
 static int run_encode(const codec_request *req, const sm_model *m, const sm_result *res,
                       unsigned want, codec_run_out *out)
 {
+    if ((want & CODEC_RUN_CSV) && codec_result_csv(&out->csv, &out->csv_len, req, res) != SM_OK)
+        return SM_NOMEM;
     if ((want & CODEC_RUN_JSON) && codec_result_encode(&out->result, req, m, res) != SM_OK)
         return SM_NOMEM;
-    if ((want & CODEC_RUN_CSV) && codec_result_csv(&out->csv, &out->csv_len, req, res) != SM_OK)
+    if ((want & CODEC_RUN_TEXT) &&
+        codec_result_text(&out->result_text, &out->result_len, req, m, res) != SM_OK)
         return SM_NOMEM;
     return run_outcome_of(res, out);
 }
@@ -226,6 +232,13 @@ codec_run_outcome codec_run(const codec_request *req, unsigned want, sm_progress
         out->seconds = run_clock() - t0;
         if (st == SM_NOMEM)
             goto nomem;
+        if (st == SM_CANCELED) { /* every speed is solved: keep them, without the estimate */
+            res->refine_stopped = 1;
+            out->outcome = CODEC_RUN_DONE;
+            out->status = SM_OK;
+            out->speeds_done = n;
+            st = SM_OK;
+        }
         if (st != SM_OK)
             goto done;
     }
@@ -234,9 +247,12 @@ codec_run_outcome codec_run(const codec_request *req, unsigned want, sm_progress
     goto done;
 nomem:
     json_decref(out->result);
+    free(out->result_text);
     free(out->csv);
     free(out->error);
     out->result = NULL;
+    out->result_text = NULL;
+    out->result_len = 0;
     out->csv = NULL;
     out->csv_len = 0;
     out->status = SM_NOMEM;
@@ -253,6 +269,7 @@ void codec_run_clear(codec_run_out *out)
     if (!out)
         return;
     json_decref(out->result);
+    free(out->result_text);
     free(out->csv);
     free(out->error);
     memset(out, 0, sizeof(*out));

@@ -37,7 +37,9 @@ typedef enum codec_run_outcome {
 /** Documents codec_run writes (bits of want). */
 enum {
     CODEC_RUN_JSON = 1,   /* the result document (DESIGN.md §4) */
-    CODEC_RUN_CSV = 2     /* the frequency table */
+    CODEC_RUN_CSV = 2,    /* the frequency table */
+    CODEC_RUN_TEXT = 4    /* the result document as text (codec_result_text: one case at a
+                             time, no tree of the whole document) */
 };
 
 /** Output of codec_run; release with codec_run_clear. */
@@ -45,6 +47,9 @@ typedef struct codec_run_out {
     codec_run_outcome outcome;
     int status;           /* sm_status of the core step that ended the run (SM_OK: DONE, PARTIAL) */
     json_t *result;       /* result document (CODEC_RUN_JSON; DONE, PARTIAL), owned */
+    char *result_text;    /* result document as text, malloc'd (CODEC_RUN_TEXT; DONE,
+                             PARTIAL); a caller may take it (and set it NULL) */
+    size_t result_len;    /* bytes of result_text */
     char *csv;            /* frequency table, malloc'd (CODEC_RUN_CSV; DONE, PARTIAL) */
     size_t csv_len;       /* bytes of csv */
     char *error;          /* the job's error object as JSON text (PARTIAL, INVALID, FAILED,

@@ -119,6 +119,7 @@ typedef struct jobs_outcome_rec {
     store_state state;       /* DONE, FAILED, CANCELED; QUEUED = requeue */
     char *error;             /* JSON text or NULL */
     char *result;            /* JSON text or NULL */
+    size_t result_len;       /* bytes of result */
     char *csv;               /* CSV text or NULL */
     size_t csv_len;
     int speeds_done;
@@ -175,6 +176,27 @@ static void jobs_stopped(jobs *j, jobs_slot *slot, int total, jobs_outcome_rec *
 }
 
 /*
+ * A result over --max-result-bytes although its request passed the estimate
+ * (codec size.c, an upper bound but for what the counts cannot bound:
+ * critical speeds beyond two per mode and engine order): the job fails with
+ * the reason instead of storing it.  Returns 1 then (rec filled), else 0.
+ */
+static int jobs_too_large(jobs *j, const codec_run_out *out, jobs_outcome_rec *rec)
+{
+    size_t lim = j->cfg.limits.max_result_bytes;
+    char detail[256];
+
+    if (lim == 0 || out->result_len <= lim)
+        return 0;
+    snprintf(detail, sizeof(detail),
+             "the result is %zu bytes, more than the limit of %zu (--max-result-bytes); ask "
+             "for fewer speeds, modes or engine orders, or leave mode_shapes out",
+             out->result_len, lim);
+    jobs_fail(rec, "result_too_large", "Result too large", detail);
+    return 1;
+}
+
+/*
  * Run the claimed job through the codec's pipeline (parse the stored
  * canonical request, then codec_run); fills rec.
  */
@@ -202,7 +224,7 @@ static void jobs_run(jobs *j, jobs_slot *slot, const store_job *job, jobs_outcom
             codec_errors_to_json(errs), NULL);
         goto done;
     }
-    codec_run(req, CODEC_RUN_JSON | CODEC_RUN_CSV, jobs_progress_cb, &ctx, errs, &out);
+    codec_run(req, CODEC_RUN_TEXT | CODEC_RUN_CSV, jobs_progress_cb, &ctx, errs, &out);
     rec->solve_seconds = out.seconds;
     rec->speeds_done = out.speeds_done;
     switch (out.outcome) {
@@ -211,12 +233,13 @@ static void jobs_run(jobs *j, jobs_slot *slot, const store_job *job, jobs_outcom
         goto done;
     case CODEC_RUN_DONE:
     case CODEC_RUN_PARTIAL:
-        rec->result = json_dumps(out.result, JSON_COMPACT | JSON_REAL_PRECISION(17));
-        if (!rec->result)
-            goto nomem;
+        if (jobs_too_large(j, &out, rec))
+            goto done;
+        rec->result = out.result_text; /* taken over: the one copy, handed to the store */
+        rec->result_len = out.result_len;
         rec->csv = out.csv;
         rec->csv_len = out.csv_len;
-        out.csv = NULL;
+        out.result_text = out.csv = NULL;
         rec->state = out.outcome == CODEC_RUN_DONE ? STORE_DONE : STORE_FAILED;
         break;
     default: /* INVALID, FAILED, NOMEM: the pipeline wrote the error object */
@@ -350,8 +373,7 @@ static int jobs_finish_retrying(jobs *j, const char *id, const jobs_outcome_rec 
 
     for (;;) {
         rc = store_finish(j->st, id, rec->state, log_now(), rec->speeds_done, rec->error,
-                          rec->result, rec->result ? strlen(rec->result) : 0, rec->csv,
-                          rec->csv_len);
+                          rec->result, rec->result_len, rec->csv, rec->csv_len);
         if ((rc != STORE_UNAVAILABLE && rc != STORE_BUSY && rc != STORE_TIMEOUT) ||
             spent >= JOBS_FINISH_RETRY)
             return rc;
@@ -597,7 +619,7 @@ int jobs_start(jobs **out, store *st, metrics *mx, const jobs_config *cfg)
     if (j->cfg.queue_max < 1)
         j->cfg.queue_max = 1;
     if (!(j->cfg.job_timeout > 0))
-        j->cfg.job_timeout = 300;
+        j->cfg.job_timeout = 30;
     /* A stored request was accepted once: its body limit does not apply to
      * the canonical text (longer: defaults added, reals at 17 digits). */
     j->cfg.limits.max_request_bytes = (size_t)-1;

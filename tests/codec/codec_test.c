@@ -28,8 +28,8 @@
  * Before the folders a few unit checks run (SHA-256 vector, error list cap,
  * problem document, CSV encoder, diag pointers; spatial_units.c: spatial
  * diag pointers and result rows; blade_units.c: a solved blade's Hz,
- * per-rev and rpm).  One line per case; exit status 1 when
- * anything failed.
+ * per-rev and rpm; size_units.c: the result's text and size estimate).
+ * One line per case; exit status 1 when anything failed.
  */
 #include <dirent.h>
 #include <math.h>
@@ -110,6 +110,8 @@ static void apply_limits(codec_limits *lim, const json_t *spec)
         lim->max_request_bytes = (size_t)json_integer_value(x);
     if ((x = json_object_get(spec, "max_shape_values")))
         lim->max_shape_values = (long)json_integer_value(x);
+    if ((x = json_object_get(spec, "max_result_bytes")))
+        lim->max_result_bytes = (size_t)json_integer_value(x);
 #define LIMIT(f) if ((x = json_object_get(spec, #f))) lim->f = (int)json_integer_value(x);
     LIMIT(max_joints) LIMIT(max_sections) LIMIT(max_members) LIMIT(max_point_masses)
     LIMIT(max_elements) LIMIT(max_speeds) LIMIT(max_modes) LIMIT(max_coordinates)
@@ -802,7 +804,7 @@ static int cmp_name(const void *a, const void *b)
 int main(int argc, char **argv)
 {
     test_case tc = {"unit: sha256, error list, problem, csv, diag pointers, spatial diag and "
-                    "result rows, blade result (Hz, per-rev, rpm)", 0};
+                    "result rows, blade result (Hz, per-rev, rpm), result text and size", 0};
     char **names = NULL;
     size_t n = 0, cap = 0, i;
     struct dirent *de;
@@ -820,6 +822,7 @@ int main(int argc, char **argv)
     unit_spatial_diag(&tc);
     unit_spatial_result(&tc);
     unit_blade_result(&tc);
+    unit_result_size(&tc);
     if (tc.failures)
         failed++;
     else

@@ -29,4 +29,7 @@ void unit_spatial_result(test_case *tc);
 /** A solved blade-form request: frequency_hz, per_rev, rpm in JSON and CSV (blade_units.c). */
 void unit_blade_result(test_case *tc);
 
+/** The result's text against its tree, and the size estimate against it (size_units.c). */
+void unit_result_size(test_case *tc);
+
 #endif /* SPINMODAL_CODEC_TEST_H */
