@@ -54,6 +54,7 @@ enum {
     F_MAX_SPEEDS,
     F_MAX_COORDINATES,
     F_MAX_FRAME_DOFS,
+    F_MAX_RESULT_BYTES,
     F_JOB_TIMEOUT,
     F_TOKEN_FILE,
     F_AUTH_READS,
@@ -94,6 +95,8 @@ static const main_flag main_flags[F_N] = {
      "most modal coordinates of a model (dense Newton and eigen problems, cost ~n^3)"},
     {"max-frame-dofs", "SPINMODAL_MAX_FRAME_DOFS", "N", "1200",
      "most degrees of freedom in one frame's component-mode problem (cost ~n^3)"},
+    {"max-result-bytes", "SPINMODAL_MAX_RESULT_BYTES", "BYTES", "50000000",
+     "largest result document, estimated from the request (422 above; 0 = no limit)"},
     {"job-timeout", "SPINMODAL_JOB_TIMEOUT", "S", "300", "seconds of solving before a job fails"},
     {"token-file", "SPINMODAL_TOKEN_FILE", "PATH", "none (no auth)",
      "file holding the bearer token POST and DELETE need"},
@@ -140,6 +143,7 @@ typedef struct main_opts {
     double lease;            /* s, PostgreSQL claims */
     double db_timeout;       /* s, deadline of one store call */
     long long retain_bytes;  /* bytes, 0 = no size bound */
+    long long max_result_bytes; /* estimated bytes of a result document, 0 = no limit */
     const char *token_file;  /* NULL = no auth */
     int auth_reads;          /* 1: reads need the token too */
     const char *cors_origin; /* NULL = no CORS */
@@ -307,6 +311,14 @@ static int main_set(main_opts *o, int f, const char *v, const char **want)
     case F_MAX_FRAME_DOFS:
         *want = "an integer from 3 to 1000000";
         return main_long(v, 3, 1000000, &o->max_frame_dofs);
+    case F_MAX_RESULT_BYTES: {
+        long b = 0;
+        *want = "a number of bytes from 0 (no limit) to 1099511627776 (1 TiB)";
+        if (main_long(v, 0, 1099511627776L, &b))
+            return -1;
+        o->max_result_bytes = b;
+        return 0;
+    }
     case F_JOB_TIMEOUT:
         *want = "a number of seconds greater than 0 (at most 1000000)";
         return main_seconds(v, 1e-3, 1e6, &o->job_timeout);
@@ -385,6 +397,7 @@ static void main_defaults(main_opts *o)
     o->max_speeds = 1001;
     o->max_coordinates = 4000;
     o->max_frame_dofs = 1200;
+    o->max_result_bytes = 50000000;
     o->job_timeout = 300.0;
     o->per_client = 64;
     o->max_connections = 512;
@@ -671,6 +684,7 @@ static int main_serve(const main_opts *o, const char *token, main_daemon *d)
     hc.limits.max_speeds = (int)o->max_speeds;
     hc.limits.max_coordinates = (int)o->max_coordinates;
     hc.limits.max_frame_dofs = (int)o->max_frame_dofs;
+    hc.limits.max_result_bytes = (size_t)o->max_result_bytes;
     hc.token = token;
     hc.auth_reads = o->auth_reads;
     hc.cors_origin = o->cors_origin;
