@@ -50,8 +50,12 @@ typedef struct codec_limits {
                                  shapes, equilibria, modes, critical speeds), default
                                  50 000 000; 0 = no limit */
     int max_coordinates;      /* modal coordinates of a model solved by the dense path (cost
-                                 ~ n^3; models the tree-structured path takes are bounded by
-                                 max_elements only), default 4000 */
+                                 ~ n^3: ~5.6 s and ~200 MB a speed with Coriolis at 1000;
+                                 models the tree-structured path takes are bounded by
+                                 max_elements only), default SM_DENSE_MAX_DEFAULT (1000) */
+    double max_solve_seconds; /* the dense path's estimated time (sm_dense_seconds x speeds)
+                                 above which a request is refused: the daemon's --job-timeout;
+                                 0 = no limit (the CLI's default) */
     int max_frame_dofs;       /* degrees of freedom of one substructure's component-mode
                                  problem (3 x its free nodes, 6 x for a spatial request; cost
                                  ~ dofs^3 each), default 1200 (~3 s on one core) */

@@ -21,6 +21,7 @@ void codec_default_limits(codec_limits *lim)
     lim->max_modes = 200;
     lim->max_shape_values = 4000000;
     lim->max_result_bytes = 50000000;
-    lim->max_coordinates = 4000;
+    lim->max_coordinates = SM_DENSE_MAX_DEFAULT;
+    lim->max_solve_seconds = 0;
     lim->max_frame_dofs = 1200;
 }

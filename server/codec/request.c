@@ -320,6 +320,50 @@ int codec_sha256_hex(const void *data, size_t len, char hex[65])
 }
 
 /*
+ * The dense path's bounds (issue 23): a model it takes (frames of more than 40 coordinates, a
+ * small model, or more modes than the structured eigen-analysis gives) must have at most
+ * max_coordinates, and its estimated time (sm_dense_seconds a speed) must stay within
+ * max_solve_seconds.  Returns 0, 1 after adding the reason to errs, or SM_NOMEM.
+ */
+static int req_check_dense(const codec_request *r, const codec_limits *lim, codec_errors *errs)
+{
+    int n = r->info.coordinates, speeds = r->n_speeds, many = r->opt.modes > SM_TREE_MAX_MODES;
+    double t1 = sm_dense_seconds(n, r->opt.coriolis), total = t1 * speeds;
+    char why[200];
+
+    if (r->info.structured)
+        return 0;
+    if (many)
+        snprintf(why, sizeof(why),
+                 "%d modes are more than the structured eigen-analysis gives (%d): ask for at "
+                 "most %d modes, or ",
+                 r->opt.modes, SM_TREE_MAX_MODES, SM_TREE_MAX_MODES);
+    else
+        snprintf(why, sizeof(why), "frames of more than 40 coordinates or many modes take it: ");
+    if (n > lim->max_coordinates)
+        return codec_errors_add(errs, many ? "/analysis/modes" : "/structure",
+                                "the model would have %d modal coordinates on the dense solvers, "
+                                "more than the limit of %d (cost ~n^3: about %.3g s and %.0f MB a "
+                                "speed); %suse per-element or small frames, fewer elements, or "
+                                "\"modes_per_frame\"",
+                                n, lim->max_coordinates, t1,
+                                (r->opt.coriolis ? 190e-6 : 100e-6) * (double)n * n, why) == SM_NOMEM
+                   ? SM_NOMEM
+                   : 1;
+    if (lim->max_solve_seconds > 0 && total > lim->max_solve_seconds)
+        return codec_errors_add(errs, "/analysis/omega",
+                                "%d speeds on the dense solvers (%d modal coordinates, about %.3g s "
+                                "a speed) are estimated at %.3g s, more than the job time limit of "
+                                "%g s: ask for fewer speeds (at most %d), or %suse per-element or "
+                                "small frames, or fewer elements",
+                                speeds, n, t1, total, lim->max_solve_seconds,
+                                (int)(lim->max_solve_seconds / (t1 > 0 ? t1 : 1)), why) == SM_NOMEM
+                   ? SM_NOMEM
+                   : 1;
+    return 0;
+}
+
+/*
  * The checks that need the model's topology and sizes, without building it
  * (sm_structure_check is linear in the size): a tree rooted at the clamp,
  * then the cost bounds of lim (a 422 that says what to change).  A frame's
@@ -349,18 +393,9 @@ static int req_check_model(codec_request *r, const codec_limits *lim, codec_erro
                          dofs, r->info.max_frame_nodes, lim->max_frame_dofs,
                          lim->max_frame_dofs / node_dof) == SM_NOMEM)
         return SM_NOMEM;
-    if (!r->info.structured && r->info.coordinates > lim->max_coordinates &&
-        codec_errors_add(errs, "/structure",
-                         "the model would have %d modal coordinates, more than the limit of %d "
-                         "for the dense solvers (cost ~n^3; frames of more than 40 coordinates "
-                         "or many modes requested need them): use per-element frames or small "
-                         "frames, fewer elements, or \"modes_per_frame\"",
-                         r->info.coordinates, lim->max_coordinates) == SM_NOMEM)
-        return SM_NOMEM;
-    return dofs > lim->max_frame_dofs ||
-                   (!r->info.structured && r->info.coordinates > lim->max_coordinates)
-               ? SM_INVALID_INPUT
-               : SM_OK;
+    if ((st = req_check_dense(r, lim, errs)) < 0)
+        return st;
+    return dofs > lim->max_frame_dofs || st ? SM_INVALID_INPUT : SM_OK;
 }
 
 /*

@@ -91,13 +91,14 @@ static const main_flag main_flags[F_N] = {
     {"max-body", "SPINMODAL_MAX_BODY", "BYTES", "1048576", "largest request body (413 above)"},
     {"max-elements", "SPINMODAL_MAX_ELEMENTS", "N", "2000", "most finite elements of a request"},
     {"max-speeds", "SPINMODAL_MAX_SPEEDS", "N", "1001", "most speeds of a request"},
-    {"max-coordinates", "SPINMODAL_MAX_COORDINATES", "N", "4000",
-     "most modal coordinates of a model (dense Newton and eigen problems, cost ~n^3)"},
+    {"max-coordinates", "SPINMODAL_MAX_COORDINATES", "N", "1000",
+     "most modal coordinates of a model on the dense path (cost ~n^3: ~5.6 s, ~200 MB a speed at 1000)"},
     {"max-frame-dofs", "SPINMODAL_MAX_FRAME_DOFS", "N", "1200",
      "most degrees of freedom in one frame's component-mode problem (cost ~n^3)"},
     {"max-result-bytes", "SPINMODAL_MAX_RESULT_BYTES", "BYTES", "50000000",
      "largest result document, estimated from the request (422 above; 0 = no limit)"},
-    {"job-timeout", "SPINMODAL_JOB_TIMEOUT", "S", "300", "seconds of solving before a job fails"},
+    {"job-timeout", "SPINMODAL_JOB_TIMEOUT", "S", "30",
+     "seconds of solving before a job fails; requests whose dense solves are estimated longer are refused (422)"},
     {"token-file", "SPINMODAL_TOKEN_FILE", "PATH", "none (no auth)",
      "file holding the bearer token POST and DELETE need"},
     {"auth-reads", "SPINMODAL_AUTH_READS", "yes|no", "no",
@@ -395,10 +396,10 @@ static void main_defaults(main_opts *o)
     o->max_body = 1048576;
     o->max_elements = 2000;
     o->max_speeds = 1001;
-    o->max_coordinates = 4000;
+    o->max_coordinates = SM_DENSE_MAX_DEFAULT;
     o->max_frame_dofs = 1200;
     o->max_result_bytes = 50000000;
-    o->job_timeout = 300.0;
+    o->job_timeout = 30.0;
     o->per_client = 64;
     o->max_connections = 512;
     o->max_waiters = -1;
@@ -684,6 +685,7 @@ static int main_serve(const main_opts *o, const char *token, main_daemon *d)
     hc.limits.max_speeds = (int)o->max_speeds;
     hc.limits.max_coordinates = (int)o->max_coordinates;
     hc.limits.max_frame_dofs = (int)o->max_frame_dofs;
+    hc.limits.max_solve_seconds = o->job_timeout;
     hc.limits.max_result_bytes = (size_t)o->max_result_bytes;
     hc.token = token;
     hc.auth_reads = o->auth_reads;

@@ -699,7 +699,7 @@ static void unit_csv(test_case *tc)
     double freq[2] = {3.5, 20}, re[2] = {0, 0}, im[2] = {3.5, 20}, mac[2] = {-1, -1};
     int prev[2] = {-1, -1};
     sm_case cases[2];
-    sm_result res = {2, cases, 0, NULL, 0, NULL};
+    sm_result res = {2, cases, 0, NULL, 0, NULL, 0};
     char *csv = NULL;
     size_t len = 0;
     /* per_rev is empty at rest; rpm = omega 60 / (2 pi) without a request */
