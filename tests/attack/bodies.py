@@ -286,6 +286,15 @@ def cases(quick=False):
     add("blade-elements-2001", _j(_blade(elements=2001)), [422], "/blade*")
     add("engine-orders-17", _j(_set("/analysis/engine_orders", list(range(1, 18)))), [422],
         "/analysis/engine_orders*")
+    # issue 23 item 9: a small request for a huge result (3.9 M shape numbers, 94 MB), and the
+    # largest sweep of a 2000-element model without shapes (its steady states ~200 MB)
+    big = _blade(elements=2000)
+    big["analysis"] = {"rpm": {"from": 0, "to": 260, "steps": 26}, "modes": 6, "mode_shapes": True}
+    add("result-94MB-shapes", _j(big), [422], "/analysis/mode_shapes", quick_too=True)
+    sweep = _blade(elements=2000)
+    sweep["analysis"] = {"rpm": {"from": 0, "to": 1000, "steps": 1000}, "modes": 10,
+                         "mode_shapes": False}
+    add("result-steady-states-1001-speeds", _j(sweep), [422], "/analysis/rpm")
 
     # --- unicode tricks in names and keys: pointers escaped right -------------
     weird = _small()

@@ -105,7 +105,9 @@ def main():
         return 77
     ts.calibrate(exe)
     tmp = tempfile.mkdtemp(prefix="spinmodal-nginx-")
-    d = dm.Daemon(exe, tmp, ["--workers", "1"])
+    # one worker kept busy by a long sweep (below), whose ~67 MB result is over the default
+    # --max-result-bytes: no result-size limit here
+    d = dm.Daemon(exe, tmp, ["--workers", "1", "--max-result-bytes", "0"])
     ngx = None
     try:
         d.start()
