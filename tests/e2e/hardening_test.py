@@ -88,6 +88,7 @@ hard link to the database (both used to run beside the first), and full_disk
 checks /readyz is 503 as soon as the job is failed (the small write recording
 the failure used to clear it).
 """
+import json
 import os
 import socket
 import subprocess
@@ -259,6 +260,56 @@ def rss_kb(pid):
             if line.startswith("VmRSS:"):
                 return int(line.split()[1])
     return -1
+
+
+def spatial_blade(elements, modes, omega=(10.0,), **analysis):
+    """The attack tool's 10 m spatial blade (hub radius 0.5 m) as request bytes, without mode
+    shapes (their size has its own budget: result_budget)."""
+    a = {"omega": list(omega), "modes": modes, "mode_shapes": False}
+    a.update(analysis)
+    return json.dumps({"blade": {"length": 10.0, "hub_radius": 0.5, "elements": elements,
+                                 "section": {"EA": 2.8e7, "EI_flap": 1.4e4, "EI_edge": 5.6e4,
+                                             "GJ": 1.3e4, "mass_per_length": 1.2}},
+                       "analysis": a}).encode()
+
+
+def scenario_bounded_cost(exe, tmp):
+    """Issue 23 item 1: every path's cost bounded before it starts.  On 0.7.0 each request below
+    was accepted: 666 elements x 200 modes ran the dense eigen-analysis for ~100 s and 2.3 GB a
+    speed; 2000 x 200 and 1000 x 200 with error_estimate ended eigen_failed after 3-5 s and
+    ~200 MB; a dense sweep past the job time limit ran until it."""
+    js = {"Content-Type": "application/json"}
+    d = Daemon(exe, tmp, ["--workers", "1"])
+    d.start()
+    before = rss_kb(d.proc.pid)
+    for what, body, pointer, words in (
+            ("666 elements, 200 modes", spatial_blade(666, 200), "/analysis/modes", "at most 64 modes"),
+            ("2000 elements, 200 modes", spatial_blade(2000, 200), "/analysis/modes", "at most 64 modes"),
+            ("1000 elements, 200 modes, error_estimate", spatial_blade(1000, 200, error_estimate=True),
+             "/analysis/modes", "at most 64 modes"),
+            ("150 elements, 100 modes (dense), 101 speeds",
+             spatial_blade(150, 100, omega=[0.2 * i for i in range(101)]), "/analysis/omega",
+             "job time limit")):
+        for path in ("/v1/validate", "/v1/analyses"):
+            r = d.request("POST", path, body=body, headers=js)
+            errs = (r.json() or {}).get("errors", []) if r.status == 422 else []
+            hit = [e for e in errs if e.get("pointer") == pointer and words in e.get("message", "")]
+            check(r.status == 422 and hit, "POST %s %s (%d bytes): 422 at %s saying '%s' (got %s %s)"
+                  % (path, what, len(body), pointer, words, r.status, errs[:1]))
+    check(rss_kb(d.proc.pid) - before < 100 * 1024, "refused before any model was built (RSS)")
+    # what stays allowed takes the cheap path: 48 modes of 300 elements (tree path; on 0.7.0 it
+    # fell back to the dense one, ~50 s and 480 MB a speed); a speed of a 150-element blade with
+    # 100 modes on the dense path (~4 s)
+    for what, body in (("300 elements, 48 modes", spatial_blade(300, 48)),
+                       ("150 elements, 100 modes, one speed", spatial_blade(150, 100))):
+        r = d.request("POST", "/v1/analyses?wait=%g" % timescale.wait_param(30), body=body, headers=js)
+        job = (r.json() or {}).get("id")
+        st = wait_until(lambda: job_state(d, job).get("state") in ("done", "failed"), 120) and \
+            job_state(d, job)
+        check(bool(st) and st.get("state") == "done",
+              "%s: accepted and done (%s)" % (what, st and st.get("state")))
+    check(d.get("/livez").status == 200, "/livez answers")
+    check(d.stop() == 0, "daemon stops cleanly")
 
 
 def scenario_cost_bound(exe, tmp):
