@@ -244,7 +244,8 @@ done:
     return rc;
 }
 
-int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, sm_eig_out *out, int *fallback)
+int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const sm_progress *pr,
+                   sm_eig_out *out, int *fallback)
 {
     int n = m->n, N2 = 2 * n, rc, nv = 0, done_x = 0;
     int pmax = EIG_TREE_MAX_BASIS < N2 - 1 ? EIG_TREE_MAX_BASIS : N2 - 1;
@@ -320,6 +321,10 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, sm_ei
         if (breakdown || p >= pmax) {
             eig_out_free(out); /* no convergence: the dense path */
             break;
+        }
+        if (pr && pr->cb && pr->cb(pr->user, pr->done, pr->total)) { /* a stop between projections */
+            rc = SM_CANCELED;
+            goto done;
         }
         next += EIG_TREE_STEP;
     }

@@ -249,11 +249,11 @@ static int sweep_equilibrium_out(const sm_model *m, const double *q, sweep_lin *
  * The eigen-analysis failed (status rc) at the converged equilibrium of case
  * c: the case keeps its equilibrium fields and reports the cause.  finite: 0
  * when the linearised matrices had non-finite entries.  Returns SM_OK, or rc
- * when the failure is fatal to the whole solve (SM_NOMEM).
+ * when the failure is fatal to the whole solve (SM_NOMEM) or a stop (SM_CANCELED).
  */
 static int sweep_eigen_failed(sm_case *c, int rc, int finite)
 {
-    if (rc == SM_NOMEM)
+    if (rc == SM_NOMEM || rc == SM_CANCELED) /* a stop asked between Arnoldi projections */
         return rc;
     c->status = SM_CASE_EIGEN_FAILED;
     if (rc == SM_LIMIT) /* sweep_eigen wrote the reason */
@@ -271,7 +271,7 @@ static int sweep_eigen_failed(sm_case *c, int rc, int finite)
  * Returns the status of the eigen-analysis (SM_NOMEM also for the fallback's allocation).
  */
 static int sweep_eigen(const sm_model *m, const double *q, sweep_lin *L, sweep_lin *D, sweep_lin **use,
-                       sm_case *c, sm_eig_out *e, int *finite)
+                       const sm_progress *pr, sm_case *c, sm_eig_out *e, int *finite)
 {
     int rc, fallback = 1;
     double t0 = sweep_ms(), t1;
@@ -282,7 +282,7 @@ static int sweep_eigen(const sm_model *m, const double *q, sweep_lin *L, sweep_l
         int fin = sweep_linearize(m, q, c->omega, L);
         t1 = sweep_ms();
         c->t_linearize = t1 - t0;
-        if (fin && (rc = eig_solve_tree(m, &L->t, m->opt.coriolis, m->opt.modes, e, &fallback)) < 0)
+        if (fin && (rc = eig_solve_tree(m, &L->t, m->opt.coriolis, m->opt.modes, pr, e, &fallback)) < 0)
             return rc;
         c->t_eigen = sweep_ms() - t1;
         if (!fallback)
@@ -320,15 +320,16 @@ static int sweep_eigen(const sm_model *m, const double *q, sweep_lin *L, sweep_l
     return rc;
 }
 
-/* Modes of case c at the equilibrium q.  An eigen-analysis failure is
- * reported on the case (sweep_eigen_failed); returns SM_OK or SM_NOMEM. */
-static int sweep_modes(const sm_model *m, const double *q, sweep_lin *L, sm_case *c)
+/* Modes of case c at the equilibrium q; pr: the stop callback the tree path asks between its
+ * projections.  An eigen-analysis failure is reported on the case (sweep_eigen_failed); returns
+ * SM_OK, SM_NOMEM or SM_CANCELED. */
+static int sweep_modes(const sm_model *m, const double *q, sweep_lin *L, const sm_progress *pr, sm_case *c)
 {
     sm_eig_out e;
     sweep_lin D, *use = L;
     int finite = 1;
     memset(&D, 0, sizeof D);
-    int rc = sweep_eigen(m, q, L, &D, &use, c, &e, &finite);
+    int rc = sweep_eigen(m, q, L, &D, &use, pr, c, &e, &finite);
     if (rc < 0) {
         sweep_lin_free(&D);
         return sweep_eigen_failed(c, rc, finite);
@@ -485,7 +486,7 @@ static int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_p
             snprintf(c->message, sizeof c->message, "%s", eo.message);
             from_rest = 1;
         } else {
-            if ((rc = sweep_modes(m, q, &L, c)) < 0)
+            if ((rc = sweep_modes(m, q, &L, &pr, c)) < 0)
                 goto fail;
             s_prev = s; /* tracking (track.c) runs once every speed is solved */
             from_rest = 0;
