@@ -188,6 +188,23 @@ const char *codec_request_canonical_text(const codec_request *r);
 /** SHA-256 of the canonical text as 64 lowercase hex digits, borrowed from r. */
 const char *codec_request_sha256(const codec_request *r);
 
+/** Longest request "name", in bytes. */
+#define CODEC_NAME_MAX 200
+
+/**
+ * The request's optional top-level "name" (a label for people, kept out of
+ * the canonical text and so of the job id), borrowed from r; NULL without one.
+ */
+const char *codec_request_name(const codec_request *r);
+
+/**
+ * The text a job stores and GET /v1/analyses/{id}/request serves: the
+ * canonical text, with the "name" among its sorted keys when the request has
+ * one (its SHA-256 is then not the job's: the id is the canonical text's).
+ * Borrowed from r, NUL-terminated.
+ */
+const char *codec_request_stored_text(const codec_request *r);
+
 /**
  * SHA-256 of len bytes of data as lowercase hex into hex[65] (NUL-terminated).
  * Returns SM_OK or SM_NOMEM (OpenSSL failure).

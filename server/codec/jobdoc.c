@@ -116,6 +116,22 @@ static void jdoc_time(codec_text *t, double when)
     codec_text_printf(t, "\"%s\"", ts);
 }
 
+/* key, then s as a JSON string (escaped by jansson). */
+static void jdoc_string(codec_text *t, const char *key, const char *s)
+{
+    json_t *j = json_string(s);
+    char *q = j ? json_dumps(j, JSON_ENCODE_ANY) : NULL;
+
+    if (!q)
+        t->nomem = 1;
+    else {
+        codec_text_puts(t, key);
+        codec_text_puts(t, q);
+    }
+    free(q);
+    json_decref(j);
+}
+
 /* The status document of v, with the result when with_result and v has one. */
 static void jdoc_status(codec_text *t, const codec_job_view *v, int with_result)
 {
@@ -130,6 +146,8 @@ static void jdoc_status(codec_text *t, const codec_job_view *v, int with_result)
     codec_text_printf(t, ",\"attempts\":%d,\"cancel_requested\":%s,\"error\":", v->attempts,
                       v->cancel_requested ? "true" : "false");
     codec_text_puts(t, v->error && v->error[0] ? v->error : "null");
+    if (v->name)
+        jdoc_string(t, ",\"name\":", v->name);
     codec_text_printf(t, ",\"links\":{\"self\":\"/v1/analyses/%s\",", v->id);
     codec_text_printf(t, "\"result\":\"/v1/analyses/%s/result\"}", v->id);
     if (with_result && v->result) {

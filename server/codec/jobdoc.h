@@ -69,14 +69,15 @@ typedef struct codec_job_view {
     int attempts;                /* claims so far */
     int cancel_requested;        /* 1 once a DELETE asked a running job to stop */
     const char *error;           /* the error object as JSON text, NULL or "" = null */
+    const char *name;            /* the request's "name" (plain text), NULL = no member */
     const char *result;          /* result JSON text spliced in verbatim, or NULL = no member */
     size_t result_len;           /* bytes of result */
 } codec_job_view;
 
 /**
  * Append the status document of v: {id, state, progress, created_at,
- * started_at, finished_at, attempts, cancel_requested, error, links[,
- * result]}.  Out of memory shows as t->nomem.
+ * started_at, finished_at, attempts, cancel_requested, error[, name],
+ * links[, result]}.  Out of memory shows as t->nomem.
  */
 void codec_job_status(codec_text *t, const codec_job_view *v);
 

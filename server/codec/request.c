@@ -32,6 +32,8 @@ struct codec_request {
     int blade;                  /* 1 for the blade form: pointers move into /blade */
     json_t *warnings;           /* input_warnings (warn.c), an array, maybe empty */
     char *canon_text;           /* its sorted compact dump */
+    char *name;                 /* the request's "name" (not in canon), or NULL */
+    char *stored_text;          /* canon with "name", dumped as canon_text; NULL without one */
     char sha[65];               /* SHA-256 of canon_text, hex */
     const char **joint_names;   /* n_joints, sorted, borrowed from canon */
     const char **section_names; /* n_sections, sorted, borrowed from canon */
@@ -602,6 +604,29 @@ static int req_check_estimate(codec_request *r, const codec_limits *lim, codec_e
 }
 
 /*
+ * Keep root's "name" (validated: a string) beside the canonical request, and
+ * the stored text: canon with the name, dumped as the canonical text.
+ * Returns SM_OK or SM_NOMEM.
+ */
+static int req_keep_name(codec_request *r, const json_t *root)
+{
+    const json_t *n = json_object_get(root, "name");
+    json_t *copy;
+
+    if (!json_is_string(n))
+        return SM_OK;
+    r->name = strdup(json_string_value(n));
+    copy = json_copy(r->canon); /* shallow: shares the values */
+    if (!r->name || !copy || json_object_set_new(copy, "name", json_string(r->name))) {
+        json_decref(copy);
+        return SM_NOMEM;
+    }
+    r->stored_text = json_dumps(copy, CODEC_DUMP_CANON);
+    json_decref(copy);
+    return r->stored_text ? SM_OK : SM_NOMEM;
+}
+
+/*
  * codec_request_from_json; core_check 0 leaves out the core's structure
  * check and the cost bounds (req_parse_codec_only).
  */
@@ -633,7 +658,7 @@ static int req_from_json(codec_request **out, const json_t *root, const codec_li
     r->blade = json_object_get(canon, "blade") != NULL;
     canon = structure = NULL;
     r->canon_text = json_dumps(r->canon, CODEC_DUMP_CANON);
-    if (!r->canon_text)
+    if (!r->canon_text || req_keep_name(r, root))
         goto fail;
     if ((rc = codec_sha256_hex(r->canon_text, strlen(r->canon_text), r->sha)) ||
         (rc = req_build_tables(r)) || (rc = req_build_structure(r)) ||
@@ -728,6 +753,8 @@ void codec_request_free(codec_request *r)
     free(r->section_names);
     free(r->joint_names);
     free(r->canon_text);
+    free(r->name);
+    free(r->stored_text);
     json_decref(r->canon);
     free(r);
 }
@@ -801,6 +828,16 @@ const char *codec_request_canonical_text(const codec_request *r)
 const char *codec_request_sha256(const codec_request *r)
 {
     return r->sha;
+}
+
+const char *codec_request_name(const codec_request *r)
+{
+    return r->name;
+}
+
+const char *codec_request_stored_text(const codec_request *r)
+{
+    return r->stored_text ? r->stored_text : r->canon_text;
 }
 
 int codec_request_error_estimate(const codec_request *r)

@@ -747,13 +747,45 @@ static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
 }
 
 /*
+ * The optional top-level "name" (a label for people: lists, file names): a
+ * string of 1 to CODEC_NAME_MAX bytes without control characters.  It is
+ * not copied into the canonical request, so it never changes the job id;
+ * request.c keeps it beside (codec_request_name).
+ */
+static void val_name(val_ctx *v, const json_t *root)
+{
+    const json_t *n = json_object_get(root, "name");
+    const unsigned char *s;
+    size_t len;
+
+    if (!n)
+        return;
+    if (!json_is_string(n)) {
+        field_error(v, "/name", "must be a string (a label for the design), not %s",
+                    field_type_name(n));
+        return;
+    }
+    s = (const unsigned char *)json_string_value(n);
+    len = json_string_length(n);
+    if (len == 0 || len > CODEC_NAME_MAX) {
+        field_error(v, "/name", "must be 1 to %d bytes long, not %zu", CODEC_NAME_MAX, len);
+        return;
+    }
+    for (size_t i = 0; i < len; i++)
+        if (s[i] < 0x20 || s[i] == 0x7f) {
+            field_error(v, "/name", "must not hold control characters (byte %zu)", i);
+            return;
+        }
+}
+
+/*
  * Validate root; returns the canonical request (new) or NULL, and in
  * *structure the canonical structure the core's arrays come from (new, or
  * NULL): the request's, or the one its "blade" stands for (blade.c).
  */
 static json_t *val_document(val_ctx *v, const json_t *root, json_t **structure)
 {
-    static const char *const keys[] = {"structure", "blade", "frames", "analysis", NULL};
+    static const char *const keys[] = {"structure", "blade", "frames", "analysis", "name", NULL};
     json_t *canon;
 
     if (!json_is_object(root)) {
@@ -776,6 +808,7 @@ static json_t *val_document(val_ctx *v, const json_t *root, json_t **structure)
     }
     val_frames(v, root, canon);
     val_analysis(v, root, canon);
+    val_name(v, root);
     if (json_object_get(canon, "analysis") && *structure)
         size_check(v, canon, *structure); /* the result's size (size.c) */
     return canon;

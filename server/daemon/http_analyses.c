@@ -35,6 +35,7 @@ static codec_job_view http_view(const store_job *jb, int with_result)
     v.attempts = jb->attempts;
     v.cancel_requested = jb->cancel_requested;
     v.error = jb->error;
+    v.name = jb->name;
     if (with_result && jb->result) {
         v.result = jb->result;
         v.result_len = jb->result_len;

@@ -772,8 +772,9 @@ int jobs_submit(jobs *j, const codec_request *req, jobs_outcome *outcome, store_
     j->reserving++;
     pthread_mutex_unlock(&j->lock);
     codec_request_speeds(req, &speeds);
-    rc = store_submit(j->st, id, codec_request_canonical_text(req),
-                      strlen(codec_request_canonical_text(req)), speeds, log_now(), &created, jb);
+    /* the canonical text, with the request's "name" when it has one (not in the id) */
+    rc = store_submit(j->st, id, codec_request_stored_text(req),
+                      strlen(codec_request_stored_text(req)), speeds, log_now(), &created, jb);
     pthread_mutex_lock(&j->lock);
     j->reserving--;
     j->qver++;

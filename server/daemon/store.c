@@ -194,6 +194,7 @@ void store_job_clear(store_job *j)
     free(j->error);
     free(j->result);
     free(j->result_csv);
+    free(j->name);
     memset(j, 0, sizeof *j);
 }
 

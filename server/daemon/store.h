@@ -177,6 +177,7 @@ typedef struct store_job {
     char *result_csv;        /* result CSV text (STORE_WITH_CSV), or NULL */
     size_t csv_len;
     int has_result;          /* 1 when a result is stored, whatever the flags */
+    char *name;              /* the stored request's "name" (store_list only), or NULL */
     char owner[64];          /* PostgreSQL: the owner id of the store that claimed it
                               * last ("" before; kept after it ends); SQLite: "" */
     double lease_until;      /* PostgreSQL, while running: the claim holds until this

@@ -105,10 +105,12 @@ const char *const store_pg_sql[PG_N] = {
     " WHERE id = $1::text AND state = 'queued'",
     /* PG_CANCEL_RUNNING */
     "UPDATE jobs SET cancel_requested = true WHERE id = $1::text AND state = 'running'",
-    /* PG_LIST_ALL */
-    "SELECT " PG_JOB_COLS " FROM jobs WHERE seq < $1::int8 ORDER BY seq DESC LIMIT $2::int8",
+    /* PG_LIST_ALL (column 14: the request's "name", codec_request_stored_text) */
+    "SELECT " PG_JOB_COLS ", request::json ->> 'name' FROM jobs WHERE seq < $1::int8"
+    " ORDER BY seq DESC LIMIT $2::int8",
     /* PG_LIST_STATE */
-    "SELECT " PG_JOB_COLS " FROM jobs WHERE state = $3::text AND seq < $1::int8"
+    "SELECT " PG_JOB_COLS ", request::json ->> 'name' FROM jobs WHERE state = $3::text"
+    " AND seq < $1::int8"
     " ORDER BY seq DESC LIMIT $2::int8",
     /* PG_COUNT */ "SELECT state, count(*) FROM jobs GROUP BY state",
     /* PG_RENEW */
@@ -486,6 +488,10 @@ static int pg_list(store *s, long long before, int filter, int max, store_job *o
         rows = PQntuples(r);
         for (int i = 0; i < rows && i < max && status == STORE_OK; i++) {
             status = pg_job_from_row(c, r, i, 0, &out[i]);
+            if (status == STORE_OK && col_dup(r, i, 14, &out[i].name, NULL)) {
+                store_job_clear(&out[i]);
+                status = store_pg_fail_kind(c, STORE_NOMEM, "out of memory copying a job's name");
+            }
             if (status == STORE_OK)
                 (*n)++;
         }

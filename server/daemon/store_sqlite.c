@@ -56,6 +56,8 @@
 #define JOB_COLS                                                                        \
     "seq, id, state, speeds_total, speeds_done, attempts, cancel_requested, created_at," \
     " started_at, finished_at, typeof(result) <> 'null', error"
+/* A listing's column 12: the request's "name" (codec_request_stored_text), NULL without one. */
+#define JOB_NAME "json_extract(request, '$.name')"
 #define JOB_GET(req, res, csv) "SELECT " JOB_COLS ", " req ", " res ", " csv " FROM jobs WHERE id = ?1"
 #define JOB_FINISHED "state IN ('done', 'failed', 'canceled')"
 
@@ -96,9 +98,10 @@ const char *const store_sqlite_sql[STMT_N] = {
     /* STMT_CANCEL_RUNNING */
     "UPDATE jobs SET cancel_requested = 1 WHERE id = ?1 AND state = 'running'",
     /* STMT_LIST_ALL */
-    "SELECT " JOB_COLS " FROM jobs WHERE seq < ?1 ORDER BY seq DESC LIMIT ?2",
+    "SELECT " JOB_COLS ", " JOB_NAME " FROM jobs WHERE seq < ?1 ORDER BY seq DESC LIMIT ?2",
     /* STMT_LIST_STATE */
-    "SELECT " JOB_COLS " FROM jobs WHERE state = ?3 AND seq < ?1 ORDER BY seq DESC LIMIT ?2",
+    "SELECT " JOB_COLS ", " JOB_NAME " FROM jobs WHERE state = ?3 AND seq < ?1"
+    " ORDER BY seq DESC LIMIT ?2",
     /* STMT_COUNT */ "SELECT state, count(*) FROM jobs GROUP BY state",
     /* STMT_PAGES */
     "SELECT p.page_count, f.freelist_count, s.page_size"
@@ -799,6 +802,10 @@ static int list_rows(store_conn *c, sqlite3_stmt *st, int max, store_job *out, i
         status = job_from_row(c, st, 0, &out[*n]);
         if (status != STORE_OK)
             return status;
+        if (column_dup(st, 12, &out[*n].name, NULL) != SQLITE_OK) {
+            store_job_clear(&out[*n]);
+            return conn_fail_kind(c, STORE_NOMEM, "out of memory copying a job's name");
+        }
         (*n)++;
     }
     if (rc != SQLITE_ROW && rc != SQLITE_DONE)

@@ -17,7 +17,10 @@
  *       spatial, joint_z, joint_xy, member_spatial, point_mass_inertia,
  *       point_mass_products, point_mass_offset, member_stations), sections
  *       (sm_section values, offsets), model (sizes from sm_model_get_info),
- *       rpm (codec_request_rpm) and input_warnings (exactly these).
+ *       rpm (codec_request_rpm) and input_warnings (exactly these); name (the
+ *       request's "name", null for none), canonical_lacks, stored_contains (the
+ *       text a job stores: re-parsed, it has the same SHA-256 and name) and
+ *       listing_contains (a job listing of the request, codec_job_list).
  *
  * Spatial requests (DESIGN.md 7.3): a valid case with "spatial": true in
  * checks.json is read twice: by the codec alone (req_parse_codec_only, no
@@ -571,6 +574,47 @@ static void check_exact(test_case *tc, const char *what, const double *got, int 
             fail(tc, "%s %d is %.17g", what, k, got[k]);
 }
 
+/* The request's "name": kept out of the canonical text (and the id), in the stored text
+ * and in a job listing (checks name, canonical_lacks, stored_contains, listing_contains). */
+static void check_name(test_case *tc, const codec_request *req, const json_t *chk)
+{
+    const char *name = codec_request_name(req), *stored = codec_request_stored_text(req);
+    const json_t *x = json_object_get(chk, "name");
+    codec_errors *errs = codec_errors_new();
+    codec_request *again = NULL;
+    codec_job_view v;
+    codec_text t = {0};
+    char id[65];
+    size_t i;
+
+    if (x && (json_is_null(x) ? name != NULL : !name || strcmp(name, json_string_value(x))))
+        fail(tc, "name is '%s'", name ? name : "(none)");
+    json_array_foreach(json_object_get(chk, "canonical_lacks"), i, x)
+        if (strstr(codec_request_canonical_text(req), json_string_value(x)))
+            fail(tc, "canonical text holds %s", json_string_value(x));
+    json_array_foreach(json_object_get(chk, "stored_contains"), i, x)
+        if (!strstr(stored, json_string_value(x)))
+            fail(tc, "stored text lacks %s:\n       %s", json_string_value(x), stored);
+    if (!errs || codec_request_parse(&again, stored, strlen(stored), NULL, errs) != SM_OK)
+        fail(tc, "the stored text does not validate");
+    else if (strcmp(codec_request_sha256(again), codec_request_sha256(req)) ||
+             (name && (!codec_request_name(again) || strcmp(codec_request_name(again), name))))
+        fail(tc, "the stored text parses to another SHA-256 or name");
+    memset(&v, 0, sizeof(v));
+    if (codec_job_id(req, id) != SM_OK)
+        fail(tc, "no job id");
+    v.id = id;
+    v.state = "done";
+    v.name = name;
+    codec_job_list(&t, &v, 1, NULL);
+    json_array_foreach(json_object_get(chk, "listing_contains"), i, x)
+        if (!t.p || !strstr(t.p, json_string_value(x)))
+            fail(tc, "listing lacks %s:\n       %s", json_string_value(x), t.p ? t.p : "");
+    codec_text_free(&t);
+    codec_request_free(again);
+    codec_errors_free(errs);
+}
+
 /* A valid request and its checks. */
 static void run_valid(test_case *tc, const char *dir, const json_t *chk)
 {
@@ -623,6 +667,7 @@ static void run_valid(test_case *tc, const char *dir, const json_t *chk)
     if (strlen(codec_request_sha256(req)) != 64)
         fail(tc, "SHA-256 is not 64 hex digits");
     check_idempotent(tc, req, spatial);
+    check_name(tc, req, chk);
     if (spatial)
         check_with_core(tc, dir, req, chk);
     codec_request_free(req);
