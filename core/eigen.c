@@ -578,11 +578,13 @@ done:
     return rc;
 }
 
-/* Measured on one core of the development machine (issue 23): 10 speeds of a spatial blade on the
- * dense path, user time a speed 0.05 s at 180 coordinates, 0.18 s at 300, 1.04 s at 600, 9.6 s at
- * 1200 with Coriolis (companion form, dgeev); 1.5 s at 1200 without (symmetric). */
+/* Measured on one core of the development machine (issue 23), a speed on the dense path: 12 ms at
+ * 191 coordinates with 3 modes (the 32 + 32 element angled beam, Newton included); with n/8 modes
+ * (a spatial blade) 0.05 s at 180, 0.18 s at 300, 1.04 s at 600, 9.6 s at 1200 with Coriolis, 1.5 s
+ * at 1200 without.  The estimate takes the low end (few modes): a request is refused only when it
+ * surely runs past the limit; the job time limit bounds the rest. */
 double sm_dense_seconds(int n, int coriolis)
 {
     double x = (double)(n > 0 ? n : 0);
-    return (coriolis ? 5.6e-9 : 0.9e-9) * x * x * x;
+    return (coriolis ? 1.8e-9 : 0.3e-9) * x * x * x;
 }

@@ -193,9 +193,10 @@ typedef enum sm_basis {
  * vectors, about 3.5 a mode; more modes take the dense path (issue 23). */
 #define SM_TREE_MAX_MODES 64
 
-/** Estimated seconds of one dense eigen-analysis of n coordinates on one core (measured: 0.15 s
- * at 300, 1.0 s at 600, 9.6 s at 1200 with Coriolis; a sixth of that without): what the daemon's
- * request check weighs against its job time limit.  A rough bound, not a promise. */
+/** Estimated seconds of one speed on the dense path of n coordinates on one core, at the low end
+ * (few modes: 12 ms at 191 coordinates with Coriolis; with n/8 modes 1.0 s at 600 and 9.6 s at
+ * 1200, a sixth of that without Coriolis): what the daemon's request check weighs against its job
+ * time limit, refusing only what surely runs past it. */
 double sm_dense_seconds(int n, int coriolis);
 
 /** Analysis options; fill with sm_default_options first. */

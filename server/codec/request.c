@@ -345,7 +345,7 @@ static int req_check_dense(const codec_request *r, const codec_limits *lim, code
     if (n > lim->max_coordinates)
         return codec_errors_add(errs, many ? "/analysis/modes" : "/structure",
                                 "the model would have %d modal coordinates on the dense solvers, "
-                                "more than the limit of %d (cost ~n^3: about %.3g s and %.0f MB a "
+                                "more than the limit of %d (cost ~n^3: at least %.3g s and about %.0f MB a "
                                 "speed); %suse per-element or small frames, fewer elements, or "
                                 "\"modes_per_frame\"",
                                 n, lim->max_coordinates, t1,
@@ -354,8 +354,8 @@ static int req_check_dense(const codec_request *r, const codec_limits *lim, code
                    : 1;
     if (lim->max_solve_seconds > 0 && total > lim->max_solve_seconds)
         return codec_errors_add(errs, "/analysis/omega",
-                                "%d speeds on the dense solvers (%d modal coordinates, about %.3g s "
-                                "a speed) are estimated at %.3g s, more than the job time limit of "
+                                "%d speeds on the dense solvers (%d modal coordinates, at least %.3g s "
+                                "a speed) are estimated at %.3g s or more, past the job time limit of "
                                 "%g s: ask for fewer speeds (at most %d), or %suse per-element or "
                                 "small frames, or fewer elements",
                                 speeds, n, t1, total, lim->max_solve_seconds,

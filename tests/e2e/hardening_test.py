@@ -29,11 +29,16 @@ holds; none decides a pass by elapsed time.
                 first keeps working); a corrupt database refuses to start
                 naming the corruption; deleting the database under a running
                 daemon makes /readyz 503 ("gone") and POST 503, not silence.
-  build_cancel  the model build is inside the job time limit: a request whose
-                five frames each sit near the --max-frame-dofs bound, with
-                --job-timeout 0.05, fails with error type timeout after its first
-                frame, in well under the time the whole run takes (measured by the
-                CLI in the same test: a ratio, not a fixed budget).
+  build_cancel  the model build can be stopped: a request whose five frames each
+                sit near the --max-frame-dofs bound, canceled once it runs, ends
+                canceled after its first frame, in well under the time the whole
+                run takes (measured by the CLI in the same test: a ratio, not a
+                fixed budget).  (Until issue 23 it ran with --job-timeout 0.05,
+                which the request check now refuses up front.)
+  bounded_cost  issue 23 item 1: 200 modes of 666, 2000 and 1000 (+ error_estimate)
+                element blades and a dense sweep estimated past --job-timeout are
+                422s naming what to ask for; 48 modes of 300 elements (tree path)
+                and 100 modes of 150 elements (dense, one speed) are done.
   cors          --cors-origin accepts one exact origin only ('*', lists and
                 paths are refused at start); OPTIONS answers 204 on a route and
                 404 on an unknown path.
@@ -502,17 +507,21 @@ def scenario_build_cancel(exe, tmp):
     check(p.returncode == 0, "the CLI solves the 5-frame request (exit %d, %.2f s)"
           % (p.returncode, full))
     js = {"Content-Type": "application/json"}
-    d = Daemon(exe, tmp, ["--workers", "1", "--job-timeout", "0.05"])
+    # a cancel once it runs (the stop callback of the build; before issue 23 this was
+    # --job-timeout 0.05, which the request check now refuses up front: the dense solve of its 800
+    # coordinates is estimated past it)
+    d = Daemon(exe, tmp, ["--workers", "1"])
     d.start()
     r = d.request("POST", "/v1/analyses", body=HEAVY, headers=js)
     check(r.status == 202, "accepted (%s)" % r.status)
     job = r.json()["id"]
+    wait_until(lambda: job_state(d, job).get("state") != "queued", 60)
+    r = d.request("DELETE", "/v1/analyses/" + job)
+    check(r.status in (200, 202), "DELETE while it runs (%s)" % r.status)
     doc = wait_until(lambda: job_state(d, job) if job_state(d, job).get("state") in
-                     ("failed", "done") else None, 120)
-    err = (doc or {}).get("error") or {}
-    check(doc is not None and doc["state"] == "failed" and err.get("type") == "timeout",
-          "the job fails with error type timeout (%s %s)"
-          % (doc and doc.get("state"), err.get("type")))
+                     ("failed", "done", "canceled") else None, 120)
+    check(doc is not None and doc["state"] == "canceled",
+          "the job is canceled (%s)" % (doc and doc.get("state")))
     if doc and doc.get("started_at") and doc.get("finished_at"):
         import datetime
         def ts(x):
