@@ -290,6 +290,14 @@ def cases(quick=False):
     # largest sweep of a 2000-element model without shapes (its steady states ~200 MB)
     big = _blade(elements=2000)
     big["analysis"] = {"rpm": {"from": 0, "to": 260, "steps": 26}, "modes": 6, "mode_shapes": True}
+    # issue 23 item 1: a ~240-byte request for 200 modes of a 666-element blade (on 0.7.0 ~100 s
+    # and 2.3 GB a speed on the dense path); a dense sweep estimated past --job-timeout
+    many = _blade(elements=666)
+    many["analysis"] = {"omega": [10], "modes": 200, "mode_shapes": False}
+    add("modes-200-of-666-elements", _j(many), [422], "/analysis/modes", quick_too=True)
+    dense = _blade(elements=150)
+    dense["analysis"] = {"omega": [0.2 * i for i in range(101)], "modes": 100, "mode_shapes": False}
+    add("dense-sweep-past-job-timeout", _j(dense), [422], "/analysis/omega")
     add("result-94MB-shapes", _j(big), [422], "/analysis/mode_shapes", quick_too=True)
     sweep = _blade(elements=2000)
     sweep["analysis"] = {"rpm": {"from": 0, "to": 1000, "steps": 1000}, "modes": 10,
