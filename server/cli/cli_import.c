@@ -8,9 +8,11 @@
  * it names, relative to the .bmi's folder and, without --allow-outside,
  * inside it: no absolute path, no '..', never '-'), calls the importer and
  * prints the request; the importer's warnings (values it had to assume) go to
- * stderr as "spinmodal: warning: ..." lines.  --full prints the whole import
- * document {"request", "warnings", "source"} instead (what POST
- * /v1/import/{format} answers).
+ * stderr as "spinmodal: warning: POINTER: ..." lines (POINTER: the field of
+ * the request, as `solve --table` prints a result's input_warnings).  --full
+ * prints the whole import document {"request", "warnings", "input_warnings",
+ * "source"} instead (what POST /v1/import/{format} answers).  --rpm takes one
+ * speed, a list 0,5,10 or a range START:STOP:COUNT (import_rpm_option).
  *
  * Exit codes: 0 imported, 2 the file is refused (one line
  * "FILE:LINE: FIELD: what is wrong" on stderr, nothing on stdout), 1 the
@@ -29,23 +31,26 @@
 enum { CLI_IMPORT_OK = 0, CLI_IMPORT_FAILED = 1, CLI_IMPORT_INVALID = 2, CLI_IMPORT_USAGE = 64 };
 
 static const char cli_import_usage_text[] =
-    "usage: spinmodal import bmodes FILE.bmi [--rpm N] [--bmodes-mesh K] [--allow-outside] "
+    "usage: spinmodal import bmodes FILE.bmi [--rpm SPEEDS] [--bmodes-mesh K] [--allow-outside] "
     "[--pretty] [--full]\n"
-    "       spinmodal import elastodyn FILE --tip-radius R [--hub-radius H] [--rpm N] "
+    "       spinmodal import elastodyn FILE --tip-radius R [--hub-radius H] [--rpm SPEEDS] "
     "[--pretty] [--full]\n"
-    "       spinmodal import csv FILE [--tip-radius R] [--hub-radius H] [--rpm N] [--pretty] "
+    "       spinmodal import csv FILE [--tip-radius R] [--hub-radius H] [--rpm SPEEDS] [--pretty] "
     "[--full]\n";
 
 static const char cli_import_help_text[] =
     "\noptions:\n"
     "  --tip-radius R   m from the spin axis to the tip (ElastoDyn; CSV with s)\n"
     "  --hub-radius H   m from the spin axis to the root (default 0, with a warning)\n"
-    "  --rpm N          rotor speed, rev/min (overrides the file's)\n"
+    "  --rpm SPEEDS     rotor speeds, rev/min (override the file's): one speed 12.1,\n"
+    "                   a list 0,5,10 or a range START:STOP:COUNT (COUNT speeds, both\n"
+    "                   ends included: 0:15:16 is 0, 1, ... 15 rpm)\n"
     "  --bmodes-mesh K  BModes: its own elements as members, K FE elements each\n"
     "  --allow-outside  BModes: let the .bmi's sec_props_file be an absolute path or\n"
     "                   go up with '..' (by default it must lie in the .bmi's folder\n"
     "                   or below; '-' is never standard input)\n"
-    "  --full           print the import document {request, warnings, source}\n"
+    "  --full           print the import document {request, warnings, input_warnings,\n"
+    "                   source}\n"
     "  --pretty         indent the JSON output\n"
     "  -h, --help       show this help\n\n"
     "exit status: 0 imported, 2 the file is refused (FILE:LINE: FIELD: ... on stderr),\n"
@@ -59,6 +64,7 @@ typedef struct cli_import_args {
     int full;           /* --full: the import document, not only the request */
     int allow_outside;  /* --allow-outside: sec_props_file may leave the .bmi's folder */
     import_options opt; /* --tip-radius, --hub-radius, --rpm */
+    json_t *rpm_speeds; /* --rpm as a list or range (opt.rpm_speeds), NULL for one speed */
 } cli_import_args;
 
 /* A file read whole; the loader's context for BModes. */
@@ -192,17 +198,41 @@ static int cli_import_number(const char *s, double *v)
     return end == s || *end != '\0' || errno || !isfinite(*v) ? -1 : 0;
 }
 
+/* --rpm SPEEDS (one, a list or START:STOP:COUNT: import_rpm_option); 0, or an exit code. */
+static int cli_import_rpm(cli_import_args *a, const char *text)
+{
+    char why[200];
+    int st;
+
+    json_decref(a->rpm_speeds); /* a second --rpm replaces the first */
+    a->rpm_speeds = NULL;
+    if (!text) {
+        fprintf(stderr, "spinmodal: --rpm needs a speed, a list or a range\n%s",
+                cli_import_usage_text);
+        return CLI_IMPORT_USAGE;
+    }
+    st = import_rpm_option(text, &a->opt, &a->rpm_speeds, why, sizeof(why));
+    if (st == SM_NOMEM) {
+        fprintf(stderr, "spinmodal: out of memory\n");
+        return CLI_IMPORT_FAILED;
+    }
+    if (st) {
+        fprintf(stderr, "spinmodal: --rpm: %s\n%s", why, cli_import_usage_text);
+        return CLI_IMPORT_USAGE;
+    }
+    return 0;
+}
+
 /* Parse argv[2..] (argv[1] is "import"); 0, or an exit code. */
 static int cli_import_args_parse(int argc, char **argv, cli_import_args *a)
 {
-    static const char *const num_opts[3] = {"--tip-radius", "--hub-radius", "--rpm"};
-    double *num_dst[3];
+    static const char *const num_opts[2] = {"--tip-radius", "--hub-radius"};
+    double *num_dst[2];
     int i, k, opts_done = 0;
 
     import_default_options(&a->opt);
     num_dst[0] = &a->opt.tip_radius;
     num_dst[1] = &a->opt.hub_radius;
-    num_dst[2] = &a->opt.rpm;
     for (i = 2; i < argc; i++) {
         const char *s = argv[i];
         if (!opts_done && !strcmp(s, "--")) {
@@ -237,10 +267,16 @@ static int cli_import_args_parse(int argc, char **argv, cli_import_args *a)
             i++;
             continue;
         }
-        for (k = 0; !opts_done && k < 3; k++)
+        if (!opts_done && !strcmp(s, "--rpm")) {
+            if ((k = cli_import_rpm(a, i + 1 < argc ? argv[i + 1] : NULL)))
+                return k;
+            i++;
+            continue;
+        }
+        for (k = 0; !opts_done && k < 2; k++)
             if (!strcmp(s, num_opts[k]))
                 break;
-        if (!opts_done && k < 3) {
+        if (!opts_done && k < 2) {
             if (i + 1 >= argc || cli_import_number(argv[i + 1], num_dst[k])) {
                 fprintf(stderr, "spinmodal: %s needs a number\n%s", s, cli_import_usage_text);
                 return CLI_IMPORT_USAGE;
@@ -279,13 +315,15 @@ static int cli_import_args_parse(int argc, char **argv, cli_import_args *a)
 /* Print the warnings, then the request (or the whole document); an exit code. */
 static int cli_import_print(const cli_import_args *a, const json_t *doc)
 {
-    const json_t *w = json_object_get(doc, "warnings");
+    const json_t *w;
     char *text;
     size_t i;
     int ok;
 
-    for (i = 0; i < json_array_size(w); i++)
-        fprintf(stderr, "spinmodal: warning: %s\n", json_string_value(json_array_get(w, i)));
+    json_array_foreach(json_object_get(doc, "input_warnings"), i, w)
+        fprintf(stderr, "spinmodal: warning: %s: %s\n",
+                json_string_value(json_object_get(w, "pointer")),
+                json_string_value(json_object_get(w, "message")));
     text = import_dumps(a->full ? doc : json_object_get(doc, "request"), a->pretty);
     if (!text) {
         fprintf(stderr, "spinmodal: out of memory\n");
@@ -312,13 +350,16 @@ int cli_import_main(int argc, char **argv)
     int rc, st, err;
 
     memset(&a, 0, sizeof(a));
-    if ((rc = cli_import_args_parse(argc, argv, &a)))
+    if ((rc = cli_import_args_parse(argc, argv, &a))) {
+        json_decref(a.rpm_speeds);
         return rc < 0 ? CLI_IMPORT_OK : rc;
+    }
     err = cli_import_read(a.path, 1, &text, &len);
     if (err) {
         fprintf(stderr, "spinmodal: cannot read %s: %s\n",
                 strcmp(a.path, "-") ? a.path : "standard input",
                 err == EFBIG ? "larger than 16 MiB" : strerror(err));
+        json_decref(a.rpm_speeds);
         return CLI_IMPORT_FAILED;
     }
     f.name = strcmp(a.path, "-") ? a.path : "<stdin>";
@@ -342,6 +383,7 @@ int cli_import_main(int argc, char **argv)
         rc = CLI_IMPORT_FAILED;
     }
     json_decref(doc);
+    json_decref(a.rpm_speeds);
     free(fs.sec);
     free(text);
     return rc;

@@ -39,8 +39,111 @@ void import_default_options(import_options *o)
     o->tip_radius = NAN;
     o->hub_radius = NAN;
     o->rpm = NAN;
+    o->rpm_speeds = NULL;
     o->max_modes = lim.max_modes;
     o->bmodes_mesh = 0;
+}
+
+/*
+ * One speed of an --rpm option, text[0..n): 0, or -1 when not a number >= 0 that a request
+ * carries (imp_finite; a lone speed is checked by imp_option instead, as the file's).
+ */
+static int imp_rpm_number(const char *text, size_t n, double *v)
+{
+    char buf[64], *end;
+
+    if (n == 0 || n >= sizeof(buf))
+        return -1;
+    memcpy(buf, text, n);
+    buf[n] = '\0';
+    *v = strtod(buf, &end);
+    return end == buf || *end != '\0' || !(*v >= 0.0) || !imp_finite(*v) ? -1 : 0;
+}
+
+/* "START:STOP:COUNT" (colon at c1 and c2) into o and *speeds; see import_rpm_option. */
+static int imp_rpm_range(const char *text, const char *c1, const char *c2, import_options *o,
+                         json_t **speeds, char *why, size_t cap)
+{
+    double from, to, count;
+
+    if (imp_rpm_number(text, (size_t)(c1 - text), &from) ||
+        imp_rpm_number(c1 + 1, (size_t)(c2 - c1 - 1), &to) ||
+        imp_rpm_number(c2 + 1, strlen(c2 + 1), &count) || count != floor(count) ||
+        count < 1 || count > 1e9) {
+        snprintf(why, cap, "expected START:STOP:COUNT with speeds >= 0 and a whole COUNT >= 1 "
+                 "(\"%.40s\")", text);
+        return SM_INVALID_INPUT;
+    }
+    if (to < from) {
+        snprintf(why, cap, "the range runs from %g to %g rpm: STOP must not be below START",
+                 from, to);
+        return SM_INVALID_INPUT;
+    }
+    if (count == 1 && to != from) {
+        snprintf(why, cap, "%g:%g:1 would be %g rpm alone: COUNT is the number of speeds, both "
+                 "ends included (%g:%g:%.0f is every 1 rpm)", from, to, from, from, to,
+                 to - from == floor(to - from) && to - from < 1e6 ? to - from + 1 : 2.0);
+        return SM_INVALID_INPUT;
+    }
+    o->rpm = from;
+    *speeds = count == 1 ? json_pack("[f]", from)
+                         : json_pack("{s:f, s:f, s:I}", "from", from, "to", to, "steps",
+                                     (json_int_t)(count - 1));
+    return *speeds ? SM_OK : SM_NOMEM;
+}
+
+/* import_rpm_option but for o->rpm_speeds. */
+static int imp_rpm_parse(const char *text, import_options *o, json_t **speeds, char *why,
+                         size_t cap)
+{
+    const char *c1 = strchr(text, ':'), *c2 = c1 ? strchr(c1 + 1, ':') : NULL, *p, *comma;
+    double v;
+
+    *speeds = NULL;
+    if (c1 && c2 && !strchr(c2 + 1, ':'))
+        return imp_rpm_range(text, c1, c2, o, speeds, why, cap);
+    if (c1) {
+        snprintf(why, cap, "a range is START:STOP:COUNT (\"%.40s\")", text);
+        return SM_INVALID_INPUT;
+    }
+    if (!strchr(text, ',')) {
+        char *end;
+        o->rpm = strtod(text, &end);
+        if (end == text || *end != '\0' || !isfinite(o->rpm) || o->rpm < 0.0)
+            goto bad;
+        return SM_OK; /* imp_option refuses it beyond what a request carries */
+    }
+    if (!(*speeds = json_array()))
+        return SM_NOMEM;
+    for (p = text;; p = comma + 1) {
+        comma = strchr(p, ',');
+        if (imp_rpm_number(p, comma ? (size_t)(comma - p) : strlen(p), &v))
+            goto bad;
+        if (json_array_append_new(*speeds, json_real(v))) {
+            json_decref(*speeds);
+            *speeds = NULL;
+            return SM_NOMEM;
+        }
+        if (!comma)
+            break;
+    }
+    o->rpm = json_number_value(json_array_get(*speeds, 0));
+    return SM_OK;
+bad:
+    json_decref(*speeds);
+    *speeds = NULL;
+    snprintf(why, cap, "expected a speed >= 0 (rev/min), a list 0,5,10 or a range "
+             "START:STOP:COUNT (\"%.40s\")", text);
+    return SM_INVALID_INPUT;
+}
+
+int import_rpm_option(const char *text, import_options *o, json_t **speeds, char *why,
+                      size_t cap)
+{
+    int st = imp_rpm_parse(text, o, speeds, why, cap);
+
+    o->rpm_speeds = st == SM_OK ? *speeds : NULL;
+    return st;
 }
 
 int import_format_known(const char *name)
@@ -303,7 +406,7 @@ int imp_value(import_diag *d, const char *file, int line, const char *field, con
     return imp_check(d, file, line, field, kind, *v);
 }
 
-int imp_warn(json_t *warnings, const char *fmt, ...)
+int imp_warn(json_t *warnings, const char *pointer, const char *fmt, ...)
 {
     char msg[512];
     va_list ap;
@@ -311,7 +414,20 @@ int imp_warn(json_t *warnings, const char *fmt, ...)
     va_start(ap, fmt);
     vsnprintf(msg, sizeof(msg), fmt, ap);
     va_end(ap);
-    return json_array_append_new(warnings, json_string(msg));
+    return json_array_append_new(warnings, json_pack("{s:s, s:s}", "pointer", pointer,
+                                                     "message", msg));
+}
+
+int imp_legacy_warnings(json_t *doc)
+{
+    const json_t *w;
+    json_t *strings = json_array();
+    size_t i;
+    int bad = !strings;
+
+    json_array_foreach(json_object_get(doc, "input_warnings"), i, w)
+        bad |= json_array_append_new(strings, json_copy(json_object_get(w, "message")));
+    return bad || json_object_set_new(doc, "warnings", strings) ? -1 : 0;
 }
 
 /* ------------------------------------------------------ station table */
@@ -497,7 +613,7 @@ int imp_assumed_section(json_t **out, import_diag *d, const char *file, const im
     if (!(t->mask & (1u << IK_EA))) {
         double ea = imp_round(IMP_EA_RATIO * ei / (length * length));
         bad |= json_object_set_new(sec, "EA", json_real(ea));
-        bad |= imp_warn(warnings, "EA is not in the %s file: blade.section.EA = %.6g N assumed "
+        bad |= imp_warn(warnings, "/blade/section/EA", "EA is not in the %s file: blade.section.EA = %.6g N assumed "
                         "(1e4 x the largest EI / length^2: nearly rigid in extension); the "
                         "default rotary inertias mass_per_length x EI / EA depend on it: "
                         "review", format, ea);
@@ -505,7 +621,7 @@ int imp_assumed_section(json_t **out, import_diag *d, const char *file, const im
     if (!(t->mask & (1u << IK_GJ))) {
         double gj = imp_round(IMP_GJ_RATIO * ei);
         bad |= json_object_set_new(sec, "GJ", json_real(gj));
-        bad |= imp_warn(warnings, "GJ is not in the %s file: blade.section.GJ = %.6g N m^2 "
+        bad |= imp_warn(warnings, "/blade/section/GJ", "GJ is not in the %s file: blade.section.GJ = %.6g N m^2 "
                         "assumed (10 x the largest EI: nearly rigid in torsion): review",
                         format, gj);
     }
@@ -554,14 +670,16 @@ int imp_options_apply(import_diag *d, const char *file, const import_options *o,
     if ((st = imp_option(d, file, "hub_radius", o->hub_radius)) ||
         (st = imp_option(d, file, "rpm", o->rpm)))
         return st;
-    if (!isnan(o->rpm))
+    if (!isnan(o->rpm)) {
         b->rpm = o->rpm;
-    else
-        bad |= imp_warn(warnings, "no rotor speed in the file: analysis.rpm = [0] (not "
-                        "spinning); give one with --rpm (HTTP: ?rpm=)");
+        b->rpm_speeds = o->rpm_speeds;
+    } else {
+        bad |= imp_warn(warnings, "/analysis/rpm", "no rotor speed in the file: analysis.rpm = "
+                        "[0] (not spinning); give one with --rpm (HTTP: ?rpm=)");
+    }
     if (length_known) {
         if (!isnan(o->tip_radius) || !isnan(o->hub_radius))
-            bad |= imp_warn(warnings, "the file gives the blade's radii: the tip and hub "
+            bad |= imp_warn(warnings, "/blade/length", "the file gives the blade's radii: the tip and hub "
                             "radius options are ignored");
         return bad ? SM_NOMEM : SM_OK;
     }
@@ -572,7 +690,7 @@ int imp_options_apply(import_diag *d, const char *file, const import_options *o,
                         "file) and the hub radius (--hub-radius, ?hub_radius=; HubRad)");
     if (isnan(o->hub_radius)) {
         b->hub_radius = 0.0;
-        bad |= imp_warn(warnings, "no hub radius given: blade.hub_radius = 0 assumed (give "
+        bad |= imp_warn(warnings, "/blade/hub_radius", "no hub radius given: blade.hub_radius = 0 assumed (give "
                         "--hub-radius, HTTP ?hub_radius=)");
     } else {
         b->hub_radius = o->hub_radius;
@@ -680,11 +798,13 @@ static json_t *imp_blade_json(const imp_blade *b, const imp_table *t, json_t *se
 json_t *imp_document(const imp_blade *b, const imp_table *t, json_t *section,
                      json_t *warnings, json_t *source)
 {
-    json_t *doc = json_object(), *req = json_object(), *an = json_object(), *rpm = json_array();
+    json_t *doc = json_object(), *req = json_object(), *an = json_object();
+    json_t *rpm = b->rpm_speeds ? json_deep_copy(b->rpm_speeds) : json_array();
     int bad = !doc || !req || !an || !rpm || !warnings || !source;
 
     if (!bad) {
-        bad |= json_array_append_new(rpm, imp_real(b->rpm));
+        if (!b->rpm_speeds)
+            bad |= json_array_append_new(rpm, imp_real(b->rpm));
         bad |= json_object_set(an, "rpm", rpm);
         bad |= json_object_set_new(an, "modes", json_integer(b->modes));
         bad |= json_object_set_new(an, "coriolis", json_false());
@@ -695,8 +815,10 @@ json_t *imp_document(const imp_blade *b, const imp_table *t, json_t *section,
         bad |= json_object_set_new(req, "frames", json_string("per_element"));
         bad |= json_object_set(req, "analysis", an);
         bad |= json_object_set(doc, "request", req);
-        bad |= json_object_set(doc, "warnings", warnings);
+        bad |= json_object_set(doc, "warnings", warnings); /* replaced below, keeps its place */
+        bad |= json_object_set(doc, "input_warnings", warnings);
         bad |= json_object_set(doc, "source", source);
+        bad |= imp_legacy_warnings(doc);
     }
     json_decref(section);
     json_decref(rpm);

@@ -11,9 +11,14 @@
  *
  *     {"request": {"blade": {...}, "frames": "per_element", "analysis": {...}},
  *      "warnings": ["values assumed, ..."],
+ *      "input_warnings": [{"pointer": "/blade/section/EA", "message": "values assumed, ..."}],
  *      "source": {"format": "bmodes", "file": "...", ...}}
  *
- * whose "request" is what `spinmodal solve` takes.  A bad file is refused
+ * whose "request" is what `spinmodal solve` takes.  "input_warnings" has the
+ * shape of a result's input_warnings: the pointer names the field of the
+ * request the warning is about (a value assumed, an option that replaced the
+ * file's, a column left out: /blade/stations); "warnings" holds the same
+ * messages as plain strings, the shape before 0.8, kept for older clients.  A bad file is refused
  * with one diagnostic naming the file, the line and the field:
  * "blade_sec_props.dat:7: axial_stff: not a number (\"abc\")".
  * Numbers too large for the request (past 1.79769313486231e+308, which
@@ -59,6 +64,11 @@ typedef struct import_options {
     double tip_radius; /* m, from the spin axis along the blade; NAN = not given */
     double hub_radius; /* m, >= 0; NAN = not given */
     double rpm;        /* rev/min, >= 0; NAN = not given (overrides the file's) */
+    const json_t *rpm_speeds; /* NULL, or several speeds (rev/min) for analysis.rpm instead of
+                                 [rpm]: an array of numbers or a range {"from", "to", "steps"}
+                                 as a request takes them (CLI --rpm 0:15:16 or 0,5,10); borrowed,
+                                 checked by the caller (finite, >= 0); rpm is then its first
+                                 speed */
     int max_modes;     /* cap of analysis.modes (the codec's limit) */
     int bmodes_mesh;   /* BModes only: > 0 = BModes' own model (its nselt elements as uniform
                           members with its midpoint properties, BModes.f90:1110), this many FE
@@ -101,6 +111,19 @@ int import_elastodyn(json_t **out, const import_file *f, const import_options *o
 
 /** CSV with a header row of station keys (units in brackets optional, '#' comments). */
 int import_csv(json_t **out, const import_file *f, const import_options *o, import_diag *d);
+
+/**
+ * The rotor-speed option (CLI --rpm, HTTP ?rpm=), in rev/min: one number "12.1", a list
+ * "0,5,10", or a range "START:STOP:COUNT" (COUNT speeds from START to STOP, both ends
+ * included, as the Python client's and campbell.sh's ranges: "0:15:16" is 0, 1, ... 15 rpm;
+ * COUNT 1 only when START = STOP, so that "0:15:1" is not silently 0 rpm alone).  Every
+ * speed finite and >= 0, START <= STOP.  Sets o->rpm to the first speed and o->rpm_speeds to
+ * *speeds: NULL for one number, else a new reference (an array, or the range
+ * {"from", "to", "steps": COUNT - 1} of a request) that the caller keeps while it imports and
+ * then json_decref's.  SM_OK; SM_INVALID_INPUT with why[cap] saying what is wrong; SM_NOMEM.
+ */
+int import_rpm_option(const char *text, import_options *o, json_t **speeds, char *why,
+                      size_t cap);
 
 /** 1 when name is an import format: "bmodes", "elastodyn" or "csv". */
 int import_format_known(const char *name);

@@ -337,13 +337,22 @@ static int bm_blade(const bm_main *m, const import_options *o, imp_blade *bl, js
     bl->length_line = m->length_line;
     bl->length_field = "hub_rad";
     if (!isnan(o->rpm)) {
-        bad |= imp_warn(warn, "rotor speed %g rpm given: the file's %g rpm (rot_rpm x "
-                        "rpm_mult) is not used", o->rpm, bl->rpm);
+        const json_t *to = json_object_get(o->rpm_speeds, "to");
+        if (o->rpm_speeds)
+            bad |= imp_warn(warn, "/analysis/rpm", "rotor speeds %g %s %g rpm given (%s): the "
+                            "file's %g rpm (rot_rpm x rpm_mult) is not used", o->rpm,
+                            to ? "to" : "...", to ? json_number_value(to) : json_number_value(
+                            json_array_get(o->rpm_speeds, json_array_size(o->rpm_speeds) - 1)),
+                            to ? "a range" : "a list", bl->rpm);
+        else
+            bad |= imp_warn(warn, "/analysis/rpm", "rotor speed %g rpm given: the file's %g "
+                            "rpm (rot_rpm x rpm_mult) is not used", o->rpm, bl->rpm);
         bl->rpm = o->rpm;
+        bl->rpm_speeds = o->rpm_speeds;
     }
     bl->modes = (int)m->modepr;
     if (o->max_modes > 0 && bl->modes > o->max_modes) {
-        bad |= imp_warn(warn, "modepr %d is above the limit of %d modes: analysis.modes = %d",
+        bad |= imp_warn(warn, "/analysis/modes", "modepr %d is above the limit of %d modes: analysis.modes = %d",
                         bl->modes, o->max_modes, o->max_modes);
         bl->modes = o->max_modes;
     }
@@ -359,8 +368,8 @@ static int bm_blade(const bm_main *m, const import_options *o, imp_blade *bl, js
     bl->tip_products[1] = m->tip[6];   /* ixy -> I23 */
     bl->tip_products[2] = m->tip[7];   /* izx -> I31 */
     if (m->tip[2] != 0.0)
-        bad |= imp_warn(warn, "cm_axial = %g m is ignored: BModes uses it for towers only",
-                        m->tip[2]);
+        bad |= imp_warn(warn, bl->has_tip ? "/blade/tip_mass" : "/blade",
+                        "cm_axial = %g m is ignored: BModes uses it for towers only", m->tip[2]);
     return bad ? SM_NOMEM : SM_OK;
 }
 
@@ -583,7 +592,7 @@ static int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *fil
     if (!json_array_size(pms))
         json_object_del(st, "point_masses");
     if (json_object_set(req, "structure", st) || json_object_del(req, "blade") ||
-        imp_warn(warn, "BModes' own model (bmodes_mesh %d): its %zu elements as uniform members "
+        imp_warn(warn, "/structure", "BModes' own model (bmodes_mesh %d): its %zu elements as uniform members "
                        "with the properties at their midpoints (BModes.f90:1110), %d FE elements "
                        "each, which reproduces BModes' numbers; without the option the "
                        "properties are interpolated along the span as the file gives them (the "
@@ -600,6 +609,32 @@ done:
     codec_request_free(r);
     codec_errors_free(errs);
     return rc;
+}
+
+/*
+ * After bm_own_mesh: the warnings' pointers into the blade form point into the structure that
+ * replaced it (/blade/section/K -> /structure/sections/blade/K, any other /blade... ->
+ * /structure), and "warnings" gets the message of the one bm_own_mesh added.  0, -1 (memory).
+ */
+static int bm_mesh_warnings(json_t *doc)
+{
+    static const char sec[] = "/blade/section/";
+    json_t *w;
+    size_t i;
+    char p[160];
+
+    json_array_foreach(json_object_get(doc, "input_warnings"), i, w) {
+        const char *ptr = json_string_value(json_object_get(w, "pointer"));
+        if (!ptr || strncmp(ptr, "/blade", 6) || (ptr[6] != '/' && ptr[6] != '\0'))
+            continue;
+        if (!strncmp(ptr, sec, sizeof(sec) - 1))
+            snprintf(p, sizeof(p), "/structure/sections/blade/%s", ptr + sizeof(sec) - 1);
+        else
+            snprintf(p, sizeof(p), "/structure");
+        if (json_object_set_new(w, "pointer", json_string(p)))
+            return -1;
+    }
+    return imp_legacy_warnings(doc);
 }
 
 int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void *ctx,
@@ -648,7 +683,7 @@ int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void
     /* BModes has no tension-torsion (Wagner) term (DESIGN.md 8.2): the request switches it
      * off so that it is BModes' model, and says how to put it back */
     sec = json_pack("{s:f}", "ip_over_a", 0.0);
-    if (!sec || imp_warn(warn, "blade.section.ip_over_a = 0: BModes has no tension-torsion "
+    if (!sec || imp_warn(warn, "/blade/section/ip_over_a", "blade.section.ip_over_a = 0: BModes has no tension-torsion "
                                "(Wagner) stiffness, so the import leaves it out to reproduce "
                                "BModes; delete ip_over_a to include it (it raises the first "
                                "torsion frequency, ~1.4 %% on BModes' Test01)")) {
@@ -660,9 +695,13 @@ int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void
     *out = imp_document(&bl, &t, sec, warn, src);
     warn = NULL;
     st = *out ? SM_OK : SM_NOMEM;
-    if (!st && o->bmodes_mesh > 0 &&
-        (st = bm_own_mesh(*out, el_loc, o->bmodes_mesh, bmi->name, d,
-                          json_object_get(*out, "warnings")))) {
+    if (!st && o->bmodes_mesh > 0) {
+        st = bm_own_mesh(*out, el_loc, o->bmodes_mesh, bmi->name, d,
+                         json_object_get(*out, "input_warnings"));
+        if (!st && bm_mesh_warnings(*out))
+            st = SM_NOMEM;
+    }
+    if (st && *out) {
         json_decref(*out);
         *out = NULL;
     }

@@ -169,7 +169,8 @@ static int ed_columns(imp_reader *r, import_diag *d, int *col, int *ncol, json_t
         imp_tok_copy(name, sizeof(name), &t[c]);
         if (col[c] >= 0 && seen[col[c]]++)
             return imp_fail(d, file, r->line, name, "column given twice");
-        if (col[c] < 0 && imp_warn(warn, "column %s of the ElastoDyn table is not used", name))
+        if (col[c] < 0 && imp_warn(warn, "/blade/stations", "column %s of the ElastoDyn table is not used",
+                                    name))
             return SM_NOMEM;
     }
     for (k = 0; k < ED_NCOLS; k++)

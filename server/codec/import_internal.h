@@ -106,12 +106,22 @@ int imp_value(import_diag *d, const char *file, int line, const char *field, con
 int imp_check(import_diag *d, const char *file, int line, const char *field, int kind,
               double v);
 
-/** Add a sentence to the warnings array (printf style); -1 when out of memory. */
-int imp_warn(json_t *warnings, const char *fmt, ...)
+/**
+ * Add {"pointer", "message"} to the warnings array: pointer (RFC 6901) names the field of the
+ * request the warning is about, as the result's input_warnings do; the message is printf style.
+ * -1 when out of memory.
+ */
+int imp_warn(json_t *warnings, const char *pointer, const char *fmt, ...)
 #if defined(__GNUC__)
-    __attribute__((format(printf, 2, 3)))
+    __attribute__((format(printf, 3, 4)))
 #endif
     ;
+
+/**
+ * Set doc's "warnings" to the messages of its "input_warnings", as strings: the shape of the
+ * import document before 0.8 (kept for older clients; DAEMON.md).  -1 when out of memory.
+ */
+int imp_legacy_warnings(json_t *doc);
 
 /* ---------------------------------------------------- station table */
 
@@ -182,6 +192,7 @@ typedef struct imp_blade {
     double tip_inertia[3];  /* [I11 torsion, I22 flap, I33 edge] kg m^2 */
     double tip_products[3]; /* [I12, I23, I31] kg m^2 */
     double rpm;          /* rev/min */
+    const json_t *rpm_speeds; /* NULL, or analysis.rpm instead of [rpm] (import_options) */
     int modes;           /* analysis.modes */
     int length_line;     /* the line that gives the length (0 = an option) */
     const char *length_field; /* its field ("r", "radius", "tip_radius"), for messages */
@@ -224,7 +235,7 @@ int imp_options_apply(import_diag *d, const char *file, const import_options *o,
                       int length_known, imp_blade *b, json_t *warnings);
 
 /**
- * The import document {"request", "warnings", "source"}: takes section
+ * The import document {"request", "warnings", "input_warnings", "source"}: takes section
  * (may be NULL), warnings and source (stolen, even on failure).  NULL when
  * out of memory.
  */

@@ -13,7 +13,8 @@
  * "sec_props": "section file text", "name": "optional .bmi name"};
  * elastodyn and csv take the same JSON (without sec_props) or the raw text
  * (text/plain, text/csv or application/octet-stream).  Query parameters:
- * tip_radius, hub_radius, rpm (numbers, as the CLI options) and name (the
+ * tip_radius, hub_radius (numbers), rpm (a number, a list 0,5,10 or a range
+ * START:STOP:COUNT: import_rpm_option, as the CLI's --rpm) and name (the
  * file name used in messages).  The token is needed only under
  * --auth-reads (as for /v1/validate: nothing is written).
  */
@@ -34,6 +35,7 @@ typedef struct http_import_in {
     import_file main;      /* the .bmi / blade file / CSV */
     import_file sec;       /* BModes section file (JSON "sec_props") */
     import_options opt;
+    json_t *rpm_speeds;    /* ?rpm= as a list or range (opt.rpm_speeds), NULL for one speed */
 } http_import_in;
 
 /* The format of the path /v1/import/{format} (routed only when known). */
@@ -108,13 +110,13 @@ static enum MHD_Result http_import_bad(struct MHD_Connection *c, http_req *r,
 static int http_import_query(struct MHD_Connection *c, http_req *r, http_import_in *in,
                              enum MHD_Result *q)
 {
-    static const char *const names[3] = {"tip_radius", "hub_radius", "rpm"};
-    double *dst[3] = {&in->opt.tip_radius, &in->opt.hub_radius, &in->opt.rpm};
+    static const char *const names[2] = {"tip_radius", "hub_radius"};
+    double *dst[2] = {&in->opt.tip_radius, &in->opt.hub_radius};
     const char *v;
-    char *end;
+    char *end, why[200];
     int k;
 
-    for (k = 0; k < 3; k++) {
+    for (k = 0; k < 2; k++) {
         v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, names[k]);
         if (!v)
             continue;
@@ -123,6 +125,12 @@ static int http_import_query(struct MHD_Connection *c, http_req *r, http_import_
             *q = http_bad_query(c, r, names[k], "expected a number >= 0");
             return -1;
         }
+    }
+    v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "rpm");
+    k = v ? import_rpm_option(v, &in->opt, &in->rpm_speeds, why, sizeof(why)) : SM_OK;
+    if (k) {
+        *q = k == SM_NOMEM ? http_send_oom(c, r) : http_bad_query(c, r, "rpm", why);
+        return -1;
     }
     v = MHD_lookup_connection_value(c, MHD_GET_ARGUMENT_KIND, "bmodes_mesh");
     if (v) { /* BModes' own model, this many FE elements per BModes element (import.h) */
@@ -276,11 +284,16 @@ enum MHD_Result http_import_end(struct MHD_Connection *c, http_req *r)
         if (!strcmp(in.format, default_names[k][0]))
             in.main.name = default_names[k][1];
     in.json = http_import_ctype(ct, "application/json");
-    if (http_import_query(c, r, &in, &q))
+    if (http_import_query(c, r, &in, &q)) {
+        json_decref(in.rpm_speeds);
         return q;
-    if (in.opt.bmodes_mesh && strcmp(in.format, "bmodes"))
+    }
+    if (in.opt.bmodes_mesh && strcmp(in.format, "bmodes")) {
+        json_decref(in.rpm_speeds);
         return http_bad_query(c, r, "bmodes_mesh", "applies to bmodes only");
+    }
     if (in.json && http_import_json(c, r, &in, &doc, &q)) {
+        json_decref(in.rpm_speeds);
         json_decref(doc);
         return q;
     }
@@ -289,6 +302,7 @@ enum MHD_Result http_import_end(struct MHD_Connection *c, http_req *r)
         in.main.len = r->len;
     }
     q = http_import_run(c, r, &in);
+    json_decref(in.rpm_speeds);
     json_decref(doc);
     return q;
 }

@@ -164,6 +164,37 @@ def sec_props_file_confined(exe, bm, tmp):
     check(rc == 0 and "--allow-outside" in out, "item 8: import --help documents --allow-outside")
 
 
+def rpm_ranges(exe, bmi, tmp):
+    """--rpm takes one speed, a list or START:STOP:COUNT (COUNT speeds, both ends included, as
+    the Python client and campbell.sh): a range is the request's {from, to, steps}, and it
+    solves at those speeds; 0:15:1 (which would be 0 rpm alone) and STOP < START are usage
+    errors (issue 26)."""
+    for spec, want in (("0:15:16", {"from": 0.0, "to": 15.0, "steps": 15}),
+                       ("0,5,10", [0.0, 5.0, 10.0]), ("7:7:1", [7.0]), ("12.1", [12.1])):
+        rc, out, err = run(exe, ["import", "bmodes", bmi, "--rpm", spec])
+        req = json.loads(out) if rc == 0 else {}
+        check(rc == 0 and req.get("analysis", {}).get("rpm") == want,
+              "--rpm %s: analysis.rpm %r (%d %r)" % (spec, want, rc, req.get("analysis", {}).get("rpm")))
+        if spec == "0:15:16":
+            check("rotor speeds 0 to 15 rpm given (a range)" in err,
+                  "--rpm 0:15:16: the warning names the range (%s)" % err.strip())
+    rc, out, err = run(exe, ["import", "bmodes", bmi, "--rpm", "0:15:4"])
+    path = os.path.join(tmp, "range.json")
+    with open(path, "w") as f:
+        f.write(out)
+    rc, out, err = run(exe, ["solve", "--csv", path])
+    lines = out.strip().split("\n") if rc == 0 else ["rpm"]
+    col = lines[0].split(",").index("rpm")
+    rpms = sorted({round(float(line.split(",")[col]), 9) for line in lines[1:]})
+    check(rpms == [0.0, 5.0, 10.0, 15.0], "--rpm 0:15:4 solves at 0, 5, 10, 15 rpm (%d %r)" % (rc, rpms))
+    for spec, say in (("0:15:1", "0:15:16"), ("15:0:4", "STOP must not be below START"),
+                      ("0:15", "START:STOP:COUNT"), ("0:15:2.5", "COUNT"), ("1,x", "list"),
+                      ("-1", "speed >= 0")):
+        rc, out, err = run(exe, ["import", "bmodes", bmi, "--rpm", spec])
+        check(rc == 64 and out == "" and say in err and "usage:" in err,
+              "--rpm %s: exit 64, says %r (%d %s)" % (spec, say, rc, err.strip()[:160]))
+
+
 def csv_bom(exe, tmp):
     """Issue 23 item 6: Excel's "CSV UTF-8" (a byte-order mark) imports; UTF-16 is refused."""
     text = "s, mass_per_length, EI_flap, EI_edge\n0,1,1,1\n1,1,1,1\n"
@@ -210,13 +241,22 @@ def main(argv):
         # --full --pretty: the import document; --rpm overrides with a warning
         rc, out, err = run(exe, ["import", "bmodes", test02, "--full", "--pretty", "--rpm", "30"])
         doc = json.loads(out) if rc == 0 else {}
-        check(rc == 0 and set(doc) == {"request", "warnings", "source"},
-              "bmodes --full: request, warnings, source")
+        check(rc == 0 and set(doc) == {"request", "warnings", "input_warnings", "source"},
+              "bmodes --full: request, warnings, input_warnings, source")
+        # issue 26: the import's warnings have the shape of a result's input_warnings
+        check([w.get("pointer") for w in doc.get("input_warnings", [])] ==
+              ["/analysis/rpm", "/blade/section/ip_over_a"] and
+              all(set(w) == {"pointer", "message"} for w in doc["input_warnings"]),
+              "bmodes --full: input_warnings [{pointer, message}] at /analysis/rpm and "
+              "/blade/section/ip_over_a (%r)" % doc.get("input_warnings"))
+        check(doc.get("warnings") == [w["message"] for w in doc.get("input_warnings", [])],
+              "bmodes --full: warnings, the same messages as strings (older clients)")
         check(doc.get("request", {}).get("analysis", {}).get("rpm") == [30.0], "bmodes --rpm 30")
         check(doc.get("source", {}).get("el_loc", [None])[-1] == 1.0, "bmodes: source.el_loc")
         check("\n  " in out, "--pretty indents")
-        check(err.startswith("spinmodal: warning: rotor speed 30 rpm given"),
-              "bmodes --rpm: warning on stderr (%s)" % err.strip())
+        check(err.startswith("spinmodal: warning: /analysis/rpm: rotor speed 30 rpm given"),
+              "bmodes --rpm: warning with its pointer on stderr (%s)" % err.strip())
+        rpm_ranges(exe, test02, tmp)
 
         # a refused file: one line on stderr, exit 2, nothing on stdout
         rc, out, err = run(exe, ["import", "bmodes", os.path.join(bm, "Test03_tower.bmi")])

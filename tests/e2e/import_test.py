@@ -52,7 +52,8 @@ def scenario(exe, ref, tmp):
         blade = doc.get("request", {}).get("blade", {})
         check(r.status == 200 and r.headers.get("Content-Type") == "application/json",
               "bmodes: 200 application/json (got %s)" % r.status)
-        check(set(doc) == {"request", "warnings", "source"}, "bmodes: request, warnings, source")
+        check(set(doc) == {"request", "warnings", "input_warnings", "source"},
+              "bmodes: request, warnings, input_warnings, source")
         check(blade.get("length") == 33.25 and blade.get("hub_radius") == 1.75 and
               len(blade.get("stations", [])) == 21, "bmodes: length, hub radius, 21 stations")
         check(blade.get("stations", [{}] * 3)[2].get("mass_per_length") == 181.672,
@@ -97,6 +98,9 @@ def scenario(exe, ref, tmp):
               "elastodyn raw: 200, length 61.5, 49 stations (got %s)" % r.status)
         check(doc.get("source", {}).get("file") == "5MW.dat" and len(doc.get("warnings", [])) == 2,
               "elastodyn: ?name= and 2 warnings")
+        check([w.get("pointer") for w in doc.get("input_warnings", [])] ==
+              ["/blade/section/EA", "/blade/section/GJ"],
+              "elastodyn: input_warnings {pointer, message} at the assumed EA and GJ (issue 26)")
         r = d.post("/v1/import/elastodyn", {"main": ed.decode()})
         p = r.json() or {}
         check(r.status == 422 and p.get("field") == "tip_radius" and
