@@ -3,7 +3,10 @@
 #
 #   campbell.sh REQUEST.json START:STOP:COUNT      e.g. campbell.sh examples/angled-beam-90.json 0:20:101
 #   campbell.sh REQUEST.json 0,5,10,20             explicit speeds (rad/s)
-#   campbell.sh --rpm REQUEST.json 0:15:16         the same in rev/min
+#   campbell.sh --rpm REQUEST.json 0:15:16         the same in rev/min (0, 1, ... 15)
+#
+# COUNT is the number of speeds, both ends included, as in `spinmodal import --rpm` and the
+# Python client: 0:15:1 is refused (it would be 0 alone).
 #
 # Replaces the request's speeds (analysis.omega or analysis.rpm, whichever it has: the
 # importers write rpm) by COUNT evenly spaced speeds from START to STOP (both included), in
@@ -34,14 +37,15 @@ try:
     if ":" in spec:
         start, stop, count = spec.split(":")
         start, stop, count = float(start), float(stop), int(count)
-        if count < 1:
-            raise ValueError
+        if count < 1 or (count == 1 and stop != start):
+            raise ValueError  # 0:15:1 would be 0 alone: COUNT counts the speeds (0:15:16)
         speeds = [start] if count == 1 else \
             [start + i * (stop - start) / (count - 1) for i in range(count - 1)] + [stop]
     else:
         speeds = [float(s) for s in spec.split(",")]
 except ValueError:
-    print("campbell.sh: bad speed range %r (START:STOP:COUNT or S1,S2,...)" % spec, file=sys.stderr)
+    print("campbell.sh: bad speed range %r (START:STOP:COUNT, COUNT speeds with both ends "
+          "included, so COUNT 1 only when START = STOP; or S1,S2,...)" % spec, file=sys.stderr)
     sys.exit(64)
 try:
     req = json.load(sys.stdin if path == "-" else open(path))

@@ -149,7 +149,9 @@ def _request_dict(request):
 
 def parse_speeds(text):
     """Speeds from 'START:STOP:COUNT' (COUNT evenly spaced values, both ends included, like
-    numpy.linspace) or a comma-separated list '0,5,10'.  Returns a list of floats."""
+    numpy.linspace: '0:15:16' is 0, 1, ... 15), one number or a comma-separated list '0,5,10'.
+    Returns a list of floats.  COUNT 1 needs START = STOP ('0:15:1' would silently be 0 alone:
+    ValueError), the same rule as `spinmodal import --rpm` and clients/curl/campbell.sh."""
     text = text.strip()
     if ":" in text:
         parts = text.split(":")
@@ -158,6 +160,10 @@ def parse_speeds(text):
         start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
         if count < 1:
             raise ValueError("COUNT must be >= 1, got %d" % count)
+        if count == 1 and stop != start:
+            raise ValueError("%s would be %g alone: COUNT is the number of speeds, both ends "
+                             "included (e.g. %g:%g:%d)" % (text, start, start, stop,
+                                                           int(abs(stop - start)) + 1))
         if count == 1:
             return [start]
         step = (stop - start) / (count - 1)
@@ -371,17 +377,31 @@ class Client:
     def import_file(self, format, main, sec_props=None, name=None, tip_radius=None,
                     hub_radius=None, rpm=None, bmodes_mesh=None):
         """POST /v1/import/{format}: a blade file's text (``main``; BModes also the text of its
-        section-properties file, ``sec_props``) -> the import document {request, warnings,
-        source}.  SpinmodalError 422 names the file, line and field of a refused file."""
+        section-properties file, ``sec_props``) -> the import document {request,
+        input_warnings, warnings, source}.  ``rpm`` (rev/min, replaces the file's speed): a
+        number, a list of numbers, or the text of a range 'START:STOP:COUNT' (COUNT speeds,
+        both ends included) or list '0,5,10' as `spinmodal import --rpm` takes it.
+
+        ``input_warnings`` is [{"pointer", "message"}], the shape of a result's input_warnings
+        (pointer: the field of the request the warning is about); ``warnings`` holds the same
+        messages as plain strings (the older shape; a daemon before 0.8 sends only these, and
+        they come back here as input_warnings with pointer "").  SpinmodalError 422 names the
+        file, line and field of a refused file."""
         body = {"main": main}
         if sec_props is not None:
             body["sec_props"] = sec_props
         if name:
             body["name"] = name
-        return self._call("POST", "/v1/import/" + urllib.parse.quote(format, safe=""),
-                          body=json.dumps(body).encode("utf-8"),
-                          query={"tip_radius": tip_radius, "hub_radius": hub_radius,
-                                 "rpm": rpm, "bmodes_mesh": bmodes_mesh})[2]
+        if isinstance(rpm, (list, tuple)):
+            rpm = ",".join(repr(float(v)) for v in rpm)
+        doc = self._call("POST", "/v1/import/" + urllib.parse.quote(format, safe=""),
+                         body=json.dumps(body).encode("utf-8"),
+                         query={"tip_radius": tip_radius, "hub_radius": hub_radius,
+                                "rpm": rpm, "bmodes_mesh": bmodes_mesh})[2]
+        if isinstance(doc, dict) and "input_warnings" not in doc:
+            doc["input_warnings"] = [{"pointer": "", "message": str(w)}
+                                     for w in doc.get("warnings") or []]
+        return doc
 
     def cancel(self, id):
         """DELETE /v1/analyses/{id}: the status document (``canceled`` for a queued job,
@@ -604,6 +624,12 @@ def bmodes_sec_props_name(bmi_text):
 
 
 def _cmd_import(c, a):
+    if a.rpm is not None:
+        try:
+            parse_speeds(a.rpm)     # the daemon parses it again (400 for what this misses)
+        except ValueError as e:
+            print("import: --rpm: %s" % e, file=sys.stderr)
+            return EXIT_USAGE
     try:
         with open(a.file, encoding="utf-8", errors="replace", newline="") as f:
             main = f.read()
@@ -621,8 +647,8 @@ def _cmd_import(c, a):
     doc = c.import_file(a.format, main, sec_props=sec, name=os.path.basename(a.file),
                         tip_radius=a.tip_radius, hub_radius=a.hub_radius, rpm=a.rpm,
                         bmodes_mesh=a.bmodes_mesh)
-    for w in doc.get("warnings", []):
-        print("warning: %s" % w, file=sys.stderr)
+    for w in doc.get("input_warnings", []):
+        print("warning: %s: %s" % (w.get("pointer"), w.get("message")), file=sys.stderr)
     _dump(doc if a.full else doc.get("request"), a.pretty)
     return EXIT_OK
 
@@ -741,12 +767,15 @@ def _parser():
                                        ".bmi names, next to it)")
     s.add_argument("--tip-radius", type=float, help="m from the spin axis (ElastoDyn, CSV)")
     s.add_argument("--hub-radius", type=float, help="m")
-    s.add_argument("--rpm", type=float, help="rotor speed, rev/min (overrides the file's)")
+    s.add_argument("--rpm", metavar="SPEEDS",
+                   help="rotor speeds, rev/min (override the file's): 12.1, a list 0,5,10 or "
+                        "START:STOP:COUNT (COUNT speeds, both ends included: 0:15:16)")
     s.add_argument("--bmodes-mesh", type=int, metavar="K",
                    help="BModes: BModes' own model (its elements as uniform members with "
                         "midpoint properties), K FE elements each")
     s.add_argument("--full", action="store_true",
-                   help="print the whole import document {request, warnings, source}")
+                   help="print the whole import document {request, warnings, input_warnings, "
+                        "source}")
     s.set_defaults(func=_cmd_import)
 
     s = sub.add_parser("validate", parents=[common],

@@ -308,6 +308,89 @@ def scenario_campbell(d):
           "campbell(speeds=, rpm=) together: ValueError")
 
 
+def resolve(doc, pointer):
+    """The value at an RFC 6901 pointer of doc; KeyError/IndexError when it is not there."""
+    for tok in pointer.split("/")[1:]:
+        tok = tok.replace("~1", "/").replace("~0", "~")
+        doc = doc[int(tok)] if isinstance(doc, list) else doc[tok]
+    return doc
+
+
+def scenario_import(d):
+    """import_file(): warnings as {pointer, message} like a result's input_warnings; rpm ranges."""
+    sm = client_module()
+    c = sm.Client(d.url, timeout=B(30))
+    nrel = os.path.join(SRC, "tests", "reference", "blades", "elastodyn",
+                        "NRELOffshrBsline5MW_Blade.dat")
+    with open(nrel) as f:
+        text = f.read()
+    # issue 26: one shape for the warnings of an import and of a result
+    doc = c.import_file("elastodyn", text, tip_radius=63, hub_radius=1.5, rpm=12.1)
+    iw = doc.get("input_warnings")
+    check(isinstance(iw, list) and all(isinstance(w, dict) and set(w) == {"pointer", "message"}
+                                       for w in iw),
+          "import_file(): input_warnings are {pointer, message} (%r)" % (iw,))
+    check([w["pointer"] for w in iw or []] == ["/blade/section/EA", "/blade/section/GJ"],
+          "import_file(): the pointers name the assumed EA and GJ (%r)" % [w.get("pointer") for w in iw or []])
+    ok = True
+    for w in iw or []:
+        try:
+            resolve(doc["request"], w["pointer"])
+        except (KeyError, IndexError, ValueError):
+            ok = False
+    check(bool(iw) and ok, "import_file(): every pointer is a field of the imported request")
+    check(doc.get("warnings") == [w["message"] for w in iw or []],
+          "import_file(): 'warnings' keeps the same messages as strings (older clients)")
+    # a slip both the import and the solve warn about: the same shape in both documents
+    slip = c.import_file("elastodyn", text, tip_radius=63000, hub_radius=1.5, rpm=12.1)
+    st = c.submit(slip["request"], wait=30)
+    st = c.wait(st["id"], timeout=B(120))
+    res = st.get("result") or c.result(st["id"])
+    rw = res.get("input_warnings", [])
+    check(bool(rw) and bool(slip.get("input_warnings")) and
+          {frozenset(w) for w in rw} == {frozenset(w) for w in slip["input_warnings"]} ==
+          {frozenset({"pointer", "message"})},
+          "import and result warnings: the same keys {pointer, message} (%r / %r)"
+          % ([sorted(w) for w in slip.get("input_warnings", [])], [sorted(w) for w in rw]))
+    # an older daemon sends only the strings: the client gives them the same shape
+    real_call = c._call
+    c._call = lambda *a, **k: (200, {}, {"request": {}, "warnings": ["w1"], "source": {}})
+    try:
+        old = c.import_file("csv", "x")
+    finally:
+        c._call = real_call
+    check(old.get("input_warnings") == [{"pointer": "", "message": "w1"}],
+          "import_file() from an older daemon: input_warnings from the strings (%r)" % old)
+    # rpm: one speed, a list, a range of COUNT speeds; 0:12:1 is refused, not 0 alone
+    for rpm, want in ((12.1, [12.1]), ([0, 6], [0.0, 6.0]), ("0,6", [0.0, 6.0]),
+                      ("0:12:4", {"from": 0.0, "to": 12.0, "steps": 3}), ("5:5:1", [5.0])):
+        got = c.import_file("elastodyn", text, tip_radius=63, hub_radius=1.5,
+                            rpm=rpm)["request"]["analysis"]["rpm"]
+        check(got == want, "import_file(rpm=%r): analysis.rpm %r (%r)" % (rpm, want, got))
+    for bad in ("0:12:1", "12:0:3", "0:12", "x"):
+        e = raises(lambda: c.import_file("elastodyn", text, tip_radius=63, rpm=bad), sm.SpinmodalError)
+        check(e is not None and e.status == 400 and [x.get("pointer") for x in e.errors] == ["/query/rpm"],
+              "import_file(rpm=%r): 400 at /query/rpm (%r)" % (bad, e and (e.status, e.errors)))
+    check(raises(lambda: sm.parse_speeds("0:15:1"), ValueError) is not None,
+          "parse_speeds('0:15:1'): ValueError (COUNT counts the speeds: it would be 0 alone)")
+    check(sm.parse_speeds("0:15:16") == [float(k) for k in range(16)] and sm.parse_speeds("5:5:1") == [5.0],
+          "parse_speeds('0:15:16'): 0 ... 15; '5:5:1': [5]")
+    # python3 -m spinmodal_client import: warnings on stderr with their pointer, --rpm ranges
+    env = dict(os.environ, SPINMODAL_URL=d.url)
+    env.pop("SPINMODAL_TOKEN", None)
+    p = run_py(["import", "elastodyn", nrel, "--tip-radius", "63", "--hub-radius", "1.5",
+                "--rpm", "0:12:13", "--full"], env)
+    out = json.loads(p.stdout) if p.returncode == 0 else {}
+    check(p.returncode == 0 and out.get("request", {}).get("analysis", {}).get("rpm") ==
+          {"from": 0.0, "to": 12.0, "steps": 12},
+          "python CLI import --rpm 0:12:13: analysis.rpm the range (%d %s)" % (p.returncode, p.stderr[-300:]))
+    check(p.stderr.count("warning: /blade/section/") == 2,
+          "python CLI import: 'warning: POINTER: message' on stderr (%r)" % p.stderr[-300:])
+    p = run_py(["import", "elastodyn", nrel, "--tip-radius", "63", "--rpm", "0:12:1"], env)
+    check(p.returncode == 64 and p.stdout == "" and "0:12:13" in p.stderr,
+          "python CLI import --rpm 0:12:1: exit 64, suggests 0:12:13 (%d %r)" % (p.returncode, p.stderr[-200:]))
+
+
 def scenario_errors(d):
     """SpinmodalError fields on 422, 400, 404, 409; connection errors; retry on 429."""
     sm = client_module()
@@ -623,6 +706,9 @@ def scenario_curl(d):
           "campbell.sh rad/s on a request with analysis.rpm: exit 0, 8 rows (%d %s)" % (p.returncode, p.stderr[-200:]))
     p = run_sh("campbell.sh", [example("angled-beam-90.json"), "0:x:3"], env)
     check(p.returncode == 64, "campbell.sh with a bad range: exit 64 (%d)" % p.returncode)
+    p = run_sh("campbell.sh", ["--rpm", example("tapered-blade.json"), "0:15:1"], env)
+    check(p.returncode == 64 and "COUNT" in p.stderr,
+          "campbell.sh --rpm 0:15:1: exit 64, COUNT counts the speeds (%d %r)" % (p.returncode, p.stderr[-200:]))
 
     # cancel.sh of a running sweep (one worker, the daemon of this scenario)
     sm = client_module()
@@ -676,6 +762,7 @@ SCENARIOS = {
     "queue_full": (scenario_queue_full, {"workers": 1, "extra": ["--queue-max", "1"]}),
     "token": (scenario_token, {"token": "s3cret-token"}),
     "python_cli": (scenario_python_cli, {}),
+    "import": (scenario_import, {}),
     "curl": (scenario_curl, {"workers": 1}),
 }
 
