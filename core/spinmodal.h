@@ -1,12 +1,15 @@
 /*
  * spinmodal.h — public API of libspinmodal, the numerical core.
  *
- * Modal analysis of planar beam structures spinning at a constant speed about
- * the hub (z) axis with the multi-reference-frame method of Kim & Yoo (2006),
- * see DESIGN.md section 1.  The core does no I/O, keeps no global state and is
- * re-entrant: distinct sm_model objects may be used from distinct threads, and
- * one sm_model may be solved from several threads at once (sm_solve only reads
- * the model).
+ * Modal analysis of beam structures spinning at a constant speed about the
+ * hub (z) axis with the multi-reference-frame method of Kim & Yoo (2006),
+ * see DESIGN.md section 1: planar structures (in the rotation plane, 3 DOF
+ * per node) and spatial ones (sm_structure.spatial: 6 DOF per node with
+ * flap, lead-lag, torsion and axial motion, twisted sections, offsets and
+ * blade stations; DESIGN.md sections 7 and 8).  The core does no I/O, keeps
+ * no global state and is re-entrant: distinct sm_model objects may be used
+ * from distinct threads, and one sm_model may be solved from several threads
+ * at once (sm_solve only reads the model).
  *
  * Usage:
  *   sm_structure st = {...};          // joints, sections, members, clamp

@@ -277,9 +277,10 @@ int codec_result_csv(char **out, size_t *len, const codec_request *r, const sm_r
 /**
  * Span-wise mode shapes (DESIGN.md 8.3) from a result document (as
  * codec_result_encode writes it, or read back from the store): bmodes 0 the
- * CSV omega,rpm,mode,frequency_hz,per_rev,member,member_id,s,r_m,flap,
+ * CSV omega,rpm,mode,frequency_hz,per_rev,member,member_id,s,span_m,flap,
  * flap_slope,edge,edge_slope,twist,axial (one row per speed, mode, member
- * and node); 1 a BModes-style text table.  *out receives a malloc'd
+ * and node; span_m = s x length, m from the member's `from` joint, named
+ * r_m before 0.8); 1 a BModes-style text table.  *out receives a malloc'd
  * NUL-terminated string, *len its length (len may be NULL).  Returns SM_OK,
  * SM_NOMEM, or SM_INVALID_INPUT with err saying why (a planar result, or
  * one without mode shapes).

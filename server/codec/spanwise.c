@@ -13,7 +13,13 @@
  *   flap  = d . e3      flap_slope = -(r . e2) L   (d flap / d s)
  *   edge  = d . e2      edge_slope =  (r . e3) L   (d edge / d s)
  *   twist = r . e1      axial      =  d . e1
- * with d the displacement and r the small rotation of the node.  It reads
+ * with d the displacement and r the small rotation of the node.  The CSV's
+ * columns: omega (rad/s), rpm, mode (1-based), frequency_hz, per_rev,
+ * member (0-based index), member_id, s (span fraction, 0 at the member's
+ * `from` joint, 1 at its `to` joint), span_m = s x the member's length (m
+ * from the `from` joint: for a blade from its root, not from the spin axis,
+ * whose distance is blade.hub_radius + span_m on a blade without precone;
+ * before 0.8 this column was named r_m), then the six motions above.  It reads
  * nothing but the result document, so the CLI (`spinmodal export`) and the
  * daemon (GET .../result?format=spanwise|bmodes, from the stored result)
  * give the same bytes.
@@ -268,7 +274,7 @@ int codec_result_spanwise(char **out, size_t *len, const json_t *result, int bmo
                 json_string_value(json_object_get(json_object_get(result, "solver"),
                                                   "request_sha256")));
     else
-        fputs("omega,rpm,mode,frequency_hz,per_rev,member,member_id,s,r_m,flap,flap_slope,"
+        fputs("omega,rpm,mode,frequency_hz,per_rev,member,member_id,s,span_m,flap,flap_slope,"
               "edge,edge_slope,twist,axial\n", f);
     json_array_foreach(cases, i, cs) {
         modes = json_object_get(cs, "modes");

@@ -227,6 +227,13 @@ def t_help_version(tmp):
     """(e) --help and --version."""
     rc, out, _ = run(["--help"])
     check(rc == 0 and "usage: spinmodal solve" in out, "--help: exit 0 and usage on stdout")
+    # issue 26: a newcomer's --help names both kinds of structure and every command and option
+    check("planar and spatial" in out.split("\n")[0] and "blade" in out,
+          "--help: planar and spatial structures, blades (%r)" % out.split("\n")[0])
+    for word in ("solve", "validate", "import", "export spanwise|bmodes", "--csv", "--table",
+                 "--critical-csv", "--pretty", "--rpm SPEEDS", "--bmodes-mesh", "--allow-outside",
+                 "--full", "START:STOP:COUNT"):
+        check(word in out, "--help mentions %s" % word)
     rc, out, _ = run(["--version"])
     check(rc == 0 and re.fullmatch(r"spinmodal \d+\.\d+\.\d+\S*\n", out) is not None,
           "--version: 'spinmodal X.Y.Z' (%r)" % out)
@@ -380,6 +387,28 @@ def t_blade(tmp):
     check(rc == 0 and "input_warnings" not in json.loads(out), "blade validate: no warnings for the example")
     rc, out, err = run(["solve", "--csv", "--table", example])
     check(rc == 64, "blade: --csv with --table is a usage error (%d)" % rc)
+    # the span-wise CSV names its length column for what it is: span_m, m from the blade's root
+    # (s x length), not r_m, which a wind engineer reads as the radius from the axis (issue 26)
+    req = json.loads(open(example).read())
+    req["analysis"].update({"rpm": 60, "mode_shapes": True})
+    rc, out, err = run(["solve", write_request(tmp, "shapes.json", req)])
+    res_path = os.path.join(tmp, "shapes.result.json")
+    with open(res_path, "w") as f:
+        f.write(out)
+    rc, out, err = run(["export", "spanwise", res_path])
+    lines = out.splitlines()
+    head = lines[0].split(",") if rc == 0 and lines else []
+    check(head == ["omega", "rpm", "mode", "frequency_hz", "per_rev", "member", "member_id", "s",
+                   "span_m", "flap", "flap_slope", "edge", "edge_slope", "twist", "axial"],
+          "export spanwise: header with span_m, no r_m (%s)" % head)
+    if "span_m" in head:
+        length = req["blade"]["length"]
+        pairs = [(float(l.split(",")[head.index("s")]), float(l.split(",")[head.index("span_m")]))
+                 for l in lines[1:]]
+        check(pairs and all(abs(sm - s * length) <= 1e-9 * length for s, sm in pairs) and
+              max(sm for _, sm in pairs) == length and min(sm for _, sm in pairs) == 0.0,
+              "export spanwise: span_m = s x blade.length, 0 at the root, the length at the tip "
+              "(not hub_radius + ...)")
 
 
 # The keys of a mode and the CSV header without analysis.error_estimate (as before it existed).

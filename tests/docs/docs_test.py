@@ -14,7 +14,14 @@ readme    what README.md shows without a daemon: each "`CMD` prints (excerpt):" 
           output of CMD (numbers to the digits shown), each "`examples/X.json`:" block is that
           file, each inline `build/server/spinmodal …` command exits 0, the geometrically exact
           reference numbers are those of tests/reference, the daemon's flags and defaults are
-          those of `spinmodald --help`, every repository path in backquotes exists.
+          those of `spinmodald --help`, every repository path in backquotes exists; the
+          "Command line" synopsis names every command and option of `spinmodal --help` and
+          `spinmodal import --help` and no other; every ```sh block's spinmodal commands (other
+          than the curl session's) run as written from the repository root after the
+          documented build — `build/server/spinmodal …`, never a bare `spinmodal` (not on PATH),
+          each exits 0 with output, and a CSV header shown in a line's comment is the first line
+          of what it wrote; `meson install -C build`, when the README offers it, installs both
+          programs (into a temporary --destdir).
 http      the README's curl session against a real spinmodald (free loopback port, temporary
           database; tests/e2e/daemon.py): every command runs, its HTTP status is a success (or
           one the line's comment names), every output line shown under it ("#   …") is in its
@@ -325,6 +332,10 @@ def t_readme():
                 want = {"1 MiB": "1048576", "cores": "online cores"}.get(default, re.sub(r" s$", "", default))
                 check(want == real, "README's default of %s (%s) is the --help default (%s)" % (flag, default, real))
 
+    cli_synopsis(text)
+    cli_blocks(text)
+    meson_install(text)
+
     # repository paths in backquotes exist
     missing, n_paths = [], 0
     for c in sorted(set(inline_code(text))):
@@ -340,6 +351,102 @@ def t_readme():
                 missing.append(c)
     check(n_paths >= 20 and not missing, "every repository path README names exists (%d paths; missing: %s)"
           % (n_paths, missing))
+
+
+def cli_synopsis(text):
+    """The "## Command line" block names every command and option the CLI's help lists, and no
+    other (issue 26: the README omitted --critical-csv and --bmodes-mesh)."""
+    m = re.search(r"^## Command line\n(.*?)(?=^## )", text, re.M | re.S)
+    blocks = code_blocks(m.group(1)) if m else []
+    if not check(blocks, "README has a \"## Command line\" section with the synopsis"):
+        return
+    shown = blocks[0][1]
+    helps = ""
+    for args in (["--help"], ["import", "--help"]):
+        p = subprocess.run([CLI] + args, capture_output=True, text=True, timeout=ts.budget(30), env=env1())
+        check(p.returncode == 0, "`spinmodal %s` exits 0 (%d)" % (" ".join(args), p.returncode))
+        helps += p.stdout
+    opt = re.compile(r"(?<![\w-])--[a-z][a-z-]*")
+    real, doc = set(opt.findall(helps)), set(opt.findall(shown))
+    check(real and not real - doc, "README's command-line synopsis names every option of `spinmodal "
+          "--help` and `spinmodal import --help` (missing: %s)" % sorted(real - doc))
+    check(not doc - real, "README's command-line synopsis names no option the CLI lacks (%s)"
+          % sorted(doc - real))
+    usage = re.findall(r"^(?:usage:)?\s+spinmodal (\w+)", helps, re.M)
+    listed = set(re.findall(r"^spinmodal (\w+)", shown, re.M))
+    check(set(usage) and not set(usage) - listed, "README's synopsis has every command of the usage "
+          "(%s; missing %s)" % (sorted(set(usage)), sorted(set(usage) - listed)))
+
+
+def cli_blocks(text):
+    """Each ```sh block with spinmodal commands, other than the curl session, run line by line as
+    written, from a copy of the repository root (links to its folders, build/ the build under
+    test) so that what they write stays out of the tree.  A bare `spinmodal` is not on PATH after
+    the documented build: it fails.  Lines that need the daemon ($U, curl) are the http group's."""
+    import shutil
+    n = 0
+    for lang, body, _, lineno in code_blocks(text):
+        if lang != "sh" or re.search(r"^U=http://", body, re.M) or \
+                not re.search(r"^(?:build/server/)?spinmodal\s", body, re.M):
+            continue
+        tmp = tempfile.mkdtemp(prefix="spinmodal-docs-sh-")
+        try:
+            for name in os.listdir(SRC):
+                if not name.startswith("build"):
+                    os.symlink(os.path.join(SRC, name), os.path.join(tmp, name))
+            os.symlink(BUILD, os.path.join(tmp, "build"))
+            for i, line in enumerate(body.splitlines()):
+                cmd, comment = (re.split(r"\s+#\s+", line, 1) + [""])[:2]
+                where = "README:%d" % (lineno + 1 + i)
+                if re.match(r"^spinmodal\s", cmd):
+                    check(False, "%s: `%s` calls a bare spinmodal, which the documented build does not "
+                          "put on PATH (write build/server/spinmodal)" % (where, cmd.strip()[:80]))
+                    continue
+                if not cmd.startswith("build/server/spinmodal "):
+                    continue
+                n += 1
+                p = subprocess.run(["bash", "-c", cmd], cwd=tmp, capture_output=True, text=True,
+                                   timeout=ts.budget(120), env=env1())
+                out = p.stdout
+                m = re.search(r">\s*([\w.-]+)\s*$", cmd)
+                if m and os.path.exists(os.path.join(tmp, m.group(1))):
+                    with open(os.path.join(tmp, m.group(1))) as f:
+                        out = f.read()
+                check(p.returncode == 0 and out.strip(), "%s: `%s` runs as written: exit 0 with output "
+                      "(%d %s)" % (where, cmd.strip()[:90], p.returncode, p.stderr.strip()[-200:]))
+                if re.fullmatch(r"\w+(,\w+)+", comment.strip()):
+                    first = out.splitlines()[0] if out else ""
+                    check(first == comment.strip(), "%s: the header shown is the first line of its output "
+                          "(shown %s, real %s)" % (where, comment.strip(), first))
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+    check(n >= 4, "README's ```sh blocks of CLI commands run (%d commands)" % n)
+
+
+def meson_install(text):
+    """`meson install -C build` as the README offers it: both programs land in a bin/ folder."""
+    import shutil
+    if "`meson install -C build`" not in text:
+        return
+    meson = shutil.which("meson")
+    if not meson:
+        print("SKIP meson is not on PATH: `meson install -C build` not tried")
+        return
+    tmp = tempfile.mkdtemp(prefix="spinmodal-docs-install-")
+    try:
+        p = subprocess.run([meson, "install", "-C", BUILD, "--no-rebuild", "--destdir", tmp], capture_output=True,
+                           text=True, timeout=ts.budget(120))
+        found = {f: os.path.join(top, f) for top, _, names in os.walk(tmp) for f in names
+                 if f in ("spinmodal", "spinmodald") and os.path.basename(top) == "bin"}
+        ok = p.returncode == 0 and set(found) == {"spinmodal", "spinmodald"}
+        if ok:
+            v = subprocess.run([found["spinmodal"], "--version"], capture_output=True, text=True,
+                               timeout=ts.budget(30))
+            ok = v.returncode == 0 and v.stdout.startswith("spinmodal ")
+        check(ok, "README's `meson install -C build` installs bin/spinmodal and bin/spinmodald (%d %s)"
+              % (p.returncode, sorted(found)))
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 # ================================================================ http (a real daemon)

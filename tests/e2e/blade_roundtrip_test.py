@@ -142,7 +142,7 @@ def scenario(exe, cli, ref, client_dir, tmp):
     check(len(rows) == len(hz) * n_nodes == 20 * 49,
           "spanwise CSV: one row per mode and node (%d rows, %d modes x %d nodes)"
           % (len(rows), len(hz), n_nodes))
-    m1 = [[float(x) for x in r[7:15]] for r in rows if r[2] == "1"]  # s, r_m, flap, ...
+    m1 = [[float(x) for x in r[7:15]] for r in rows if r[2] == "1"]  # s, span_m, flap, ...
     worst = 0.0
     for i in range(1, len(m1) - 1):  # central differences of flap and edge against the slopes
         ds = m1[i + 1][0] - m1[i - 1][0]
