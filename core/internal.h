@@ -370,8 +370,8 @@ int eig_solve(int n, const dmat *M, const dmat *C, const dmat *K, int coriolis,
  * factors K*, and when K* is positive definite finds the lowest modes by shift-invert Arnoldi and
  * a projection solved by eig_solve (see tree.c).  *fallback receives 1 when the dense path must be
  * used instead (K* not positive definite, a singular front, no convergence); then *out is empty
- * and the return is SM_OK.  pr (may be NULL): its callback is asked after each projection (every
- * few Krylov vectors: a 2000-element blade's 64 modes are ~8 s), nonzero stops with SM_CANCELED.
+ * and the return is SM_OK.  pr (may be NULL): its callback is asked every 8 Krylov vectors (a
+ * 2000-element blade's 64 modes are ~8 s of them), nonzero stops with SM_CANCELED.
  * Returns SM_OK, SM_NOMEM, SM_CANCELED or SM_LAPACK_FAILED.
  */
 int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const sm_progress *pr,
