@@ -1058,7 +1058,7 @@ async function blades(page, base) {
   await bmodesOwnMesh(page, bmi, sec);
 }
 
-const SPANWISE_HEADER = 'omega,rpm,mode,frequency_hz,per_rev,member,member_id,s,r_m,flap,flap_slope,edge,edge_slope,twist,axial';
+const SPANWISE_HEADER = 'omega,rpm,mode,frequency_hz,per_rev,member,member_id,s,span_m,flap,flap_slope,edge,edge_slope,twist,axial';
 
 /**
  * Span-wise mode shapes (DESIGN.md 8.3) of the solved Test01 blade: the two
@@ -1077,11 +1077,12 @@ async function spanwiseShapes(page, base, result) {
   ok(lines[0] === SPANWISE_HEADER, 'the span-wise CSV has the header omega,rpm,mode,…,twist,axial', lines[0]);
   ok(csv.buf.equals(api) && api.length > 0, 'the span-wise CSV download is the daemon\'s ?format=spanwise, byte for byte',
     `${csv.buf.length} vs ${api.length} bytes`);
-  ok(lines.length === 1 + 20 * 49 && csv.name === `spinmodal-${id.slice(0, 12)}-spanwise.csv`,
-    'one row per mode and node (20 × 49), the file named from the job id', `${lines.length} lines, ${csv.name}`);
+  ok(lines.length === 1 + 20 * 49 && csv.name === `spinmodal-Test01_nonunif_blade-${id.slice(0, 12)}-spanwise.csv`,
+    'one row per mode and node (20 × 49), the file named from the design name (the imported file\'s) and the job id',
+    `${lines.length} lines, ${csv.name}`);
   const bt = await downloadText(page, '#dl-bmodes');
   const bapi = Buffer.from(await (await fetch(`${base}/v1/analyses/${id}/result?format=bmodes`)).arrayBuffer());
-  ok(bt.text.includes('span_loc\tflap disp') && bt.buf.equals(bapi) && bt.name === `spinmodal-${id.slice(0, 12)}-bmodes.txt`,
+  ok(bt.text.includes('span_loc\tflap disp') && bt.buf.equals(bapi) && bt.name === `spinmodal-Test01_nonunif_blade-${id.slice(0, 12)}-bmodes.txt`,
     'the BModes-style table: "span_loc\\tflap disp" columns, the daemon\'s ?format=bmodes bytes', `${bt.name} ${bt.buf.length} bytes`);
   // the plot under the mode: mode 1's points are the CSV's rows of mode 1 (span fraction s of the one member)
   await page.selectOption('#mode-index', '0');
@@ -1146,6 +1147,171 @@ async function bmodesOwnMesh(page, bmi, sec) {
     return p && p.points.length === 97 && p.points[96].x === 1;
   }, null, 'the span-wise plot of the 12 members'), 'the span-wise plot runs root → tip across the 12 members (97 nodes)');
   await shot(page, '22-bmodes-mesh-solved.png');
+}
+
+/** Do any two of the rects {x, y, w, h} overlap (by more than 0.5 px)? The pairs that do. */
+function overlaps(rects) {
+  const out = [];
+  for (let i = 0; i < rects.length; i++) {
+    for (let j = i + 1; j < rects.length; j++) {
+      const a = rects[i], b = rects[j];
+      if (a.x < b.x + b.w - 0.5 && b.x < a.x + a.w - 0.5 && a.y < b.y + b.h - 0.5 && b.y < a.y + a.h - 0.5) out.push([a, b]);
+    }
+  }
+  return out;
+}
+
+/**
+ * A blade engineer's first hour (issue 26, the web page): BModes Test01 is
+ * imported with a section file under another name (a warning names both), the
+ * caption, the structure's words and the design name follow the import, no
+ * UI text cites DESIGN; a dense rpm sweep (121 speeds) is shown in rpm and Hz,
+ * without beaded markers or pixel rounding, its frequency axis fitted to the
+ * modes the engine orders cross (the orders readable), the orders' labels
+ * never overlapping (also with 12 orders); the summary gives the job's wall
+ * time; the user's unit choice is remembered; the design name is in the past
+ * jobs, the listing and the export file names; the twist axis of a mode
+ * without twist is small; one speed is a table, not an empty diagram.
+ */
+async function firstHour(page, base) {
+  const bmi = fs.readFileSync(path.join(BLADES, 'Test01_nonunif_blade.bmi'));
+  const sec = fs.readFileSync(path.join(BLADES, 'blade_sec_props.dat'));
+  await page.selectOption('#example', 'angled-90');
+  await page.click('#load-example');
+  ok(/aluminium/.test(await page.textContent('#example-desc')), 'the β = 90° example has its caption (aluminium beams)');
+  await page.click('#open-blade');
+  await page.selectOption('#import-format', 'bmodes');
+  if (await page.isChecked('#import-bmodes-mesh')) await page.uncheck('#import-bmodes-mesh');
+  await page.setInputFiles('#import-main', {name: 'Test01_nonunif_blade.bmi', mimeType: 'text/plain', buffer: bmi});
+  await page.setInputFiles('#import-sec', {name: 'tower_sec_props.dat', mimeType: 'text/plain', buffer: sec});
+  await page.click('#import-go');
+  ok(await waitFor(page, () => !document.getElementById('import-dialog').open && window.__spinmodal.doc.blade, null,
+    'the import'), 'Test01 imports with a section file of another name');
+  const mism = await page.locator('#import-warnings li.sec-mismatch').allTextContents();
+  ok(mism.length === 1 && mism[0].includes('blade_sec_props.dat') && mism[0].includes('tower_sec_props.dat'),
+    'a section file whose name differs from the .bmi\'s sec_props_file is a warning naming both', JSON.stringify(mism));
+  const cap = await page.textContent('#example-desc');
+  ok(!/aluminium/.test(cap) && /Imported from Test01_nonunif_blade\.bmi/.test(cap) && /33\.25 m/.test(cap),
+    'after an import the caption describes the import, not the last example', cap);
+  const sdesc = await page.textContent('#structure-desc');
+  ok(/\b1 member,/.test(sdesc) && !/\b1 members\b/.test(sdesc), 'one member is "1 member", not "1 members"', sdesc);
+  ok(await page.inputValue('#design-name') === 'Test01_nonunif_blade' &&
+    (await page.evaluate(() => window.__spinmodal.doc.name)) === 'Test01_nonunif_blade',
+  'the import names the design after its file (the request\'s name)', await page.inputValue('#design-name'));
+  const design = await page.evaluate(() => {
+    const texts = [document.body.innerText];
+    for (const e of document.querySelectorAll('[title], [placeholder], [aria-label]')) {
+      texts.push(e.getAttribute('title') || '', e.getAttribute('placeholder') || '', e.getAttribute('aria-label') || '');
+    }
+    for (const e of document.querySelectorAll('[hidden], template, dialog')) texts.push(e.textContent);
+    return texts.filter((t) => /DESIGN(\.md)?\s*§|DESIGN\.md/.test(t)).map((t) => t.slice(0, 80));
+  });
+  ok(design.length === 0, 'no UI text (shown, hidden, titles) cites DESIGN §', JSON.stringify(design));
+
+  // a dense sweep in rpm: 0…60 rpm, 121 speeds, 8 modes, no shapes
+  const doc = await page.evaluate(() => window.__spinmodal.doc);
+  doc.analysis = {...doc.analysis, rpm: {from: 0, to: 60, steps: 120}, modes: 8, mode_shapes: false};
+  await page.fill('#json', JSON.stringify(doc, null, 2));
+  await page.fill('#eo-list', '1-4');
+  const got = await solveHere(page, base, 'the dense rpm sweep of Test01');
+  if (!got) return;
+  ok(await page.inputValue('#speed-unit') === 'rpm' && await page.inputValue('#freq-unit') === 'hz',
+    'a request in rpm is shown in rpm and Hz by default', `${await page.inputValue('#speed-unit')} ${await page.inputValue('#freq-unit')}`);
+  let p = await page.evaluate(() => window.__spinmodal.campbell());
+  const modeStyles = p.seriesStyle.filter((s, i) => p.series[i].kind === 'mode');
+  const lineStyles = p.seriesStyle.filter((s, i) => ['mode', 'eo'].includes(p.series[i].kind));
+  ok(p.x.length >= 121 && !p.markers && modeStyles.length >= 8 && modeStyles.every((s) => !s.points) &&
+    lineStyles.every((s) => s.pxAlign === 0),
+  'a dense sweep (121 speeds): lines without point markers, not rounded to whole pixels',
+  JSON.stringify({n: p.x.length, markers: p.markers, styles: lineStyles.slice(0, 3)}));
+  const eoTop = Math.max(...p.series.filter((s) => s.kind === 'eo').flatMap((s) => s.values.filter((v) => typeof v === 'number')));
+  const modeMax = Math.max(...p.series.filter((s) => s.kind === 'mode').flatMap((s) => s.values.filter((v) => typeof v === 'number')));
+  console.log(`# Test01 0…60 rpm: 4P ends at ${eoTop} Hz, the modes reach ${modeMax} Hz, y axis 0…${p.scales.y[1]} Hz`);
+  ok(p.focus && p.focus.on && eoTop / p.scales.y[1] >= 0.45 && eoTop / modeMax < 0.3 && p.crossings.length > 0,
+    'modes far above the orders (4P ends below 30 % of them): the y axis is fitted so that the orders fill ≥ 45 % of it',
+    JSON.stringify({eoTop, modeMax, y: p.scales.y, focus: p.focus}));
+  ok(/higher mode/.test(await page.textContent('#focus-note')) && await page.isVisible('#campbell-all'),
+    'a note says modes lie above, with a "Show all modes" button', await page.textContent('#focus-note'));
+  let rects = p.labelRects.filter((r) => /^\dP$/.test(r.text));
+  ok(rects.length === 4 && overlaps(p.labelRects).length === 0,
+    'the engine-order labels 1P…4P are shown and no two labels overlap (their boxes in the page)', JSON.stringify(p.labelRects));
+  await shotEl(page, '#campbell', '23-campbell-rpm-dense.png');
+  await page.click('#campbell-all');
+  const pa = await page.evaluate(() => window.__spinmodal.campbell());
+  ok(!pa.focus.on && pa.scales.y[1] >= modeMax, '"Show all modes" shows every mode', JSON.stringify(pa.scales.y));
+  await page.click('#campbell-all');
+  await page.fill('#eo-list', '1-12');
+  p = await page.evaluate(() => window.__spinmodal.campbell());
+  rects = p.labelRects.filter((r) => /^\d+P$/.test(r.text));
+  ok(rects.length >= 8 && overlaps(p.labelRects).length === 0 &&
+    p.labelRects.every((r) => r.x >= -0.5 && r.y >= -0.5),
+  'with engine orders 1-12 the labels still never overlap', `${rects.length} labels; overlaps ${JSON.stringify(overlaps(p.labelRects))}`);
+  await shotEl(page, '#campbell', '24-campbell-12-orders.png');
+  await page.fill('#eo-list', '1-4');
+
+  // the job's wall time, not the solver's own timing
+  const st = await (await fetch(`${base}/v1/analyses/${got.id}`)).json();
+  const wall = (Date.parse(st.finished_at) - Date.parse(st.started_at)) / 1000;
+  const summary = await page.textContent('#result-summary');
+  ok(/wall time/.test(summary) && Number(await page.getAttribute('#result-summary', 'data-wall-s')) === wall &&
+    summary.includes(`wall time ${wall < 1 ? Number((wall * 1000).toPrecision(3)) + ' ms' : Number(wall.toPrecision(3)) + ' s'}`),
+  'the summary gives the job\'s wall time (finished_at − started_at)', `${summary} | ${wall} s`);
+  ok(/\b121 speeds\b/.test(summary) && !/\b1 members\b/.test(summary), 'the summary counts in words', summary);
+
+  // the name: in the listing, the past jobs and the file names
+  const list = await (await fetch(`${base}/v1/analyses?limit=100`)).json();
+  const item = list.items.find((j) => j.id === got.id);
+  ok(item && item.name === 'Test01_nonunif_blade', 'the listing carries the request\'s name', JSON.stringify(item && item.name));
+  const svg = await downloadText(page, '#campbell-svg');
+  ok(svg.name === `spinmodal-Test01_nonunif_blade-${got.id.slice(0, 12)}-campbell.svg` && /class="eo-label"/.test(svg.text),
+    'the Campbell SVG is named after the design and the job; it has the order labels', svg.name);
+  const boxes = Array.from(svg.text.matchAll(/<rect class="eo-label-box" x="([\d.]+)" y="([\d.]+)" width="([\d.]+)" height="([\d.]+)"/g))
+    .map((m) => ({x: +m[1], y: +m[2], w: +m[3], h: +m[4]}));
+  ok(boxes.length === 4 && overlaps(boxes).length === 0, 'the exported order labels do not overlap either', JSON.stringify(boxes));
+
+  // the user's unit choice is remembered (rpm requests: rad/s frequencies from now on)
+  await page.selectOption('#freq-unit', 'rad');
+  const prefs = await page.evaluate(() => JSON.parse(localStorage.getItem('spinmodal.units') || '{}'));
+  ok(prefs.rpm && prefs.rpm.freq === 'rad', 'the unit picked is kept in localStorage', JSON.stringify(prefs));
+  await page.reload({waitUntil: 'load'});
+  await waitFor(page, () => window.__spinmodal && window.__spinmodal.doc.blade, null, 'the reload');
+  ok(/Test01_nonunif_blade/.test(await page.textContent('#example-desc')), 'after a reload the caption names the design',
+    await page.textContent('#example-desc'));
+  await page.locator('#past-jobs').focus();
+  ok(await waitFor(page, (id) => Array.from(document.querySelectorAll('#past-jobs option'))
+    .some((o) => o.value === id && o.textContent.startsWith('Test01_nonunif_blade · ')), got.id, 'the named past job'),
+  'the past jobs list shows the design name');
+  await page.selectOption('#past-jobs', got.id);
+  await page.click('#open-job');
+  ok(await waitFor(page, (id) => window.__spinmodal.job && window.__spinmodal.job.id === id && window.__spinmodal.result &&
+    window.__spinmodal.campbell(), got.id, 'the reopened job'), 'the named job reopens');
+  ok(await page.inputValue('#freq-unit') === 'rad' && await page.inputValue('#speed-unit') === 'rpm',
+    'after a reload, a result in rpm is shown in the frequency unit the user chose (rad/s)');
+  ok(/wall time/.test(await page.textContent('#result-summary')), 'a reopened job gives its wall time too');
+  await page.selectOption('#freq-unit', 'hz');
+
+  // the twist axis of a mode without (much) twist: scaled to the data, not ±2 rad
+  doc.analysis = {...doc.analysis, rpm: [60], modes: 4, mode_shapes: true};
+  await page.fill('#json', JSON.stringify(doc, null, 2));
+  const one = await solveHere(page, base, 'Test01 at 60 rpm with shapes');
+  if (!one) return;
+  ok(await waitFor(page, () => window.__spinmodal.spanwise().plot && window.__spinmodal.spanwise().plot.mode === 1, null,
+    'the span-wise plot'), 'the span-wise plot of mode 1');
+  const sp = (await page.evaluate(() => window.__spinmodal.spanwise())).plot;
+  const tw = sp.points.map((q) => q.twist), tmax = Math.max(...tw.map(Math.abs));
+  const span = sp.ranges.twist[1] - sp.ranges.twist[0];
+  ok(span <= Math.max(0.05, 4 * tmax) && Math.min(...tw) >= sp.ranges.twist[0] && Math.max(...tw) <= sp.ranges.twist[1],
+    'the twist axis is scaled to the mode\'s twist (a sensible minimum span), not to ±1…2 rad',
+    `twist ≤ ${tmax} rad, axis ${JSON.stringify(sp.ranges.twist)}`);
+  // one speed: a table of the frequencies, not an empty diagram
+  ok(await page.evaluate(() => window.__spinmodal.campbellView()) === 'single' &&
+    await page.locator('#campbell table.campbell-single-table tbody tr').count() === 4 &&
+    await page.locator('#campbell canvas').count() === 0 && await page.locator('#campbell .campbell-eo-label').count() === 0 &&
+    await page.isDisabled('#campbell-svg'),
+  'one speed: the frequencies are a table with bars (4 modes), no diagram, no floating labels, no diagram export');
+  const f1 = await page.locator('#campbell table.campbell-single-table tbody tr').first().locator('td').nth(1).textContent();
+  ok(Number(f1) === Number(one.result.cases[0].modes[0].frequency_hz.toPrecision(6)), 'its first row is f₁ in Hz', f1);
+  await shotEl(page, '#campbell', '25-campbell-one-speed.png');
 }
 
 /** A design is never lost: a reload keeps the request, a file saves and opens it, a past job reopens. */
@@ -1457,6 +1623,7 @@ async function run() {
 
     await spatial(page, base);
     await blades(page, base);
+    await firstHour(page, base);
     await keepTheDesign(page, base);
     try {
       await trust(page, base);

@@ -15,8 +15,15 @@
 // (tracked_index, DESIGN.md 9.1), named by their labels; the result's
 // crossing / veering flags, the daemon's critical speeds and error bars
 // (error_estimate) are drawn by the hook.  Engine-order lines are grey, each with its own
-// dash, and labelled where they leave the plot.  Drag selects a zoom box (x,
-// y or both); double click resets.  A reference result (another design) can
+// dash, and labelled where they leave the plot: the labels are elements of .u-over
+// placed so that none overlaps another (placeLabels; export.js places the SVG's the
+// same way).  When the modes reach far above the engine orders (blades: 4P at 1 Hz,
+// modes at 8 Hz), the y range is fitted to the modes the orders cross and the next
+// one above (yFocus); "show all modes" (allModes) goes back to every mode.  Dense
+// sweeps (more than MARKER_MAX_SPEEDS speeds) are drawn as lines without point
+// markers, and no series is rounded to whole pixels (pxAlign 0: no staircase).
+// One speed is no diagram: the frequencies are a table with bars (singleSpeed).
+// Drag selects a zoom box (x, y or both); double click resets.  A reference result (another design) can
 // be overlaid: its modes are thin dashed lines.
 //
 // Divergence speeds (the result's divergence_speeds, present only when the
@@ -40,6 +47,8 @@ export const COLORS = ['#0072b2', '#d55e00', '#009e73', '#cc79a7', '#e69f00', '#
   '#aa4499', '#999933'];
 const EO_DASH = [[6, 4], [2, 3], [10, 3, 2, 3], [12, 6], [4, 2, 1, 2], [1, 2]];
 const CROSS_STROKE = '#111111';
+/** Above this many speeds the mode lines are drawn without point markers. */
+export const MARKER_MAX_SPEEDS = 60;
 const FLAG_STROKE = '#9ca3af';
 
 /** Is a case flagged (not solved, or with warnings)? */
@@ -324,6 +333,106 @@ export function plotData(rows, lines, orders, units, ref = null, critical = null
   return {data, meta, cross: crossPts, crit: critPts, marks: markPts, flagged, errbars, div, unstable};
 }
 
+/**
+ * The y range that keeps the engine orders readable.  top is where the
+ * highest order line ends (at the highest speed shown); when it lies far below
+ * the highest mode (blades: 4P at 1 Hz, modes up to 8 Hz) the range is fitted
+ * to the lines that come below top somewhere (the orders cross them), the
+ * lowest line above them (the margin to the next mode) and top itself.
+ * Returns null when every mode fits (the fitted range would be more than 60 %
+ * of the whole), else {top (the fitted maximum), hidden (lines reaching above
+ * it), max (the highest mode)}.  Not for per rev (its own range).
+ */
+export function yFocus(data, meta, ymaxAll) {
+  let eoTop = -Infinity;
+  const modes = [];
+  meta.forEach((m, i) => {
+    const vals = data[i].filter((v) => typeof v === 'number' && Number.isFinite(v));
+    if (!vals.length) return;
+    if (m.kind === 'eo') eoTop = Math.max(eoTop, ...vals);
+    if (m.kind === 'mode') modes.push({lo: Math.min(...vals), hi: Math.max(...vals)});
+  });
+  if (!(eoTop > 0) || !modes.length || !(ymaxAll > 0)) return null;
+  let top = eoTop;
+  for (const m of modes) if (m.lo <= eoTop) top = Math.max(top, m.hi);
+  const above = modes.filter((m) => m.lo > eoTop).sort((a, b) => a.lo - b.lo)[0];
+  if (above) top = Math.max(top, above.hi);
+  if (top >= 0.6 * ymaxAll) return null;
+  return {top, hidden: modes.filter((m) => m.hi > top * 1.0000001).length, max: ymaxAll};
+}
+
+/**
+ * Where each engine-order line leaves the plot (the last point inside the
+ * scales, interpolated to the top edge): [{order, x, y}] in data units.
+ * xs: the x column; cols[i]: the values of orders[i].
+ */
+export function orderExits(xs, cols, orders, sc) {
+  const out = [];
+  orders.forEach((k, i) => {
+    const ys = cols[i];
+    let xi = -1;
+    for (let j = 0; j < xs.length; j++) {
+      if (xs[j] >= sc.xMin && xs[j] <= sc.xMax && typeof ys[j] === 'number' && ys[j] <= sc.yMax && ys[j] >= sc.yMin) xi = j;
+    }
+    if (xi < 0) return;
+    let x = xs[xi], y = ys[xi];
+    if (xi + 1 < xs.length && ys[xi + 1] > sc.yMax && ys[xi + 1] !== ys[xi]) { // interpolate to the top edge
+      const t = (sc.yMax - ys[xi]) / (ys[xi + 1] - ys[xi]);
+      x = xs[xi] + t * (xs[xi + 1] - xs[xi]);
+      y = sc.yMax;
+    }
+    out.push({order: k, x: Math.min(x, sc.xMax), y});
+  });
+  return out;
+}
+
+/** Do boxes a and b ({x, y, w, h}) overlap, with gap px between them? */
+export function boxesOverlap(a, b, gap = 1) {
+  return a.x < b.x + b.w + gap && b.x < a.x + a.w + gap && a.y < b.y + b.h + gap && b.y < a.y + a.h + gap;
+}
+
+/**
+ * Place labels in a W × H box so that none overlaps another or the boxes
+ * taken: each item {w, h, x, y} wants its left edge at x and its middle at
+ * y; it takes the nearest free place on a grid of shifts (up and down by its
+ * height, to the left by its width), kept inside the box.  Returns one box
+ * {x, y, w, h} per item (top-left corner), or null where no place is free.
+ */
+export function placeLabels(items, W, H, taken = []) {
+  const placed = [];
+  const shifts = [];
+  for (let i = 0; i <= 8; i++) for (let j = -8; j <= 8; j++) shifts.push([i, j]);
+  shifts.sort((a, b) => (a[0] + Math.abs(a[1])) - (b[0] + Math.abs(b[1])) || Math.abs(a[1]) - Math.abs(b[1]) || a[1] - b[1]);
+  return items.map((it) => {
+    for (const [i, j] of shifts) {
+      const b = {x: Math.max(0, Math.min(W - it.w, it.x - i * (it.w + 3))),
+        y: Math.max(0, Math.min(H - it.h, it.y - it.h / 2 + j * (it.h + 1))), w: it.w, h: it.h};
+      if (!taken.some((o) => boxesOverlap(b, o)) && !placed.some((o) => boxesOverlap(b, o))) {
+        placed.push(b);
+        return b;
+      }
+    }
+    return null;
+  });
+}
+
+/**
+ * The engine-order labels ("2P") of a drawn diagram laid out without
+ * overlaps: data/meta/orders as plotData gives them, sc the scales
+ * {xMin, xMax, yMin, yMax}, X/Y data → px in a W × H box, measure(text) the
+ * text's width in px, h its height.  [{order, text, box ({x, y, w, h} or null)}].
+ */
+export function orderLabelLayout(data, meta, orders, sc, X, Y, W, H, measure, h, taken = []) {
+  const cols = orders.map((k) => data[meta.findIndex((m) => m.kind === 'eo' && m.order === k)] || []);
+  const exits = orderExits(data[0], cols, orders, sc);
+  const items = exits.map((e) => {
+    const text = `${e.order}P`;
+    return {order: e.order, text, w: measure(text) + 4, h, x: X(e.x) + 3, y: Y(e.y) - h / 2 - 1};
+  });
+  const boxes = placeLabels(items, W, H, taken);
+  return items.map((it, i) => ({order: it.order, text: it.text, box: boxes[i]}));
+}
+
 /** "1, 2, 4-6" -> [1, 2, 4, 5, 6] (whole orders 1…50, sorted, unique); anything else is ignored. */
 export function parseOrders(text) {
   const out = new Set();
@@ -350,13 +459,14 @@ function seriesFor(last, units) {
     return hit.length ? hit.map(text).join('; ') : '–';
   };
   const s = [{label: `Ω (${su})`, value: (self, v) => (v === null || v === undefined ? '–' : Number(v.toPrecision(6)))}];
+  // point markers only where the speeds are few enough to tell apart; no rounding to whole pixels
   lines.forEach((ln) => {
     s.push({label: ln.name, stroke: COLORS[ln.id % COLORS.length], width: 2, value: (self, v) => fmt(v),
-      points: {show: true, size: 5}});
+      points: {show: last.markers, size: 5}, pxAlign: 0});
   });
   orders.forEach((k, i) => {
     s.push({label: `${k}P`, stroke: '#6b7280', width: 1, dash: EO_DASH[i % EO_DASH.length], value: (self, v) => fmt(v),
-      points: {show: false}});
+      points: {show: false}, pxAlign: 0});
   });
   s.push({label: MARK_NAMES.crossings, stroke: CROSS_STROKE, fill: '#ffffff', width: 0, paths: () => null,
     value: (self, v, si, idx) => (v === undefined || v === null ? '–' : markAt(last.cross, idx, (c) => `${c.name} × ${c.order}P`)),
@@ -372,7 +482,7 @@ function seriesFor(last, units) {
   if (ref) {
     ref.lines.forEach((ln) => {
       s.push({label: `ref ${ln.name}`, stroke: COLORS[ln.id % COLORS.length] + '99', width: 1.5, dash: [3, 3],
-        value: (self, v) => fmt(v), points: {show: false}});
+        value: (self, v) => fmt(v), points: {show: false}, pxAlign: 0});
     });
   }
   if (s.length !== meta.length) throw new Error('campbell: series and data columns differ');
@@ -470,38 +580,48 @@ function decorations(getLast, onDraw) {
       markShape(ctx, c.refined ? 'critical' : 'ring', u.valToPos(c.x, 'x', true), u.valToPos(c.y, 'y', true), 5.5 * px);
     }
     for (const m of L.marks) markShape(ctx, m.kind, u.valToPos(m.x, 'x', true), u.valToPos(m.y, 'y', true), 5 * px);
-    // engine-order labels where each line leaves the plot (top or right edge)
-    ctx.font = `${Math.round(11 * px)}px system-ui, sans-serif`;
-    ctx.fillStyle = '#374151';
-    ctx.textBaseline = 'middle';
-    const yMax = u.scales.y.max, yMin = u.scales.y.min;
-    const base = 1 + L.lines.length;
-    L.orders.forEach((k, i) => {
-      const ys = u.data[base + i], xs = u.data[0];
-      // the last point of the line inside the y range
-      let xi = -1;
-      for (let j = 0; j < xs.length; j++) if (xs[j] <= xMax && ys[j] <= yMax && ys[j] >= yMin) xi = j;
-      if (xi < 0) return;
-      let x = xs[xi], y = ys[xi];
-      if (xi + 1 < xs.length && ys[xi + 1] > yMax && ys[xi + 1] !== ys[xi]) { // interpolate to the top edge
-        const t = (yMax - ys[xi]) / (ys[xi + 1] - ys[xi]);
-        x = xs[xi] + t * (xs[xi + 1] - xs[xi]);
-        y = yMax;
-      }
-      let X = u.valToPos(Math.min(x, xMax), 'x', true), Y = u.valToPos(y, 'y', true);
-      const text = `${k}P`;
-      const w = ctx.measureText(text).width;
-      X = Math.min(X + 3 * px, left + width - w - 2 * px);
-      Y = Math.max(top + 8 * px, Math.min(Y - 7 * px, top + height - 8 * px));
-      ctx.fillStyle = 'rgba(255,255,255,0.85)';
-      ctx.fillRect(X - 1 * px, Y - 7 * px, w + 2 * px, 14 * px);
-      ctx.fillStyle = '#374151';
-      ctx.fillText(text, X, Y);
-    });
     ctx.restore();
+    orderLabels(u, L);
     L.errDrawn = {drawn, hidden, max: emax, total: L.errbars.length};
     if (onDraw) onDraw(L);
   };
+}
+
+/**
+ * The engine-order labels as elements of .u-over (CSS px of the plot area),
+ * where each line leaves the plot, moved so that none overlaps another or a
+ * divergence label; L.labelBoxes keeps what was placed.
+ */
+function orderLabels(u, L) {
+  for (const el of Array.from(u.over.querySelectorAll('.campbell-eo-label'))) el.remove();
+  const px = uPlot.pxRatio || 1;
+  const W = u.bbox.width / px, H = u.bbox.height / px;
+  const taken = Array.from(u.over.querySelectorAll('.campbell-divergence-label'))
+    .map((e) => ({x: e.offsetLeft, y: e.offsetTop, w: e.offsetWidth, h: e.offsetHeight}));
+  const probe = document.createElement('span');
+  probe.className = 'campbell-eo-label';
+  probe.style.visibility = 'hidden';
+  u.over.append(probe);
+  const measure = (t) => {
+    probe.textContent = t;
+    return probe.offsetWidth || 7 * t.length;
+  };
+  const h = Math.max(14, probe.offsetHeight || 14);
+  const sc = {xMin: u.scales.x.min, xMax: u.scales.x.max, yMin: u.scales.y.min, yMax: u.scales.y.max};
+  const lay = orderLabelLayout(u.data, L.meta, L.orders, sc, (v) => u.valToPos(v, 'x'), (v) => u.valToPos(v, 'y'),
+    W, H, (t) => measure(t) - 4, h, taken);
+  probe.remove();
+  L.labelBoxes = [];
+  for (const l of lay) {
+    if (!l.box) continue; // no free place: the legend names the line
+    const e = document.createElement('span');
+    e.className = 'campbell-eo-label';
+    e.textContent = l.text;
+    e.dataset.order = String(l.order);
+    Object.assign(e.style, {left: `${l.box.x}px`, top: `${l.box.y}px`, width: `${l.box.w}px`, height: `${l.box.h}px`});
+    u.over.append(e);
+    L.labelBoxes.push({order: l.order, ...l.box});
+  }
 }
 
 /** Half-width (CSS px) of a divergence speed's band, on the page and in the exported SVG. */
@@ -692,13 +812,25 @@ export function campbellChart(container, onDraw = null) {
     return Math.max(280, Math.floor(container.clientWidth || 560));
   }
 
-  function update({result, orders, units, ref = null, critical = null}) {
+  function update({result, orders, units, ref = null, critical = null, allModes = false}) {
     const {rows, lines, nModes} = campbellData(result);
     const refData = ref ? campbellData(ref) : null;
     const pd = plotData(rows, lines, orders, units, refData, critical, divergenceSpeeds(result));
     const {data, meta, flagged} = pd;
-    last = {rows, lines, nModes, orders, units, ref: refData, ...pd};
+    last = {rows, lines, nModes, orders, units, ref: refData, ...pd, markers: rows.length <= MARKER_MAX_SPEEDS,
+      focus: null, focused: false, labelBoxes: [], single: rows.length < 2};
     if (plot) plot.destroy();
+    plot = null;
+    for (const e of Array.from(container.querySelectorAll('.campbell-single'))) e.remove();
+    container.dataset.view = last.single ? 'single' : 'diagram';
+    container.dataset.cases = String(rows.length);
+    container.dataset.crossings = String(pd.cross.length);
+    container.dataset.divergence = String(pd.div.length);
+    if (last.single) { // one speed: no diagram, the frequencies as bars
+      container.append(singleSpeed(rows[0], lines, units));
+      if (onDraw) onDraw(last);
+      return last;
+    }
     const fu = FREQ_UNITS[units.freq], su = SPEED_UNITS[units.speed];
     const yl = `frequency ${fu.sym} (${fu.label})`;
     let ymax = 0;
@@ -715,6 +847,11 @@ export function campbellChart(container, onDraw = null) {
         return 0;
       });
       ymax = Math.min(ymax, Math.max(1.5 * (orders.length ? orders[orders.length - 1] : 1), ...top));
+    } else {
+      // modes far above the engine orders: fit the range to the modes the orders cross
+      last.focus = yFocus(data, meta, ymax);
+      last.focused = !!last.focus && !allModes;
+      if (last.focused) ymax = last.focus.top;
     }
     plot = new uPlot({
       width: width(),
@@ -763,9 +900,6 @@ export function campbellChart(container, onDraw = null) {
             `${d.label} at ${sig(d.x)} ${su.label}`).join(', ')}` : '')
         : 'Campbell diagram: no speeds');
     }
-    container.dataset.cases = String(rows.length);
-    container.dataset.crossings = String(pd.cross.length);
-    container.dataset.divergence = String(pd.div.length);
     return last;
   }
 
@@ -779,6 +913,7 @@ export function campbellChart(container, onDraw = null) {
     /** What is plotted, from the uPlot instance itself (for tests and debugging). */
     plotted() {
       if (!plot || !last) return null;
+      const over = plot.over.getBoundingClientRect();
       const labels = plot.series.map((s) => s.label);
       return {
         units: {...last.units},
@@ -796,6 +931,17 @@ export function campbellChart(container, onDraw = null) {
         unstable: last.unstable.map((r) => ({...r})),
         scales: {x: [plot.scales.x.min, plot.scales.x.max], y: [plot.scales.y.min, plot.scales.y.max]},
         axisLabels: plot.axes.map((a) => a.label),
+        // point markers and pixel rounding of each series, as uPlot holds them
+        markers: last.markers,
+        seriesStyle: plot.series.slice(1).map((s) => ({label: s.label, points: s.points.show(plot, 1) === true,
+          pxAlign: s.pxAlign})),
+        focus: last.focus ? {...last.focus, on: last.focused} : null,
+        // the engine-order labels as laid out and as the page shows them (client rects)
+        labelBoxes: last.labelBoxes.map((b) => ({...b})),
+        labelRects: Array.from(plot.over.querySelectorAll('.campbell-eo-label, .campbell-divergence-label')).map((e) => {
+          const r = e.getBoundingClientRect();
+          return {text: e.textContent, x: r.left - over.left, y: r.top - over.top, w: r.width, h: r.height};
+        }),
         xTicks: plot.axes[0]._values ? Array.from(plot.axes[0]._values) : [],
       };
     },
@@ -816,4 +962,54 @@ export function campbellChart(container, onDraw = null) {
 
 function sig(v) {
   return typeof v === 'number' && Number.isFinite(v) ? String(Number(v.toPrecision(6))) : '–';
+}
+
+/**
+ * One speed: the modes' frequencies as a table with bars (a Campbell
+ * diagram needs a sweep), in the units shown, each bar in its line's
+ * colour, with its frequency per revolution (the nearest engine order).
+ */
+function singleSpeed(row, lines, units) {
+  const fu = FREQ_UNITS[units.freq], su = SPEED_UNITS[units.speed];
+  const wrap = document.createElement('div');
+  wrap.className = 'campbell-single';
+  const t = document.createElement('table');
+  t.className = 'small campbell-single-table';
+  const cap = t.createCaption();
+  const x = row ? speedIn(units.speed, row) : null;
+  cap.textContent = row ? `Frequencies at Ω = ${sig(x)} ${su.label} (one speed: a Campbell diagram needs a sweep)`
+    : 'No speeds in this result';
+  const hr = t.createTHead().insertRow();
+  for (const h of ['mode', `${fu.sym} (${fu.label})`, '', 'engine order']) {
+    const th = document.createElement('th');
+    th.scope = 'col';
+    th.textContent = h;
+    hr.append(th);
+  }
+  const tb = t.createTBody();
+  if (!row) return wrap;
+  const items = lines.map((ln) => ({ln, md: row.byLine.get(ln.id)})).filter((o) => o.md)
+    .map((o) => ({...o, v: freqIn(units.freq, o.md, row.omega)})).filter((o) => o.v !== null)
+    .sort((a, b) => a.v - b.v);
+  const vmax = Math.max(...items.map((o) => o.v), 0) || 1;
+  for (const {ln, md, v} of items) {
+    const tr = tb.insertRow();
+    tr.dataset.line = String(ln.id);
+    tr.insertCell().textContent = typeof md.label === 'string' ? md.label : ln.name;
+    const c = tr.insertCell();
+    c.textContent = sig(v);
+    c.className = 'fq';
+    const bc = tr.insertCell();
+    bc.className = 'bar-cell';
+    const bar = document.createElement('span');
+    bar.className = 'bar';
+    bar.style.width = `${(100 * v / vmax).toFixed(2)}%`;
+    bar.style.background = COLORS[ln.id % COLORS.length];
+    bc.append(bar);
+    const pr = row.omega > 0 ? md.frequency_rad_s / row.omega : null;
+    const k = pr === null ? null : Math.max(1, Math.round(pr));
+    tr.insertCell().textContent = pr === null ? '– (Ω = 0)' : `${sig(Number(pr.toPrecision(3)))} per rev (near ${k}P)`;
+  }
+  wrap.append(t);
+  return wrap;
 }

@@ -7,6 +7,8 @@
 // the engine-order labels, so the file is vector graphics, not a picture of
 // the canvas.  PNG is either SVG rasterised at twice its size.
 
+import {orderLabelLayout} from './campbell.js';
+
 const NS = 'http://www.w3.org/2000/svg';
 
 function esc(t) {
@@ -165,15 +167,7 @@ export function campbellSvg(u, last, title) {
       pen = true;
     }
     out.push(`<path d="${d}" fill="none" stroke="${stroke}" stroke-width="${s.width || 1}"${dash} stroke-linejoin="round"/>`);
-    if (/^\d+P$/.test(s.label)) { // the engine order's label where its line leaves the plot
-      let k = -1;
-      for (let j = 0; j < xv.length; j++) if (typeof yv[j] === 'number' && yv[j] <= ys.max && xv[j] <= xs.max) k = j;
-      if (k >= 0) {
-        const lx = Math.min(X(xv[k]) + 3, L + pw - 22), ly = Math.max(T + 10, Y(yv[k]) - 5);
-        out.push(`<text x="${r2(lx)}" y="${r2(ly)}" fill="#374151" font-size="11">${esc(s.label)}</text>`);
-      }
-    }
-    if (kind === 'mode') {
+    if (kind === 'mode' && last.markers !== false) { // no beads on a dense sweep (campbell.js MARKER_MAX_SPEEDS)
       for (let j = 0; j < xv.length; j++) {
         if (typeof yv[j] === 'number') out.push(`<circle cx="${r2(X(xv[j]))}" cy="${r2(Y(yv[j]))}" r="2.2" fill="${stroke}"/>`);
       }
@@ -185,6 +179,16 @@ export function campbellSvg(u, last, title) {
   }
   for (const c of last.crit || []) out.push(shape(c.refined ? 'critical' : 'ring', X(c.x), Y(c.y)));
   for (const m of last.marks || []) out.push(shape(m.kind, X(m.x), Y(m.y)));
+  // the engine orders' labels where their lines leave the plot, none over another (as on the page)
+  const lay = orderLabelLayout(u.data, meta, last.orders || [], {xMin: xs.min, xMax: xs.max, yMin: ys.min, yMax: ys.max},
+    (v) => X(v) - L, (v) => Y(v) - T, pw, ph, (t) => 6.6 * t.length, 14);
+  for (const l of lay) {
+    if (!l.box) continue;
+    const b = l.box;
+    out.push(`<rect class="eo-label-box" x="${r2(L + b.x)}" y="${r2(T + b.y)}" width="${r2(b.w)}" height="${b.h}" ` +
+      'fill="#ffffff" fill-opacity="0.85"/>');
+    out.push(`<text class="eo-label" x="${r2(L + b.x + 2)}" y="${r2(T + b.y + 11)}" fill="#374151" font-size="11">${esc(l.text)}</text>`);
+  }
   out.push('</g>');
   if ((last.flagged || []).length) legend.push({label: 'flagged speeds', stroke: '#9ca3af', marker: 'ring'});
   // legend

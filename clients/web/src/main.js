@@ -43,6 +43,7 @@ const S = {
   anim: {frame: 0, running: true, raf: 0, t0: 0, view: null},
   view3d: null,        // the 3D switch: null = automatic (3D for a spatial structure), true, false
   cam: homeCamera(),   // the 3D camera {az, el} (degrees), shared by both drawings
+  allModes: false,     // the Campbell diagram shows every mode, not the range the engine orders cross
 };
 
 // ---------------------------------------------------------------- sync
@@ -52,6 +53,7 @@ function setDoc(doc, from) {
   if (from !== 'options') S.sweepError = null;
   S.blade = 'blade' in S.doc && !('structure' in S.doc);
   S.rows = structureToRows(S.doc.structure);
+  if (from !== 'name') $('design-name').value = typeof S.doc.name === 'string' ? S.doc.name : '';
   if (from !== 'table') editor.render();
   if (from !== 'blade') renderBlade();
   if (from !== 'options') renderOptions();
@@ -86,7 +88,9 @@ function afterChange() {
 /** Say so when the results shown are for another request than the editor's. */
 function markStale() {
   const R = S.result;
-  $('result-stale').hidden = !R || JSON.stringify(R.request) === JSON.stringify(S.doc);
+  // the name is no part of what was solved (nor of the job id)
+  const solved = (d) => JSON.stringify(d && typeof d === 'object' ? {...d, name: undefined} : d);
+  $('result-stale').hidden = !R || solved(R.request) === solved(S.doc);
 }
 
 // -------------------------------------------------------------- editor
@@ -108,6 +112,33 @@ $('json').addEventListener('input', () => {
     showErrors();
   }
 });
+
+/** "1 member", "2 members". */
+function plural(n, word, many = word + 's') {
+  return `${n} ${n === 1 ? word : many}`;
+}
+
+// the design's name (the request's optional "name": lists and file names, not part of the job id)
+$('design-name').addEventListener('input', () => {
+  const t = $('design-name').value.trim();
+  if (t) S.doc.name = t;
+  else delete S.doc.name;
+  setText(prettyJSON(S.doc));
+  afterChange();
+});
+
+/** A name as a part of a file name: letters, digits, - _ . kept, the rest _, at most 60 characters. */
+function fileSafe(name) {
+  return String(name).normalize('NFKD').replace(/[\u0300-\u036f]/g, '').replace(/[^A-Za-z0-9._-]+/g, '_')
+    .replace(/^[._]+|_+$/g, '').slice(0, 60);
+}
+
+/** The start of a result's file names: spinmodal-<name>-<id:12> (spinmodal-<id:12> without a name). */
+function fileBase(R = S.result) {
+  const id = R ? R.id.slice(0, 12) : 'x';
+  const n = R && R.request && typeof R.request.name === 'string' ? fileSafe(R.request.name) : '';
+  return n ? `spinmodal-${n}-${id}` : `spinmodal-${id}`;
+}
 
 // ------------------------------------------------------------- blade form
 
@@ -563,9 +594,9 @@ function draw() {
   else drawStructure(svg, st, mesh, opts);
   const n = Object.keys(mesh.joints).length, m = mesh.lines.length;
   $('structure-desc').textContent = (mesh.ok
-    ? `${n} joints, ${m} members, ${mesh.elems.length} elements, ${mesh.frames.length} frames` +
-      (equilibrium ? `; blue: ${eqLabel}` : '')
-    : `${n} joints, ${m} members drawn (${mesh.reason || 'incomplete'})`) +
+    ? `${plural(n, 'joint')}, ${plural(m, 'member')}, ${plural(mesh.elems.length, 'element')}, ` +
+      `${plural(mesh.frames.length, 'frame')}` + (equilibrium ? `; blue: ${eqLabel}` : '')
+    : `${plural(n, 'joint')}, ${plural(m, 'member')} drawn (${mesh.reason || 'incomplete'})`) +
     (in3d ? '. 3D view, z (the spin axis) up; frames: red e1 along the member, blue e3 the flap normal; ' +
       'dashed grey: shadows on the hub plane. Drag (or arrow keys) to turn, Home or double click to reset.' : '');
   viewControls();
@@ -640,6 +671,13 @@ $('view-preset').addEventListener('change', () => {
 
 // --------------------------------------------------------------- examples
 
+{ // the list shows no example while the editor holds a file, an import or a past job
+  const o = document.createElement('option');
+  o.value = '';
+  o.textContent = '—';
+  o.disabled = true;
+  $('example').append(o);
+}
 for (const ex of EXAMPLES) {
   const o = document.createElement('option');
   o.value = ex.key;
@@ -666,8 +704,10 @@ function loadExample(key) {
   setDoc(ex.doc(), 'example');
 }
 
-/** Load a request document into the editor (a file, an import, a past job). */
-function loadDoc(doc) {
+/** Load a request document into the editor (a file, an import, a past job); caption says where it came from. */
+function loadDoc(doc, caption = '') {
+  $('example').value = '';
+  $('example-desc').textContent = caption;
   S.view3d = null;
   Object.assign(S.cam, homeCamera());
   S.serverErrors = [];
@@ -795,7 +835,7 @@ async function poll(doc, gen) {
       }
     }
     if (gen !== S.pollGen) return;
-    showResult(cur.id, S.submitted && S.submitted.id === cur.id ? S.submitted.request : S.doc, result);
+    showResult(cur.id, S.submitted && S.submitted.id === cur.id ? S.submitted.request : S.doc, result, cur);
   }
 }
 
@@ -857,15 +897,20 @@ function groupBy(cases, text) {
   return Array.from(groups.values());
 }
 
-function showResult(id, request, result) {
+/**
+ * Show a result: id (a job's, or "file…"), the request it is for, the result
+ * document and the job's status document (its wall time; null for a file).
+ */
+function showResult(id, request, result, job = null) {
   const mesh = buildMesh(structureOf(request), request && 'frames' in request ? request.frames : DEFAULTS.frames);
-  S.result = {id, request, result, mesh};
+  S.result = {id, request, result, mesh, job};
   $('results').hidden = false;
+  const fb = fileBase();
   $('dl-json').href = api.resultUrl(id);
-  $('dl-json').setAttribute('download', `spinmodal-${id.slice(0, 12)}.json`);
+  $('dl-json').setAttribute('download', `${fb}.json`);
   $('dl-csv').href = api.resultUrl(id, 'csv');
-  $('dl-csv').setAttribute('download', `spinmodal-${id.slice(0, 12)}.csv`);
-  setBlobLink($('dl-json-req'), `spinmodal-${id.slice(0, 12)}-with-request.json`, 'application/json',
+  $('dl-csv').setAttribute('download', `${fb}.csv`);
+  setBlobLink($('dl-json-req'), `${fb}-with-request.json`, 'application/json',
     JSON.stringify({request, result}, null, 1));
   dlMsg('');
   spanwiseControls();
@@ -876,8 +921,7 @@ function showResult(id, request, result) {
     S.warnings = S.warnings.concat(rw.filter((w) => !have.has(w.pointer + '\n' + w.message)));
     showErrors();
   }
-  // a request in rpm is shown in rpm
-  if (request && request.analysis && 'rpm' in request.analysis && !('omega' in request.analysis)) $('speed-unit').value = 'rpm';
+  applyUnits(request);
   const sel = $('mode-speed');
   sel.textContent = '';
   let best = -1;
@@ -897,6 +941,74 @@ function showResult(id, request, result) {
   draw();
 }
 
+// ------------------------------------------------------------- units shown
+
+const UNITS_KEY = 'spinmodal.units';
+/** The units a result is shown in by default: a request in rpm in rpm and Hz, one in rad/s in rad/s. */
+const UNIT_DEFAULTS = {rpm: {speed: 'rpm', freq: 'hz'}, omega: {speed: 'rad', freq: 'rad'}};
+
+/** 'rpm' for a request that gives its speeds in rpm, else 'omega'. */
+function speedKind(request) {
+  const a = request && request.analysis;
+  return a && typeof a === 'object' && 'rpm' in a && !('omega' in a) ? 'rpm' : 'omega';
+}
+
+/** The user's choices of units, per kind of request (localStorage): {rpm: {speed, freq}, omega: …}. */
+function unitPrefs() {
+  try {
+    const p = JSON.parse(localStorage.getItem(UNITS_KEY) || '{}');
+    return p && typeof p === 'object' ? p : {};
+  } catch {
+    return {};
+  }
+}
+
+/** Show a result of request in the units the user last chose for such a request, else the defaults. */
+function applyUnits(request) {
+  const kind = speedKind(request);
+  const pref = unitPrefs()[kind] || {};
+  const want = {...UNIT_DEFAULTS[kind]};
+  if (pref.speed in SPEED_UNITS) want.speed = pref.speed;
+  if (pref.freq in FREQ_UNITS) want.freq = pref.freq;
+  $('speed-unit').value = want.speed;
+  $('freq-unit').value = want.freq;
+}
+
+/** The user picked a unit: remember it for the results of this kind of request. */
+function rememberUnits() {
+  if (!S.result) return;
+  const all = unitPrefs();
+  all[speedKind(S.result.request)] = units();
+  try {
+    localStorage.setItem(UNITS_KEY, JSON.stringify(all));
+  } catch {
+    /* storage disabled: the choice holds for this page only */
+  }
+}
+
+/** "26.1 s", "850 ms": a duration in seconds as text. */
+function durationText(s) {
+  return s < 1 ? `${sig(s * 1000, 3)} ms` : s < 600 ? `${sig(s, 3)} s` : `${sig(s / 60, 3)} min`;
+}
+
+/**
+ * How long the job took: its wall time from started_at to finished_at (the
+ * refined solves of an error estimate and the critical-speed solves
+ * included), or for a result without its job the solver's own timing_ms.
+ */
+function timingText(R) {
+  const j = R.job, t = R.result.timing_ms;
+  const t0 = j ? Date.parse(j.started_at) : NaN, t1 = j ? Date.parse(j.finished_at) : NaN;
+  const solve = t ? (t.equilibrium || 0) + (t.linearize || 0) + (t.eigen || 0) : null;
+  if (Number.isFinite(t0) && Number.isFinite(t1) && t1 >= t0) {
+    const est = R.request && R.request.analysis && R.request.analysis.error_estimate === true;
+    return `wall time ${durationText((t1 - t0) / 1000)}` + (solve !== null
+      ? ` (the requested speeds' solves: ${durationText(solve / 1000)}${est ? '; the rest is the error estimate\'s refined solves' : ''})`
+      : '');
+  }
+  return solve !== null ? `solver time ${durationText(solve / 1000)}` : '';
+}
+
 /** Everything of the results that depends on the units shown. */
 function showUnits() {
   const R = S.result;
@@ -904,10 +1016,12 @@ function showUnits() {
   const result = R.result;
   const md = result.model || {};
   const cases = result.cases || [];
-  $('result-summary').textContent = `${cases.length} speed${cases.length === 1 ? '' : 's'}; model: ${md.nodes} nodes, ` +
-    `${md.elements} elements, ${md.frames} frames, ${md.coordinates} coordinates` +
-    (result.timing_ms ? `; ${sig((result.timing_ms.equilibrium || 0) + (result.timing_ms.linearize || 0) +
-      (result.timing_ms.eigen || 0), 3)} ms` : '') + '.';
+  const tt = timingText(R);
+  $('result-summary').textContent = `${plural(cases.length, 'speed')}; model: ${plural(md.nodes, 'node')}, ` +
+    `${plural(md.elements, 'element')}, ${plural(md.frames, 'frame')}, ${plural(md.coordinates, 'coordinate')}` +
+    (tt ? `; ${tt}` : '') + '.';
+  $('result-summary').dataset.wallS = R.job && Date.parse(R.job.finished_at) >= Date.parse(R.job.started_at)
+    ? String((Date.parse(R.job.finished_at) - Date.parse(R.job.started_at)) / 1000) : '';
   const notes = $('case-notes');
   notes.textContent = '';
   // one note per distinct failure (status and message), naming its speeds
@@ -1065,7 +1179,7 @@ function tableCsv() {
   const {head, rows} = tableRows(R.result);
   const u = units();
   const text = [head, ...rows].map((r) => r.map(csvCell).join(',')).join('\n') + '\n';
-  setBlobLink($('dl-csv-units'), `spinmodal-${R.id.slice(0, 12)}-${u.speed}-${u.freq}.csv`, 'text/csv', text);
+  setBlobLink($('dl-csv-units'), `${fileBase(R)}-${u.speed}-${u.freq}.csv`, 'text/csv', text);
   $('dl-csv-units').dataset.csv = text;
 }
 
@@ -1077,7 +1191,13 @@ function updateChart() {
   $('ref-note').hidden = !ref;
   $('ref-note').textContent = ref ? `Dashed thin lines: the reference result ${S.ref.label}.` : '';
   const critical = criticalOf(S.result);
-  const d = chart.update({result: S.result.result, orders, units: u, ref, critical});
+  const d = chart.update({result: S.result.result, orders, units: u, ref, critical, allModes: S.allModes});
+  focusNote(d);
+  for (const id of ['campbell-svg', 'campbell-png']) {
+    $(id).disabled = d.single;
+    $(id).title = d.single ? 'One speed: no Campbell diagram to export (the table is in the CSV downloads)' : '';
+  }
+  $('zoom-reset').hidden = d.single;
   const tb = $('crossings').tBodies[0];
   $('cross-speed-h').textContent = `Ω (${SPEED_UNITS[u.speed].label})`;
   $('cross-freq-h').textContent = `${FREQ_UNITS[u.freq].sym} (${FREQ_UNITS[u.freq].label})`;
@@ -1194,6 +1314,25 @@ function criticalTable(critical) {
   }
 }
 
+/** Say when the y range is fitted to the engine orders (modes above it left out) and offer all modes. */
+function focusNote(d) {
+  const f = d.focus, n = $('focus-note'), b = $('campbell-all');
+  n.hidden = !f || d.single;
+  b.hidden = !f || d.single;
+  if (!f || d.single) return;
+  const fu = FREQ_UNITS[d.units.freq].label;
+  b.textContent = d.focused ? 'Show all modes' : 'Fit to the engine orders';
+  b.setAttribute('aria-pressed', d.focused ? 'false' : 'true');
+  n.textContent = d.focused
+    ? `The frequency axis is fitted to the modes the engine orders cross and the next one above (up to ${sig(f.top, 3)} ${fu}); ` +
+      `${plural(f.hidden, 'higher mode')} (up to ${sig(f.max, 3)} ${fu}) ${f.hidden === 1 ? 'lies' : 'lie'} above: “Show all modes”.`
+    : `All modes, up to ${sig(f.max, 3)} ${fu}: the engine orders stay below ${sig(f.top, 3)} ${fu}.`;
+}
+$('campbell-all').addEventListener('click', () => {
+  S.allModes = !S.allModes;
+  updateChart();
+});
+
 /** Say how the error bars are shown: drawn where longer than the point, else only in the tooltip. */
 function errbarNote(last) {
   const n = $('errbar-note');
@@ -1213,8 +1352,12 @@ function errbarNote(last) {
   n.dataset.drawn = String(e.drawn);
   n.dataset.hidden = String(e.hidden);
 }
-$('freq-unit').addEventListener('change', showUnits);
-$('speed-unit').addEventListener('change', showUnits);
+for (const id of ['freq-unit', 'speed-unit']) {
+  $(id).addEventListener('change', () => {
+    rememberUnits();
+    showUnits();
+  });
+}
 $('zoom-reset').addEventListener('click', updateChart);
 
 // ---------------------------------------------------------- mode animation
@@ -1356,14 +1499,15 @@ $('open-request').addEventListener('change', async () => {
   }
   // a "JSON + request" download holds {request, result}
   const req = doc && typeof doc === 'object' && doc.request && doc.result ? doc.request : doc;
-  loadDoc(req);
+  loadDoc(req, `Opened ${f.name}` + (req && typeof req.name === 'string' ? ` (“${req.name}”)` : '') + '.');
   if (doc && doc.request && doc.result) showResult(doc.result.solver ? 'file-' + f.name : 'file', doc.request, doc.result);
   fileMsg(`opened ${f.name}`, 'ok');
   $('open-request').value = '';
 });
 
 $('save-request').addEventListener('click', () => {
-  const name = ($('example').value && !S.blade ? $('example').value : 'request') + '.json';
+  const name = (typeof S.doc.name === 'string' && fileSafe(S.doc.name) ? fileSafe(S.doc.name)
+    : $('example').value && !S.blade ? $('example').value : 'request') + '.json';
   saveBlob(new Blob([S.text.endsWith('\n') ? S.text : S.text + '\n'], {type: 'application/json'}), `spinmodal-${name}`);
   fileMsg(`saved spinmodal-${name} (your downloads)`, 'ok');
 });
@@ -1393,7 +1537,9 @@ async function refreshJobs() {
     const o = document.createElement('option');
     o.value = j.id;
     const when = (j.created_at || '').replace('T', ' ').replace(/\.\d+Z$/, ' UTC');
-    o.textContent = `${when} · ${j.state} · ${j.progress ? j.progress.total : '?'} speed(s) · ${j.id.slice(0, 8)}`;
+    o.textContent = (typeof j.name === 'string' ? `${j.name} · ` : '') +
+      `${when} · ${j.state} · ${j.progress ? plural(j.progress.total, 'speed') : '? speeds'} · ${j.id.slice(0, 8)}`;
+    if (typeof j.name === 'string') o.dataset.name = j.name;
     sel.append(o);
   }
   if (prev && Array.from(sel.options).some((o) => o.value === prev)) sel.value = prev;
@@ -1414,12 +1560,13 @@ async function reopenJob(id) {
     return;
   }
   S.pollGen++;
-  loadDoc(request);
+  loadDoc(request, `Past job ${id.slice(0, 12)}` + (request && typeof request.name === 'string' ? ` — “${request.name}”` : '') +
+    (st && st.doc && st.doc.created_at ? `, submitted ${st.doc.created_at.replace('T', ' ').replace(/\.\d+Z$/, ' UTC')}` : '') + '.');
   if (st && st.doc) {
     showJob(st.doc);
     S.submitted = {id, request: S.doc};
     if (!TERMINAL.has(st.doc.state)) poll(st.doc, S.pollGen);
-    else if (st.doc.result) showResult(id, S.doc, st.doc.result);
+    else if (st.doc.result) showResult(id, S.doc, st.doc.result, st.doc);
   }
   fileMsg(`reopened job ${id.slice(0, 12)} (${st && st.doc ? st.doc.state : '?'})`, 'ok');
 }
@@ -1496,20 +1643,43 @@ async function importBlade() {
     return;
   }
   $('import-dialog').close();
-  loadDoc(r.request);
   const src = r.source || {};
+  const req = r.request && typeof r.request === 'object' ? r.request : {};
+  // a name for the past jobs and the file names: the file's, unless the request has one
+  if (typeof req.name !== 'string' && fileSafe(main.name.replace(/\.[^.]*$/, ''))) req.name = main.name.replace(/\.[^.]*$/, '');
+  const b = req.blade && typeof req.blade === 'object' ? req.blade : null;
+  const an = req.analysis && typeof req.analysis === 'object' ? req.analysis : {};
+  const sp = 'rpm' in an ? speedList(an.rpm) : [];
+  loadDoc(req, `Imported from ${main.name}${format === 'bmodes' ? ` + ${sec.name}` : ''}` + (src.title ? ` (“${src.title}”)` : '') +
+    (b ? `: a blade of ${fmtNum(b.length)} m${Array.isArray(b.stations) ? `, ${plural(b.stations.length, 'station')}` : ''}`
+      : req.structure && Array.isArray(req.structure.members) ? `: ${plural(req.structure.members.length, 'member')}` : '') +
+    (sp.length === 1 ? `, ${fmtNum(sp[0])} rpm` : '') + '.');
   $('import-notes').hidden = false;
   $('import-source').textContent = `${src.file || main.name}${src.sec_props_file ? ' + ' + src.sec_props_file : ''}` +
     (src.title ? ` — “${src.title}”` : '');
   const ul = $('import-warnings');
   ul.textContent = '';
-  for (const w of r.warnings) {
+  const warnings = r.warnings.slice();
+  // the section file chosen is not the one the .bmi names (a tower table would import without a word)
+  const baseName = (t) => String(t).split(/[\\/]/).pop();
+  if (format === 'bmodes' && typeof src.sec_props_file === 'string' && src.sec_props_file &&
+      baseName(src.sec_props_file).toLowerCase() !== sec.name.toLowerCase() &&
+      !warnings.some((w) => String(typeof w === 'string' ? w : w.message).includes(sec.name))) {
+    warnings.unshift({file: main.name, field: 'sec_props_file', mismatch: true,
+      message: `the .bmi names the section file “${src.sec_props_file}”, but “${sec.name}” was chosen: ` +
+        'check that it is this blade\'s table (a tower\'s would import without an error)'});
+  }
+  for (const w of warnings) {
     const li = document.createElement('li');
     li.textContent = typeof w === 'string' ? w : [w.file && `${w.file}${w.line ? ':' + w.line : ''}`, w.field, w.message]
       .filter(Boolean).join(': ') || JSON.stringify(w);
+    if (w && w.mismatch) {
+      li.className = 'warn sec-mismatch';
+      li.textContent = '⚠ ' + li.textContent;
+    }
     ul.append(li);
   }
-  if (!r.warnings.length) {
+  if (!warnings.length) {
     const li = document.createElement('li');
     li.className = 'ok';
     li.textContent = 'no import warnings';
@@ -1527,7 +1697,7 @@ $('import-go').addEventListener('click', importBlade);
 const SHAPE_FILES = {
   spanwise: {button: 'dl-spanwise', suffix: 'spanwise.csv', what: 'span-wise shapes',
     title: 'Flap, edge, their slopes, twist and axial motion of every mode along each member, each mode scaled to ' +
-      '1 m at its largest (GET …/result?format=spanwise; DESIGN.md §8.3)'},
+      '1 m at its largest (GET …/result?format=spanwise)'},
   bmodes: {button: 'dl-bmodes', suffix: 'bmodes.txt', what: 'the BModes-style table',
     title: 'The span-wise shapes in the layout of BModes\' .out: span_loc, flap disp, flap slope, lag disp, lag slope, ' +
       'twist, with BModes\' signs (GET …/result?format=bmodes)'},
@@ -1575,7 +1745,7 @@ async function downloadShapes(format) {
     dlMsg(`${f.what}: ${r.status ? r.status + ' ' : ''}${r.message}`, 'bad');
     return;
   }
-  const name = `spinmodal-${R.id.slice(0, 12)}-${f.suffix}`;
+  const name = `${fileBase(R)}-${f.suffix}`;
   S.lastExport = {name, type: r.blob.type, size: r.blob.size};
   saveBlob(r.blob, name);
   dlMsg(`saved ${name} (your downloads)`, 'ok');
@@ -1615,7 +1785,7 @@ $('dl-critical').addEventListener('click', async () => {
     dlMsg(`critical speeds: ${r.status ? r.status + ' ' : ''}${r.message}`, 'bad');
     return;
   }
-  const name = `spinmodal-${R.id.slice(0, 12)}-critical.csv`;
+  const name = `${fileBase(R)}-critical.csv`;
   S.lastExport = {name, type: r.blob.type, size: r.blob.size};
   saveBlob(r.blob, name);
   dlMsg(`saved ${name} (your downloads)`, 'ok');
@@ -1687,7 +1857,7 @@ $('clear-ref').addEventListener('click', () => {
 });
 
 function exportName(what, ext) {
-  return `spinmodal-${S.result ? S.result.id.slice(0, 12) : 'x'}-${what}.${ext}`;
+  return `${fileBase()}-${what}.${ext}`;
 }
 
 function campbellExportSvg() {
@@ -1730,6 +1900,8 @@ window.__spinmodal = {
     return S.result && S.result.result;
   },
   campbell: () => chart.plotted(),
+  // 'diagram', or 'single' (one speed: the frequencies as a table with bars)
+  campbellView: () => $('campbell').dataset.view || '',
   anim: () => ({frame: S.anim.frame, running: S.anim.running, theta: S.anim.theta,
     path: ($('mode-path') && $('mode-path').getAttribute('d')) || '',
     view: $('mode-svg').dataset.view || '',
@@ -1764,7 +1936,8 @@ try {
   keptDoc = null;
 }
 if (keptDoc && typeof keptDoc === 'object') {
-  loadDoc(keptDoc);
+  loadDoc(keptDoc, 'Your request from the last visit (kept in this browser)' +
+    (typeof keptDoc.name === 'string' ? `: “${keptDoc.name}”.` : '.'));
   fileMsg('your request from the last visit (kept in this browser)', 'ok');
 } else if (kept && kept.trim()) {
   loadExample('angled-90');

@@ -150,15 +150,36 @@ function fmt(v) {
   return Number(v.toPrecision(3)).toString();
 }
 
-/** A range [lo, hi] holding 0 and every value, a little wider (0 strictly inside). */
-function range(vals) {
+/** The smallest span of the axes: displacement (m; modes are scaled to 1 m) and twist (rad, about 0.6°). */
+export const MIN_SPAN = {displacement: 0.1, twist: 0.01};
+
+/**
+ * A range [lo, hi] holding 0 and every value, a little wider; at least
+ * minSpan wide (a mode without twist does not stretch its axis to ±1 rad:
+ * a flat line in a small range), centred on the values where widened.
+ */
+function range(vals, minSpan) {
   let lo = Math.min(0, ...vals), hi = Math.max(0, ...vals);
-  if (hi - lo < 1e-12) {
-    lo = -1;
-    hi = 1;
+  if (hi - lo < minSpan) {
+    const mid = (lo + hi) / 2;
+    lo = Math.min(lo, mid - minSpan / 2);
+    hi = Math.max(hi, mid + minSpan / 2);
   }
   const pad = 0.06 * (hi - lo);
   return [lo - pad, hi + pad];
+}
+
+/**
+ * The twist range: the values' own (range), or where they are smaller than
+ * the minimum span, the displacement range d scaled to that span (0 at the
+ * same height, so the zero lines agree without widening either axis).
+ */
+function twistRange(vals, d) {
+  const lo = Math.min(0, ...vals), hi = Math.max(0, ...vals);
+  if (hi - lo >= MIN_SPAN.twist) return range(vals, MIN_SPAN.twist);
+  const k = MIN_SPAN.twist / (d[1] - d[0]);
+  const r = [d[0] * k, d[1] * k];
+  return lo >= r[0] && hi <= r[1] ? r : range(vals, MIN_SPAN.twist);
 }
 
 /** Widen the ranges so that 0 is at the same height on both axes (one zero line). */
@@ -187,7 +208,8 @@ export function drawSpanwise(svg, pts) {
   svg.textContent = '';
   const W = 600, H = 200, L = 52, R = 56, T = 26, B = 34;
   const X = (x) => L + x * (W - L - R);
-  const [dr, tr] = alignZero(range(pts.flatMap((p) => [p.flap, p.edge])), range(pts.map((p) => p.twist)));
+  const d0 = range(pts.flatMap((p) => [p.flap, p.edge]), MIN_SPAN.displacement);
+  const [dr, tr] = alignZero(d0, twistRange(pts.map((p) => p.twist), d0));
   const Y = (v, r) => T + (r[1] - v) / (r[1] - r[0]) * (H - T - B);
   const g = el('g', {class: 'sw-axes'}, svg);
   el('rect', {x: L, y: T, width: W - L - R, height: H - T - B, class: 'sw-frame'}, g);
