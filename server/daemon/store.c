@@ -8,7 +8,8 @@
  * retention.  This file checks arguments, zeroes out-parameters, names
  * states and return codes, keeps the error record, and hands every call to
  * the backend table (store_backend.h).  The SQLite backend lives in
- * store_sqlite.c (statements, connections, the job operations, health,
+ * store_sqlite.c (the job operations), store_sqlite_conn.c (statements,
+ * connections, the waits within a deadline), store_sqlite_file.c (health,
  * retention) and store_sqlite_open.c (the lock file, checks, schema and
  * migrations at open); the PostgreSQL backend (DESIGN.md §6) in
  * store_pg.c (pool, reconnection, job operations) and store_pg_open.c
@@ -489,6 +490,20 @@ double store_mono(void)
 
     (void)clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+struct timespec store_wall_in(int ms)
+{
+    struct timespec t;
+
+    (void)clock_gettime(CLOCK_REALTIME, &t);
+    t.tv_sec += ms / 1000;
+    t.tv_nsec += (long)(ms % 1000) * 1000000L;
+    if (t.tv_nsec >= 1000000000L) {
+        t.tv_sec++;
+        t.tv_nsec -= 1000000000L;
+    }
+    return t;
 }
 
 void store_note_pruned(store *s, long long n)

@@ -16,6 +16,7 @@
 #include "store.h"
 
 #include <pthread.h>
+#include <time.h>
 
 /* The operations of one backend; the meanings and return codes are those
  * of the public functions of the same name in store.h.  open sets s->impl
@@ -51,7 +52,8 @@ typedef struct store_backend {
     int (*state_of)(store *s, const char *id, store_state *state);
 } store_backend;
 
-/* The SQLite backend (store_sqlite.c, store_sqlite_open.c). */
+/* The SQLite backend (store_sqlite.c, store_sqlite_conn.c, store_sqlite_open.c,
+ * store_sqlite_file.c). */
 extern const store_backend store_sqlite_backend;
 /* The PostgreSQL backend (store_pg.c, store_pg_open.c). */
 extern const store_backend store_pg_backend;
@@ -74,6 +76,10 @@ struct store {
 
 /* Monotonic clock, seconds: the deadlines' time base. */
 double store_mono(void);
+
+/* The wall-clock time ms milliseconds from now, for the backends' timed
+ * waits (pthread_cond_timedwait, pthread_mutex_timedlock: CLOCK_REALTIME). */
+struct timespec store_wall_in(int ms);
 
 /* n > 0 finished jobs deleted by the budget on insert: tell on_pruned. */
 void store_note_pruned(store *s, long long n);

@@ -458,26 +458,11 @@ static int pg_alive(pg_conn *c)
 
 /* ---- the pool ------------------------------------------------------------- */
 
-/* The wall-clock time ms from now (the pool's timed waits use CLOCK_REALTIME). */
-static struct timespec wall_in(int ms)
-{
-    struct timespec t;
-
-    (void)clock_gettime(CLOCK_REALTIME, &t);
-    t.tv_sec += ms / 1000;
-    t.tv_nsec += (long)(ms % 1000) * 1000000L;
-    if (t.tv_nsec >= 1000000000L) {
-        t.tv_sec++;
-        t.tv_nsec -= 1000000000L;
-    }
-    return t;
-}
-
 /* A free connection of q within ms (the probes' session when probe);
  * NULL when none came free. */
 static pg_conn *pool_take(store_pg *q, int probe, int ms)
 {
-    struct timespec until = wall_in(ms);
+    struct timespec until = store_wall_in(ms);
     pg_conn *c;
     int e = 0;
 
@@ -591,12 +576,27 @@ void store_pg_release(store *s, pg_conn *c)
 
 /* ---- statements ----------------------------------------------------------- */
 
+/* The answer r of a statement or command of c: *res = r when it succeeded
+ * (the caller's to PQclear), else recorded, cleared, and its kind. */
+static int pg_result(pg_conn *c, PGresult *r, PGresult **res)
+{
+    ExecStatusType st = PQresultStatus(r);
+    int kind;
+
+    if (st == PGRES_COMMAND_OK || st == PGRES_TUPLES_OK) {
+        *res = r;
+        return STORE_OK;
+    }
+    kind = pg_fail(c, r);
+    PQclear(r);
+    return kind;
+}
+
 int store_pg_run(pg_conn *c, int k, int n, const char *const *vals, const int *lens,
                  const int *fmts, PGresult **res)
 {
     char name[16];
     PGresult *r;
-    ExecStatusType st;
     double sent = 0.0;
     int kind;
 
@@ -622,38 +622,19 @@ int store_pg_run(pg_conn *c, int k, int n, const char *const *vals, const int *l
     c->deadline += sent / STORE_PG_SEND_RATE;
     kind = pg_answer(c, PQsendQueryPrepared(c->conn, name, n, vals, lens, fmts, 0), &r,
                      "running a statement");
-    if (kind != STORE_OK)
-        return kind;
-    st = PQresultStatus(r);
-    if (st == PGRES_COMMAND_OK || st == PGRES_TUPLES_OK) {
-        *res = r;
-        return STORE_OK;
-    }
-    kind = pg_fail(c, r);
-    PQclear(r);
-    return kind;
+    return kind == STORE_OK ? pg_result(c, r, res) : kind;
 }
 
 int store_pg_query(pg_conn *c, const char *sql, PGresult **res)
 {
     PGresult *r;
-    ExecStatusType st;
     int kind;
 
     *res = NULL;
     if (c->conn == NULL)
         return pg_fail(c, NULL);
     kind = pg_answer(c, PQsendQuery(c->conn, sql), &r, "running a command");
-    if (kind != STORE_OK)
-        return kind;
-    st = PQresultStatus(r);
-    if (st == PGRES_COMMAND_OK || st == PGRES_TUPLES_OK) {
-        *res = r;
-        return STORE_OK;
-    }
-    kind = pg_fail(c, r);
-    PQclear(r);
-    return kind;
+    return kind == STORE_OK ? pg_result(c, r, res) : kind;
 }
 
 int store_pg_exec(pg_conn *c, const char *sql)

@@ -1,7 +1,8 @@
 /*
  * store_sqlite.h — private to the SQLite backend (store_sqlite.c,
- * store_sqlite_open.c) and the store test: the backend's state, its
- * connections and the helpers both files use.
+ * store_sqlite_conn.c, store_sqlite_open.c, store_sqlite_file.c) and the
+ * store test: the backend's state, its connections and the helpers its
+ * files share.
  */
 #ifndef SPINMODAL_STORE_SQLITE_H
 #define SPINMODAL_STORE_SQLITE_H
