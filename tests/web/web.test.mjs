@@ -1269,10 +1269,10 @@ async function firstHour(page, base) {
     .map((m) => ({x: +m[1], y: +m[2], w: +m[3], h: +m[4]}));
   ok(boxes.length === 4 && overlaps(boxes).length === 0, 'the exported order labels do not overlap either', JSON.stringify(boxes));
 
-  // the user's unit choice is remembered (rpm requests: rad/s frequencies from now on)
-  await page.selectOption('#freq-unit', 'rad');
+  // the user's unit choice is remembered (rpm requests: per rev from now on)
+  await page.selectOption('#freq-unit', 'rev');
   const prefs = await page.evaluate(() => JSON.parse(localStorage.getItem('spinmodal.units') || '{}'));
-  ok(prefs.rpm && prefs.rpm.freq === 'rad', 'the unit picked is kept in localStorage', JSON.stringify(prefs));
+  ok(prefs.rpm && prefs.rpm.freq === 'rev', 'the unit picked is kept in localStorage', JSON.stringify(prefs));
   await page.reload({waitUntil: 'load'});
   await waitFor(page, () => window.__spinmodal && window.__spinmodal.doc.blade, null, 'the reload');
   ok(/Test01_nonunif_blade/.test(await page.textContent('#example-desc')), 'after a reload the caption names the design',
@@ -1285,24 +1285,16 @@ async function firstHour(page, base) {
   await page.click('#open-job');
   ok(await waitFor(page, (id) => window.__spinmodal.job && window.__spinmodal.job.id === id && window.__spinmodal.result &&
     window.__spinmodal.campbell(), got.id, 'the reopened job'), 'the named job reopens');
-  ok(await page.inputValue('#freq-unit') === 'rad' && await page.inputValue('#speed-unit') === 'rpm',
-    'after a reload, a result in rpm is shown in the frequency unit the user chose (rad/s)');
+  ok(await page.inputValue('#freq-unit') === 'rev' && await page.inputValue('#speed-unit') === 'rpm',
+    'after a reload, a result in rpm is shown in the frequency unit the user chose (per rev)');
   ok(/wall time/.test(await page.textContent('#result-summary')), 'a reopened job gives its wall time too');
   await page.selectOption('#freq-unit', 'hz');
 
-  // the twist axis of a mode without (much) twist: scaled to the data, not ±2 rad
-  doc.analysis = {...doc.analysis, rpm: [60], modes: 4, mode_shapes: true};
+  // one speed (Test01 at 60 rpm, 4 modes)
+  doc.analysis = {...doc.analysis, rpm: [60], modes: 4};
   await page.fill('#json', JSON.stringify(doc, null, 2));
-  const one = await solveHere(page, base, 'Test01 at 60 rpm with shapes');
+  const one = await solveHere(page, base, 'Test01 at 60 rpm');
   if (!one) return;
-  ok(await waitFor(page, () => window.__spinmodal.spanwise().plot && window.__spinmodal.spanwise().plot.mode === 1, null,
-    'the span-wise plot'), 'the span-wise plot of mode 1');
-  const sp = (await page.evaluate(() => window.__spinmodal.spanwise())).plot;
-  const tw = sp.points.map((q) => q.twist), tmax = Math.max(...tw.map(Math.abs));
-  const span = sp.ranges.twist[1] - sp.ranges.twist[0];
-  ok(span <= Math.max(0.05, 4 * tmax) && Math.min(...tw) >= sp.ranges.twist[0] && Math.max(...tw) <= sp.ranges.twist[1],
-    'the twist axis is scaled to the mode\'s twist (a sensible minimum span), not to ±1…2 rad',
-    `twist ≤ ${tmax} rad, axis ${JSON.stringify(sp.ranges.twist)}`);
   // one speed: a table of the frequencies, not an empty diagram
   ok(await page.evaluate(() => window.__spinmodal.campbellView()) === 'single' &&
     await page.locator('#campbell table.campbell-single-table tbody tr').count() === 4 &&
@@ -1312,6 +1304,23 @@ async function firstHour(page, base) {
   const f1 = await page.locator('#campbell table.campbell-single-table tbody tr').first().locator('td').nth(1).textContent();
   ok(Number(f1) === Number(one.result.cases[0].modes[0].frequency_hz.toPrecision(6)), 'its first row is f₁ in Hz', f1);
   await shotEl(page, '#campbell', '25-campbell-one-speed.png');
+
+  // the twist axis of a mode without twist (a uniform blade without offsets, its 1st flap mode):
+  // scaled to the data with a minimum span, not ±1 rad stretched to 2 rad by the zero line
+  await page.fill('#json', JSON.stringify({name: 'uniform blade', blade: {length: 10, elements: 12, section: {EA: 1e10,
+    EI_flap: 1e6, EI_edge: 4e6, GJ: 1e6, mass_per_length: 50}}, analysis: {omega: [5], modes: 3, mode_shapes: true}}, null, 2));
+  const ub = await solveHere(page, base, 'a uniform blade');
+  if (!ub) return;
+  await page.selectOption('#mode-index', '0');
+  ok(await waitFor(page, () => window.__spinmodal.spanwise().plot && window.__spinmodal.spanwise().plot.mode === 1, null,
+    'the span-wise plot'), 'the span-wise plot of mode 1 of the uniform blade');
+  const sp = (await page.evaluate(() => window.__spinmodal.spanwise())).plot;
+  const tw = sp.points.map((q) => q.twist), tmax = Math.max(...tw.map(Math.abs));
+  const span = sp.ranges.twist[1] - sp.ranges.twist[0];
+  ok(tmax < 1e-6 && span <= 0.05 && Math.min(...tw) >= sp.ranges.twist[0] && Math.max(...tw) <= sp.ranges.twist[1],
+    'a mode without twist: the twist axis spans a few hundredths of a rad at most (not ±1…2 rad)',
+    `twist ≤ ${tmax} rad, axis ${JSON.stringify(sp.ranges.twist)}`);
+  await shotEl(page, '#spanwise-box', '26-spanwise-no-twist.png');
 }
 
 /** A design is never lost: a reload keeps the request, a file saves and opens it, a past job reopens. */
