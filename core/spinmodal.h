@@ -298,8 +298,10 @@ typedef struct sm_model_info {
                             clamped in its basis, is not counted, so the DOF are exactly 3x */
     int spatial;        /* 1 for a spatial model (6 DOF per node), 0 planar */
     int structured;     /* 1 when the solves take the tree-structured path (cost ~ linear in
-                           the size; sm_options.solver, or the automatic choice by size),
-                           0 for the dense path (cost ~ coordinates^3) */
+                           the size; sm_options.solver, or the automatic choice: at least 200
+                           coordinates, frames of at most 40, 8 x modes <= coordinates and at
+                           most SM_TREE_MAX_MODES modes), 0 for the dense path (cost ~
+                           coordinates^3) */
 } sm_model_info;
 
 /** Sizes of the model m (borrowed) into *info. */
