@@ -106,8 +106,9 @@ def main():
     ts.calibrate(exe)
     tmp = tempfile.mkdtemp(prefix="spinmodal-nginx-")
     # one worker kept busy by a long sweep (below), whose ~67 MB result is over the default
-    # --max-result-bytes: no result-size limit here
-    d = dm.Daemon(exe, tmp, ["--workers", "1", "--max-result-bytes", "0"])
+    # --max-result-bytes and whose run may pass the default --job-timeout (30 s) on a slow
+    # machine: neither limit here (the ?wait below must find the sweep still running)
+    d = dm.Daemon(exe, tmp, ["--workers", "1", "--max-result-bytes", "0", "--job-timeout", "600"])
     ngx = None
     try:
         d.start()

@@ -1354,7 +1354,11 @@ def scenario_result_budget(exe, tmp):
     check(state == "done" and n > 30000000,
           "the sweep with shapes is solved and its result served (%s %s, %d bytes)"
           % (state, err, n))
-    check((peak_kb - solve_kb) * 1024 < 2.5 * n,
+    with open("/proc/%d/maps" % d.proc.pid) as f:
+        sanitized = "libasan" in f.read()
+    if sanitized:  # ASan's quarantine keeps freed blocks resident: the peak says nothing here
+        print("skip: the daemon runs under AddressSanitizer, its peak is not the program's")
+    check(sanitized or (peak_kb - solve_kb) * 1024 < 2.5 * n,
           "the result is held whole once beside the store's copy of it: the peak grew by %d KB, "
           "less than 2.5 times the result's %d KB" % (peak_kb - solve_kb, n // 1024))
     check(d.stop() == 0, "daemon stops cleanly")
