@@ -28,10 +28,13 @@ required=(
 # Optional: nice to have, a failure to install them is only a warning.
 # wrk: tests/bench/bench_http.sh; nginx: tests/deploy (deploy/nginx/spinmodal.conf in
 # front of a real daemon; the test runs its own nginx, the package's service may be
-# disabled); podman: tests/deploy builds deploy/Dockerfile (needs the network for the
-# base images).  kubectl is used by tests/deploy when present but not installed here:
-# Debian 12's kubernetes-client (1.20) conflicts with other kubectl installs.
-optional=(valgrind wrk nginx podman)
+# disabled); podman + debootstrap: tests/deploy (deploy-image) makes a Debian 12 base
+# with debootstrap (no registry), builds deploy/Dockerfile with podman and runs its
+# spinmodald from the image's file system (about 4 to 5 minutes on 2 cores, the
+# network needed for apt-get and npm ci).  kubectl is used by tests/deploy when present
+# but not installed here: Debian 12's kubernetes-client (1.20) conflicts with other
+# kubectl installs.
+optional=(valgrind wrk nginx podman debootstrap)
 
 say() { printf 'install-deps: %s\n' "$*"; }
 
