@@ -414,6 +414,13 @@ def main():
     if need:
         skip("%s not installed (Debian: apt-get install podman debootstrap; see deploy/configuration.md): "
              "the image was not built" % " and ".join(need))
+    # the sandbox must allow what running the image needs (a mount namespace, a tmpfs in it):
+    # a container that forbids them is an environment without the capability, not a defect
+    probe = subprocess.run(["unshare", "-m", "sh", "-c", "mount -t tmpfs tmpfs /mnt && umount /mnt"],
+                           capture_output=True, text=True)
+    if probe.returncode != 0:
+        skip("this machine refuses a mount namespace with a tmpfs (unshare -m: %s): the image "
+             "cannot be run here" % (probe.stderr.strip()[:200] or probe.returncode))
     tmp = tempfile.mkdtemp(prefix="spinmodal-image-")
     tag = "localhost/spinmodald:%s-test" % version
     pm = root = None
