@@ -253,7 +253,7 @@ static int sweep_equilibrium_out(const sm_model *m, const double *q, sweep_lin *
  */
 static int sweep_eigen_failed(sm_case *c, int rc, int finite)
 {
-    if (rc == SM_NOMEM || rc == SM_CANCELED) /* a stop asked between Arnoldi projections */
+    if (rc == SM_NOMEM || rc == SM_CANCELED) /* a stop asked during the Arnoldi iteration */
         return rc;
     c->status = SM_CASE_EIGEN_FAILED;
     if (rc == SM_LIMIT) /* sweep_eigen wrote the reason */
@@ -320,8 +320,8 @@ static int sweep_eigen(const sm_model *m, const double *q, sweep_lin *L, sweep_l
     return rc;
 }
 
-/* Modes of case c at the equilibrium q; pr: the stop callback the tree path asks between its
- * projections.  An eigen-analysis failure is reported on the case (sweep_eigen_failed); returns
+/* Modes of case c at the equilibrium q; pr: the stop callback the tree path asks every few
+ * Krylov vectors.  An eigen-analysis failure is reported on the case (sweep_eigen_failed); returns
  * SM_OK, SM_NOMEM or SM_CANCELED. */
 static int sweep_modes(const sm_model *m, const double *q, sweep_lin *L, const sm_progress *pr, sm_case *c)
 {
@@ -576,14 +576,9 @@ static int sweep_trust(const sm_model *m, sm_result *r, const double *omegas, in
         goto done;
     /* the refinements are extra solves: a stop (cancel, time limit, shutdown) ends them and keeps
      * what the sweep found */
-    if ((rc = crit_find(m, r, ord, n, cb, user)) == SM_CANCELED) {
-        r->refine_stopped = 1;
-        rc = SM_OK;
-        goto done;
-    }
-    if (rc < 0)
-        goto done;
-    if ((rc = div_find(m, r, ord, n, cb, user)) == SM_CANCELED) {
+    if ((rc = crit_find(m, r, ord, n, cb, user)) == SM_OK)
+        rc = div_find(m, r, ord, n, cb, user);
+    if (rc == SM_CANCELED) {
         r->refine_stopped = 1;
         rc = SM_OK;
     }
