@@ -1,6 +1,7 @@
 /*
- * jobs_internal.h — what jobs.c (the pool) and jobs_lease.c (replicas on a
- * shared store) share; private to server/daemon/jobs*.c.
+ * jobs_internal.h — what jobs.c (the pool), jobs_record.c (a job's end in
+ * the store) and jobs_lease.c (replicas on a shared store) share; private to
+ * server/daemon/jobs*.c.
  */
 #ifndef SPINMODAL_JOBS_INTERNAL_H
 #define SPINMODAL_JOBS_INTERNAL_H
@@ -22,7 +23,8 @@ typedef struct jobs_slot {
     int done, total;      /* speeds finished / requested */
     int cancel;           /* 1: DELETE asked to stop */
     int timed_out;        /* 1: the callback stopped it for the time limit */
-    int lost;             /* 1: another replica took the job (our lease expired): stop, record nothing */
+    int lost;             /* 1: another replica took the job (our lease expired): stop, record
+                             nothing; cleared by the next claim (the loss is the job's) */
     double started;       /* log_now() at claim */
 } jobs_slot;
 
@@ -67,6 +69,31 @@ struct jobs {
     pthread_cond_t heart_cv;   /* wakes the heartbeat to stop */
 };
 
+
+/* What a worker produced for one job, handed to store_finish. */
+typedef struct jobs_outcome_rec {
+    store_state state;       /* DONE, FAILED, CANCELED; QUEUED = requeue */
+    char *error;             /* JSON text or NULL */
+    char *result;            /* JSON text or NULL */
+    size_t result_len;       /* bytes of result */
+    char *csv;               /* CSV text or NULL */
+    size_t csv_len;
+    int speeds_done;
+    double solve_seconds;    /* < 0 when no solve ran */
+} jobs_outcome_rec;
+
+/** A job became queued in the store (committed): count it, wake an idle worker.  Lock held. */
+void jobs_posted_locked(jobs *j);
+
+/** A write to the store succeeded (rc == STORE_OK) or failed: /readyz follows it (jobs_record.c). */
+void jobs_store_health(jobs *j, int rc);
+
+/** Record the end of a claimed job, retrying a store that is briefly away; a job no write
+ * could record is kept for jobs_retry_unrecorded (jobs_record.c). */
+void jobs_record(jobs *j, const store_job *job, const jobs_outcome_rec *rec);
+
+/** Retry the ends that could not be recorded (called before each claim; jobs_record.c). */
+void jobs_retry_unrecorded(jobs *j);
 
 /** Absolute CLOCK_REALTIME deadline seconds from now, for timed waits. */
 struct timespec jobs_deadline(double seconds);

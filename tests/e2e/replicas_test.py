@@ -14,7 +14,9 @@ three daemons on it (--db postgresql://…, --lease 3), then shows:
   4. `?wait=` on another replica returns when the job finishes;
   5. a PostgreSQL restart mid-run is survived: /readyz goes 503 while it is
      down and back to 200, and jobs submitted afterwards complete;
-  6. the 429 bound (--queue-max) counts the queue all replicas share.
+  6. a replica paused (SIGSTOP) past its lease loses its job to another, and
+     afterwards runs the jobs it claims;
+  7. the 429 bound (--queue-max) counts the queue all replicas share.
 Without PostgreSQL server binaries it exits 77 (meson: skipped), saying why.
 Waits are upper bounds scaled by timescale.py; none decides a pass by time.
 """
@@ -23,6 +25,7 @@ import json
 import os
 import pwd
 import shutil
+import signal
 import socket
 import subprocess
 import sys
@@ -190,6 +193,7 @@ def main():
     tmp = tempfile.mkdtemp(prefix="spinmodal-replicas-")
     pg = Postgres(tmp)
     daemons = []
+    retired = []   # daemons stopped or killed, for the log on failure
     try:
         pg.start()
         for k in range(3):
@@ -236,6 +240,7 @@ def main():
                   % (doc and doc["state"], doc and doc.get("attempts")))
             check(any("event=job_done" in l and job in l for d in others for l in d.log_lines()),
                   "job_done for it is in another replica's log")
+            retired.append(own)
             daemons = others
 
         # 3. cancel through another replica than the owner
@@ -279,11 +284,43 @@ def main():
         r = post(daemons[1], request(9.02), "?wait=%g" % timescale.wait_param(60))
         check(r.status == 200 and r.json().get("state") == "done",
               "a job submitted after the restart completes (%s)" % r.status)
+
+        # 6. a replica paused past its lease loses its job to the other and then
+        #    runs the next job it claims (the loss belonged to that job, not to
+        #    the worker's slot: 0.8.0 kept it and lost every later job there)
+        a, b = daemons
+        job = post(a, request(10.01, n_speeds=120, elements=96)).json()["id"]
+        wait_until(lambda: state(a, job)["state"] == "running", 60)
+        if wait_until(lambda: owner_of(daemons, job), 10) is b:
+            a, b = b, a
+        mark_a, mark_b = a.log_count(), b.log_count()
+        a.signal(signal.SIGSTOP)
+        taken = b.wait_log("event=job_started job=%s" % job, 60, mark_b)
+        a.signal(signal.SIGCONT)
+        check(taken is not None, "a job whose replica is paused past its lease is taken over")
+        lost = a.wait_log("event=job_lost job=%s" % job, 30, mark_a)
+        check(lost is not None, "the paused replica, resumed, gives the job up (job_lost)")
+        mark_a = a.log_count()
+        check(b.stop() == 0, "%s stops cleanly" % b.name)
+        retired.append(b)
+        daemons = [a]
+        doc = wait_until(lambda: state(a, job) if state(a, job)["state"]
+                         in ("done", "failed") else None, 180, 0.5)
+        check(doc is not None and doc["state"] == "done",
+              "the taken-over job ends done (%s)" % (doc and doc["state"]))
+        mark_a = a.log_count()
+        r = post(a, request(10.51, n_speeds=3), "?wait=%g" % timescale.wait_param(60))
+        nxt = r.json().get("id") if r.status in (200, 202) else None
+        check(r.status == 200 and r.json().get("state") == "done" and
+              a.wait_log("event=job_done job=%s" % nxt, 5, mark_a) is not None,
+              "the replica that lost a job runs the next one it claims to the end (%s %s)"
+              % (r.status, r.json().get("state") if r.status in (200, 202) else ""))
         for d in daemons:
             check(d.stop() == 0, "%s stops cleanly" % d.name)
+        retired += daemons
         daemons = []
 
-        # 6. the queue bound (429) counts the shared queue, not one replica's submissions
+        # 7. the queue bound (429) counts the shared queue, not one replica's submissions
         for k in range(2):
             d = Daemon(exe, tmp, ["--workers", "1", "--lease", LEASE, "--queue-max", "5"],
                        db=pg.dsn(), name="bounded%d" % k)
@@ -307,8 +344,14 @@ def main():
             x.request("DELETE", "/v1/analyses/" + j)
         for d in daemons:
             check(d.stop() == 0, "%s stops cleanly" % d.name)
+        retired += daemons
         daemons = []
     finally:
+        if failures:   # what the replicas said about leases and the store, for the log
+            for d in daemons + retired:
+                for l in d.log_lines():
+                    if os.environ.get("SPINMODAL_TEST_FULL_LOG") or "level=warn" in l or "level=error" in l:
+                        print("  %s: %s" % (d.name, l[:300]))
         for d in daemons:
             if d.alive():
                 d.kill()
