@@ -3,16 +3,19 @@
  * turn a blade file into a request (the importers of server/codec/import.h)
  * and print it on stdout, ready for `spinmodal solve -`.
  *
- * How it fits: cli.c's main() hands every `import` command line here.  This
- * file reads the files (BModes: the .bmi, then the section-properties file
- * it names, relative to the .bmi's folder and, without --allow-outside,
- * inside it: no absolute path, no '..', never '-'), calls the importer and
- * prints the request; the importer's warnings (values it had to assume) go to
- * stderr as "spinmodal: warning: POINTER: ..." lines (POINTER: the field of
- * the request, as `solve --table` prints a result's input_warnings).  --full
+ * How it fits: cli.c's main() hands every `import` command line here.  The
+ * format is looked up in the codec's table import_formats[]: its parser, its
+ * usage line and which options it takes (--bmodes-mesh, --allow-outside)
+ * come from its entry, so no format is named here.  This file reads the
+ * files (BModes: the .bmi, then the section-properties file it names,
+ * relative to the .bmi's folder and, without --allow-outside, inside it: no
+ * absolute path, no '..', never '-'), calls the importer and prints the
+ * request; the importer's warnings (values it had to assume) go to stderr as
+ * "spinmodal: warning: POINTER: ..." lines (POINTER: the field of the
+ * request, as `solve --table` prints a result's input_warnings).  --full
  * prints the whole import document {"request", "warnings", "input_warnings",
- * "source"} instead (what POST /v1/import/{format} answers).  --rpm takes one
- * speed, a list 0,5,10 or a range START:STOP:COUNT (import_rpm_option).
+ * "source"} instead (what POST /v1/import/{format} answers).  --rpm takes
+ * one speed, a list 0,5,10 or a range START:STOP:COUNT (import_rpm_option).
  *
  * Exit codes: 0 imported, 2 the file is refused (one line
  * "FILE:LINE: FIELD: what is wrong" on stderr, nothing on stdout), 1 the
@@ -29,14 +32,6 @@
 #include "import.h"
 
 enum { CLI_IMPORT_OK = 0, CLI_IMPORT_FAILED = 1, CLI_IMPORT_INVALID = 2, CLI_IMPORT_USAGE = 64 };
-
-static const char cli_import_usage_text[] =
-    "usage: spinmodal import bmodes FILE.bmi [--rpm SPEEDS] [--bmodes-mesh K] [--allow-outside] "
-    "[--pretty] [--full]\n"
-    "       spinmodal import elastodyn FILE --tip-radius R [--hub-radius H] [--rpm SPEEDS] "
-    "[--pretty] [--full]\n"
-    "       spinmodal import csv FILE [--tip-radius R] [--hub-radius H] [--rpm SPEEDS] [--pretty] "
-    "[--full]\n";
 
 static const char cli_import_help_text[] =
     "\noptions:\n"
@@ -58,7 +53,7 @@ static const char cli_import_help_text[] =
 
 /* Command-line settings of `import`. */
 typedef struct cli_import_args {
-    const char *format; /* bmodes, elastodyn, csv */
+    const import_format *format; /* an entry of import_formats[], NULL until given */
     const char *path;   /* the file, "-" = stdin */
     int pretty;         /* --pretty */
     int full;           /* --full: the import document, not only the request */
@@ -74,9 +69,21 @@ typedef struct cli_import_files {
     char *sec;             /* the section file's text (malloc'd) */
 } cli_import_files;
 
+/* The usage lines, one per format of import_formats[], on out. */
+static void cli_import_usage_write(FILE *out)
+{
+    const import_format *f;
+
+    for (f = import_formats; f->name; f++)
+        fprintf(out, "%s spinmodal import %s %s [--pretty] [--full]\n",
+                f == import_formats ? "usage:" : "      ", f->name, f->synopsis);
+}
+
+/* "spinmodal: WHY" and the usage on stderr; the usage exit code. */
 static int cli_import_usage(const char *why)
 {
-    fprintf(stderr, "spinmodal: %s\n%s", why, cli_import_usage_text);
+    fprintf(stderr, "spinmodal: %s\n", why);
+    cli_import_usage_write(stderr);
     return CLI_IMPORT_USAGE;
 }
 
@@ -206,19 +213,43 @@ static int cli_import_rpm(cli_import_args *a, const char *text)
 
     json_decref(a->rpm_speeds); /* a second --rpm replaces the first */
     a->rpm_speeds = NULL;
-    if (!text) {
-        fprintf(stderr, "spinmodal: --rpm needs a speed, a list or a range\n%s",
-                cli_import_usage_text);
-        return CLI_IMPORT_USAGE;
-    }
+    if (!text)
+        return cli_import_usage("--rpm needs a speed, a list or a range");
     st = import_rpm_option(text, &a->opt, &a->rpm_speeds, why, sizeof(why));
     if (st == SM_NOMEM) {
         fprintf(stderr, "spinmodal: out of memory\n");
         return CLI_IMPORT_FAILED;
     }
     if (st) {
-        fprintf(stderr, "spinmodal: --rpm: %s\n%s", why, cli_import_usage_text);
+        fprintf(stderr, "spinmodal: --rpm: %s\n", why);
+        cli_import_usage_write(stderr);
         return CLI_IMPORT_USAGE;
+    }
+    return 0;
+}
+
+/* After the command line: a format and a file given, options that the format takes (its
+ * import_formats[] flags); 0, or the usage exit code. */
+static int cli_import_args_check(const cli_import_args *a)
+{
+    char names[200], why[300];
+
+    if (!a->format) {
+        snprintf(why, sizeof(why), "a format is required: %s",
+                 import_format_list(names, sizeof(names), 0));
+        return cli_import_usage(why);
+    }
+    if (!a->path)
+        return cli_import_usage("a file (or - for standard input) is required");
+    if (a->opt.bmodes_mesh && !(a->format->flags & IMPORT_OWN_MESH)) {
+        snprintf(why, sizeof(why), "--bmodes-mesh applies to %s only",
+                 import_format_list(names, sizeof(names), IMPORT_OWN_MESH));
+        return cli_import_usage(why);
+    }
+    if (a->allow_outside && !(a->format->flags & IMPORT_SEC_FILE)) {
+        snprintf(why, sizeof(why), "--allow-outside applies to %s only",
+                 import_format_list(names, sizeof(names), IMPORT_SEC_FILE));
+        return cli_import_usage(why);
     }
     return 0;
 }
@@ -228,6 +259,7 @@ static int cli_import_args_parse(int argc, char **argv, cli_import_args *a)
 {
     static const char *const num_opts[2] = {"--tip-radius", "--hub-radius"};
     double *num_dst[2];
+    char names[200];
     int i, k, opts_done = 0;
 
     import_default_options(&a->opt);
@@ -252,17 +284,16 @@ static int cli_import_args_parse(int argc, char **argv, cli_import_args *a)
             continue;
         }
         if (!opts_done && (!strcmp(s, "--help") || !strcmp(s, "-h"))) {
-            printf("%s%s", cli_import_usage_text, cli_import_help_text);
+            cli_import_usage_write(stdout);
+            fputs(cli_import_help_text, stdout);
             return -1; /* done: exit 0 */
         }
         if (!opts_done && !strcmp(s, "--bmodes-mesh")) {
             double per;
             if (i + 1 >= argc || cli_import_number(argv[i + 1], &per) || per < 1 ||
-                per > 1000 || per != (int)per) {
-                fprintf(stderr, "spinmodal: --bmodes-mesh needs a whole number of FE elements "
-                                "per BModes element (1 to 1000)\n%s", cli_import_usage_text);
-                return CLI_IMPORT_USAGE;
-            }
+                per > 1000 || per != (int)per)
+                return cli_import_usage("--bmodes-mesh needs a whole number of FE elements per "
+                                        "BModes element (1 to 1000)");
             a->opt.bmodes_mesh = (int)per;
             i++;
             continue;
@@ -278,38 +309,32 @@ static int cli_import_args_parse(int argc, char **argv, cli_import_args *a)
                 break;
         if (!opts_done && k < 2) {
             if (i + 1 >= argc || cli_import_number(argv[i + 1], num_dst[k])) {
-                fprintf(stderr, "spinmodal: %s needs a number\n%s", s, cli_import_usage_text);
+                fprintf(stderr, "spinmodal: %s needs a number\n", s);
+                cli_import_usage_write(stderr);
                 return CLI_IMPORT_USAGE;
             }
             i++;
             continue;
         }
         if (!opts_done && s[0] == '-' && s[1] != '\0') {
-            fprintf(stderr, "spinmodal: unknown option '%s'\n%s", s, cli_import_usage_text);
+            fprintf(stderr, "spinmodal: unknown option '%s'\n", s);
+            cli_import_usage_write(stderr);
             return CLI_IMPORT_USAGE;
         }
         if (!a->format) {
-            if (!import_format_known(s)) {
-                fprintf(stderr, "spinmodal: unknown import format '%s' (bmodes, elastodyn or "
-                                "csv)\n%s", s, cli_import_usage_text);
+            if (!(a->format = import_format_find(s))) {
+                fprintf(stderr, "spinmodal: unknown import format '%s' (%s)\n", s,
+                        import_format_list(names, sizeof(names), 0));
+                cli_import_usage_write(stderr);
                 return CLI_IMPORT_USAGE;
             }
-            a->format = s;
         } else if (!a->path) {
             a->path = s;
         } else {
             return cli_import_usage("only one file may be given");
         }
     }
-    if (!a->format)
-        return cli_import_usage("a format is required: bmodes, elastodyn or csv");
-    if (!a->path)
-        return cli_import_usage("a file (or - for standard input) is required");
-    if (a->opt.bmodes_mesh && strcmp(a->format, "bmodes"))
-        return cli_import_usage("--bmodes-mesh applies to bmodes only");
-    if (a->allow_outside && strcmp(a->format, "bmodes"))
-        return cli_import_usage("--allow-outside applies to bmodes only");
-    return 0;
+    return cli_import_args_check(a);
 }
 
 /* Print the warnings, then the request (or the whole document); an exit code. */
@@ -367,12 +392,7 @@ int cli_import_main(int argc, char **argv)
     f.len = len;
     fs.main_path = strcmp(a.path, "-") ? a.path : "";
     fs.allow_outside = a.allow_outside;
-    if (!strcmp(a.format, "bmodes"))
-        st = import_bmodes(&doc, &f, cli_import_load, &fs, &a.opt, &d);
-    else if (!strcmp(a.format, "elastodyn"))
-        st = import_elastodyn(&doc, &f, &a.opt, &d);
-    else
-        st = import_csv(&doc, &f, &a.opt, &d);
+    st = a.format->parse(&doc, &f, cli_import_load, &fs, &a.opt, &d);
     if (st == SM_OK) {
         rc = cli_import_print(&a, doc);
     } else if (st == SM_INVALID_INPUT) {

@@ -146,12 +146,6 @@ int import_rpm_option(const char *text, import_options *o, json_t **speeds, char
     return st;
 }
 
-int import_format_known(const char *name)
-{
-    return name && (!strcmp(name, "bmodes") || !strcmp(name, "elastodyn") ||
-                    !strcmp(name, "csv"));
-}
-
 /* ----------------------------------------------------------- encoding */
 
 int imp_encoding(import_diag *d, const import_file *f, import_file *body)

@@ -3,11 +3,12 @@
  * spinmodal request in the blade form (DESIGN.md section 8, spec 12
  * section 6).
  *
- * Three formats: BModes (a .bmi main file and the section-properties file
- * it names), an OpenFAST ElastoDyn blade file, and CSV with a header row of
- * station keys.  Each importer reads text already in memory (no file
- * system access: the caller loads files, so the CLI and the daemon share
- * the code) and returns an import document
+ * Three formats: BModes (a .bmi main file and the section-properties file it
+ * names), an OpenFAST ElastoDyn blade file, and CSV with a header row of
+ * station keys, listed once in the table import_formats[] (name, file roles,
+ * parser) that the CLI and the HTTP route look up.  Each importer reads text
+ * already in memory (no file system access: the caller loads files, so the
+ * CLI and the daemon share the code) and returns an import document
  *
  *     {"request": {"blade": {...}, "frames": "per_element", "analysis": {...}},
  *      "warnings": ["values assumed, ..."],
@@ -125,8 +126,48 @@ int import_csv(json_t **out, const import_file *f, const import_options *o, impo
 int import_rpm_option(const char *text, import_options *o, json_t **speeds, char *why,
                       size_t cap);
 
-/** 1 when name is an import format: "bmodes", "elastodyn" or "csv". */
+/**
+ * An importer, as the table calls it: f is the main file; load(ctx, ...) reads a file that f
+ * names (used only by formats with IMPORT_SEC_FILE; others ignore load and ctx).  Ownership
+ * and status codes as import_bmodes.
+ */
+typedef int (*import_parse_fn)(json_t **out, const import_file *f, import_loader load,
+                               void *ctx, const import_options *o, import_diag *d);
+
+#define IMPORT_SEC_FILE 1u /* the main file names a second file, read through the loader (BModes'
+                              section properties): HTTP takes only JSON {main, sec_props, name};
+                              the CLI's --allow-outside applies */
+#define IMPORT_OWN_MESH 2u /* import_options.bmodes_mesh applies (CLI --bmodes-mesh, HTTP
+                              ?bmodes_mesh=) */
+
+/**
+ * One import format (import_formats.c).  The CLI and the HTTP route do for a format only what
+ * its entry says: a new format is one entry and its parser file.
+ */
+typedef struct import_format {
+    const char *name;      /* "bmodes": the CLI's FORMAT, the HTTP path's {format} */
+    const char *label;     /* "BModes": the format in sentences */
+    const char *main_name; /* the main file's name in messages when the request names none */
+    const char *synopsis;  /* CLI usage after "spinmodal import NAME " (common options left out) */
+    unsigned flags;        /* IMPORT_SEC_FILE, IMPORT_OWN_MESH */
+    import_parse_fn parse; /* the importer */
+} import_format;
+
+/** Every import format, in the order messages list them; ends with an entry whose name is NULL. */
+extern const import_format import_formats[];
+
+/** The format called name (NULL allowed), or NULL when there is none. */
+const import_format *import_format_find(const char *name);
+
+/** 1 when name is an import format of the table (import_format_find), else 0. */
 int import_format_known(const char *name);
+
+/**
+ * The names of the formats that have every flag of flags (0: all), as a sentence lists them:
+ * "bmodes, elastodyn or csv", "bmodes"; written into buf[cap] (truncated, NUL-terminated when
+ * cap > 0) and returned.
+ */
+const char *import_format_list(char *buf, size_t cap, unsigned flags);
 
 /**
  * The import document as text, numbers at 15 significant digits (the

@@ -4,6 +4,8 @@
  *
  *   import.c            lines, tokens, numbers, diagnostics, the station
  *                       table and the request document in the blade form;
+ *   import_formats.c    the table of formats (name, file roles, parser)
+ *                       that the CLI and the HTTP route look up;
  *   import_bmodes.c     BModes .bmi + section-properties file;
  *   import_elastodyn.c  OpenFAST ElastoDyn blade file;
  *   import_csv.c        CSV with a header of station keys.

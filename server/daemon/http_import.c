@@ -3,11 +3,14 @@
  * the import document {"request", "warnings", "source"} out (200), or a 422
  * problem document naming the file, line and field that is wrong.
  *
- * How it fits: routed by http.c like /v1/validate (a POST whose body is
- * collected by http_take_body under --max-body, the same guards and
- * deadlines), but answered here: no request is validated, no model built,
- * nothing stored or queued.  The importers (server/codec/import.h) only
- * read the text once, linearly, so the cost is bounded by --max-body.
+ * How it fits: the format of the path is looked up in the codec's table
+ * import_formats[] (its parser, its default file name, whether it reads a
+ * second file: no format is named here).  Routed by http.c like /v1/validate
+ * (a POST whose body is collected by http_take_body under --max-body, the
+ * same guards and deadlines), but answered here: no request is validated, no
+ * model built, nothing stored or queued.  The importers
+ * (server/codec/import.h) only read the text once, linearly, so the cost is
+ * bounded by --max-body.
  *
  * Bodies: BModes needs two files, so it takes JSON {"main": ".bmi text",
  * "sec_props": "section file text", "name": "optional .bmi name"};
@@ -30,7 +33,7 @@
 
 /* Which body a file came from, for the pointer of a 422. */
 typedef struct http_import_in {
-    const char *format;    /* from the path */
+    const import_format *format; /* from the path: an entry of import_formats[] */
     int json;              /* the body is JSON */
     import_file main;      /* the .bmi / blade file / CSV */
     import_file sec;       /* BModes section file (JSON "sec_props") */
@@ -38,10 +41,11 @@ typedef struct http_import_in {
     json_t *rpm_speeds;    /* ?rpm= as a list or range (opt.rpm_speeds), NULL for one speed */
 } http_import_in;
 
-/* The format of the path /v1/import/{format} (routed only when known). */
-static const char *http_import_format(const http_req *r)
+/* The format of the path /v1/import/{format}, in the codec's table (routed only when known:
+ * import_format_known; NULL otherwise). */
+static const import_format *http_import_format(const http_req *r)
 {
-    return r->path + strlen("/v1/import/");
+    return import_format_find(r->path + strlen("/v1/import/"));
 }
 
 /* 1 when the media type of ct (parameters ignored) is mt. */
@@ -66,20 +70,27 @@ int http_import_begin(struct MHD_Connection *c, http_req *r, enum MHD_Result *q)
     int json = http_import_ctype(ct, "application/json");
     int text = http_import_ctype(ct, "text/plain") || http_import_ctype(ct, "text/csv") ||
                http_import_ctype(ct, "application/octet-stream");
+    const import_format *fmt = http_import_format(r);
+    int two_files = fmt && (fmt->flags & IMPORT_SEC_FILE);
+    char detail[200];
     long long n = 0;
 
+    if (!fmt) {
+        *q = http_not_found(c, r, 0);
+        return 0;
+    }
     if (r->h->auth_reads && !http_authorized(r->h, c)) {
         *q = http_unauthorized(c, r);
         return 0;
     }
-    if (!json && (!text || strcmp(http_import_format(r), "bmodes") == 0)) {
+    if (!json && (!text || two_files)) {
+        snprintf(detail, sizeof(detail), "A %s import is JSON {\"main\": \"...\", "
+                 "\"sec_props\": \"...\"} (Content-Type: application/json).", fmt->label);
         *q = http_problem(c, r, MHD_HTTP_UNSUPPORTED_MEDIA_TYPE, NULL, "Unsupported Media Type",
-                          strcmp(http_import_format(r), "bmodes") == 0
-                              ? "A BModes import is JSON {\"main\": \"...\", \"sec_props\": "
-                                "\"...\"} (Content-Type: application/json)."
-                              : "The body is the file (Content-Type: text/plain, text/csv or "
-                                "application/octet-stream) or JSON {\"main\": \"...\"} "
-                                "(application/json).",
+                          two_files ? detail
+                                    : "The body is the file (Content-Type: text/plain, text/csv "
+                                      "or application/octet-stream) or JSON {\"main\": "
+                                      "\"...\"} (application/json).",
                           NULL, 0);
         return 0;
     }
@@ -151,7 +162,7 @@ static int http_import_query(struct MHD_Connection *c, http_req *r, http_import_
 static int http_import_json(struct MHD_Connection *c, http_req *r, http_import_in *in,
                             json_t **doc, enum MHD_Result *q)
 {
-    int bmodes = strcmp(in->format, "bmodes") == 0;
+    int two = (in->format->flags & IMPORT_SEC_FILE) != 0; /* main and sec_props */
     const char *key;
     json_error_t jerr;
     json_t *v;
@@ -162,10 +173,10 @@ static int http_import_json(struct MHD_Connection *c, http_req *r, http_import_i
         return -1;
     }
     json_object_foreach(*doc, key, v) {
-        if (strcmp(key, "main") && strcmp(key, "name") && (!bmodes || strcmp(key, "sec_props"))) {
+        if (strcmp(key, "main") && strcmp(key, "name") && (!two || strcmp(key, "sec_props"))) {
             char pointer[80];
             snprintf(pointer, sizeof(pointer), "/%.60s", key);
-            *q = http_import_bad(c, r, pointer, bmodes ? "unknown key; expected main, sec_props "
+            *q = http_import_bad(c, r, pointer, two ? "unknown key; expected main, sec_props "
                                  "and name" : "unknown key; expected main and name");
             return -1;
         }
@@ -176,9 +187,9 @@ static int http_import_json(struct MHD_Connection *c, http_req *r, http_import_i
             return -1;
         }
     }
-    if (!json_object_get(*doc, "main") || (bmodes && !json_object_get(*doc, "sec_props"))) {
+    if (!json_object_get(*doc, "main") || (two && !json_object_get(*doc, "sec_props"))) {
         const char *miss = json_object_get(*doc, "main") ? "/sec_props" : "/main";
-        *q = http_import_bad(c, r, miss, bmodes ? "required: the .bmi text (main) and the "
+        *q = http_import_bad(c, r, miss, two ? "required: the .bmi text (main) and the "
                              "section-properties file's text (sec_props)"
                              : "required: the file's text");
         return -1;
@@ -245,12 +256,7 @@ static enum MHD_Result http_import_run(struct MHD_Connection *c, http_req *r, ht
     int st;
 
     in->opt.max_modes = r->h->limits.max_modes;
-    if (!strcmp(in->format, "bmodes"))
-        st = import_bmodes(&doc, &in->main, http_import_load, in, &in->opt, &d);
-    else if (!strcmp(in->format, "elastodyn"))
-        st = import_elastodyn(&doc, &in->main, &in->opt, &d);
-    else
-        st = import_csv(&doc, &in->main, &in->opt, &d);
+    st = in->format->parse(&doc, &in->main, http_import_load, in, &in->opt, &d);
     if (st == SM_INVALID_INPUT)
         return http_import_refused(c, r, in, &d);
     if (st != SM_OK)
@@ -264,33 +270,32 @@ static enum MHD_Result http_import_run(struct MHD_Connection *c, http_req *r, ht
 
 enum MHD_Result http_import_end(struct MHD_Connection *c, http_req *r)
 {
-    static const char *const default_names[3][2] = {
-        {"bmodes", "main.bmi"}, {"elastodyn", "blade.dat"}, {"csv", "stations.csv"}};
     const char *ct = MHD_lookup_connection_value(c, MHD_HEADER_KIND,
                                                  MHD_HTTP_HEADER_CONTENT_TYPE);
     http_import_in in;
     enum MHD_Result q;
     json_t *doc = NULL;
-    int k;
+    char names[100], why[140];
 
     if (r->body_state == BODY_TOO_LARGE)
         return http_too_large(c, r);
     if (r->body_state == BODY_NOMEM)
         return http_send_oom(c, r);
     memset(&in, 0, sizeof(in));
-    in.format = http_import_format(r);
+    if (!(in.format = http_import_format(r)))
+        return http_not_found(c, r, 0);
     import_default_options(&in.opt);
-    for (k = 0; k < 3; k++)
-        if (!strcmp(in.format, default_names[k][0]))
-            in.main.name = default_names[k][1];
+    in.main.name = in.format->main_name;
     in.json = http_import_ctype(ct, "application/json");
     if (http_import_query(c, r, &in, &q)) {
         json_decref(in.rpm_speeds);
         return q;
     }
-    if (in.opt.bmodes_mesh && strcmp(in.format, "bmodes")) {
+    if (in.opt.bmodes_mesh && !(in.format->flags & IMPORT_OWN_MESH)) {
         json_decref(in.rpm_speeds);
-        return http_bad_query(c, r, "bmodes_mesh", "applies to bmodes only");
+        snprintf(why, sizeof(why), "applies to %s only",
+                 import_format_list(names, sizeof(names), IMPORT_OWN_MESH));
+        return http_bad_query(c, r, "bmodes_mesh", why);
     }
     if (in.json && http_import_json(c, r, &in, &doc, &q)) {
         json_decref(in.rpm_speeds);
