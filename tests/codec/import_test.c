@@ -800,6 +800,73 @@ static void test_prefixes(void)
     free(sec), free(bmi), free(ed);
 }
 
+/* ------------------------------------------------- the table of formats */
+
+/* The document of one import as text ("" when refused: then the diagnostic). */
+static char *table_dump(int st, json_t *doc, const import_diag *d)
+{
+    char *t = st == SM_OK ? import_dumps(doc, 0) : strdup(d->text);
+
+    json_decref(doc);
+    return t;
+}
+
+/*
+ * import_formats[] is what the CLI and the HTTP route use: every entry is found by its name
+ * (and only by it), the lists in their messages come from it, and an entry's parser gives
+ * the same document as the importer called directly.
+ */
+static void test_formats_table(void)
+{
+    static const char *const names[] = {"bmodes", "elastodyn", "csv"};
+    char *bmi = slurp("bmodes_certtest/Test01_nonunif_blade.bmi");
+    char *sec = slurp("bmodes_certtest/blade_sec_props.dat");
+    char *ed = slurp("elastodyn/NRELOffshrBsline5MW_Blade.dat");
+    const char *texts[] = {bmi, ed, csv_good};
+    char list[64];
+    size_t k, n = 0;
+
+    while (import_formats[n].name)
+        n++;
+    if (n != 3)
+        fail("table: %zu formats, 3 expected", n);
+    for (k = 0; k < n && k < 3; k++) {
+        const import_format *f = &import_formats[k];
+        import_file file = {f->main_name, texts[k], strlen(texts[k])};
+        import_options o;
+        import_diag d1, d2;
+        json_t *doc = NULL;
+        char *a, *b;
+        int st;
+        if (strcmp(f->name, names[k]) || import_format_find(names[k]) != f ||
+            !import_format_known(names[k]) || !f->label || !f->main_name || !f->synopsis ||
+            !f->parse)
+            fail("table: entry %zu (%s) not found by its name or incomplete", k, names[k]);
+        import_default_options(&o);
+        o.tip_radius = 20;
+        st = f->parse(&doc, &file, load_sec, sec, &o, &d1);
+        a = table_dump(st, doc, &d1);
+        doc = NULL;
+        st = k == 0   ? import_bmodes(&doc, &file, load_sec, sec, &o, &d2)
+             : k == 1 ? import_elastodyn(&doc, &file, &o, &d2)
+                      : import_csv(&doc, &file, &o, &d2);
+        b = table_dump(st, doc, &d2);
+        if (!a || !b || strcmp(a, b) || !strncmp(a, f->main_name, strlen(f->main_name)))
+            fail("table: %s's parser differs from the importer or refuses (%.200s)", f->name,
+                 a ? a : "out of memory");
+        free(a), free(b);
+    }
+    if (import_format_find("xml") || import_format_find("BMODES") || import_format_find("") ||
+        import_format_find(NULL) || import_format_known("xml"))
+        fail("table: an unknown format is found");
+    if (strcmp(import_format_list(list, sizeof(list), 0), "bmodes, elastodyn or csv") ||
+        strcmp(import_format_list(list, sizeof(list), IMPORT_OWN_MESH), "bmodes") ||
+        strcmp(import_format_list(list, sizeof(list), IMPORT_SEC_FILE), "bmodes") ||
+        strcmp(import_format_list(list, 8, 0), "bmodes,"))
+        fail("table: import_format_list gives \"%s\"", list);
+    free(bmi), free(sec), free(ed);
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 2) {
@@ -815,6 +882,7 @@ int main(int argc, char **argv)
     test_el_loc_checked();
     test_csv_encoding_and_radii();
     test_prefixes();
+    test_formats_table();
     if (failures) {
         printf("%d failures\n", failures);
         return 1;
