@@ -5,15 +5,14 @@
  *   F(q) = K q + f_g(q) - Omega^2 g(q) = 0,     g = sum m_k J_k' r_k
  *
  * solved by Newton-Raphson with the exact tangent
- *   Kt = K + d f_g/dq - Omega^2 (M* + H)        (frames.c, linearize.c)
+ *   Kt = K + d f_g/dq - Omega^2 (M* + H)        (the kind's, through linsys.h)
  * along a continuation in s = Omega^2: tangent predictor, damped Newton
  * corrector, step halving when Newton fails or the corrector lands far from
  * the predictor (a jump to another branch), step growth when it converges
  * fast.  Running out of step size is the reported "no equilibrium" outcome.
  */
-#include "spatial.h"
+#include "linsys.h"
 
-#include <lapacke.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,171 +26,69 @@
  * state" is an artefact of too few frames (the single frame at beta = 90 deg
  * runs away), not an equilibrium of the structure. */
 #define EQ_MAX_STRAIN 0.01
-/* Spatial models from rest (DESIGN.md 7.3): the first increment is this fraction of the largest,
+/* A kind with stiffened_start (kind.h; the 3D kind, DESIGN.md 7.3), from rest: the first
+ * increment is this fraction of the largest,
  * and its predictor is stiffened (the tangent at the linear predictor, where the axial forces of
  * the centrifugal load give their geometric stiffness).  The flap of a preconed blade is governed
  * by that stiffness: with the tangent at rest the predictor overshoots it many times over, and the
  * first increments were rejected (140 Newton iterations on the 48-element R3 blade at 10 rad/s,
- * 36 with both; the planar path keeps its continuation, and its answers, unchanged). */
-#define EQ_SPATIAL_FIRST 4
+ * 36 with both; Kim & Yoo's planar kind keeps its continuation, and its answers, unchanged). */
+#define EQ_STIFFENED_FIRST 4
 /* A change of sign of det(Kt) is accepted as a crossed bifurcation only on a step no larger
  * than this fraction of the target s (the step is halved down to it first). */
 #define EQ_CROSS_STEP 1e-4
 
 typedef struct eq_ws {
-    int tree;                /* 1: tangent in the tree form (t, light kin), else dense Kt */
-    tree_ws t;
-    sm_kin kin;              /* planar kinematics */
-    sp_kin sk;               /* spatial kinematics (m->spatial) */
-    double *F, *g, *dq, *qt, *q0, *qp, *work;
+    smi_lin *L;              /* kinematics and the tangent: dense or tree (linsys.h) */
+    double *F, *g, *dq, *qt, *q0, *qp;
     double *P;               /* n_elems axial forces */
-    dmat Kt, M, H, W;
-    int *ipiv;
     int iterations;          /* total Newton iterations */
     double residual;
 } eq_ws;
 
 static void eq_ws_free(eq_ws *w)
 {
-    frames_kin_free(&w->kin);
-    sp_kin_free(&w->sk);
+    smi_lin_free(w->L);
     free(w->F);
     free(w->g);
     free(w->dq);
     free(w->qt);
     free(w->q0);
     free(w->qp);
-    free(w->work);
     free(w->P);
-    free(w->ipiv);
-    dm_free(&w->Kt);
-    dm_free(&w->M);
-    dm_free(&w->H);
-    dm_free(&w->W);
-    tree_free(&w->t);
 }
 
 static int eq_ws_alloc(const sm_model *m, eq_ws *w)
 {
-    int n = m->n, mx = 1;
+    int n = m->n;
     memset(w, 0, sizeof *w);
-    for (int s = 0; s < m->n_subs; s++)
-        mx = m->subs[s].m > mx ? m->subs[s].m : mx;
     w->F = dm_vec((size_t)n);
     w->g = dm_vec((size_t)n);
     w->dq = dm_vec((size_t)n);
     w->qt = dm_vec((size_t)n);
     w->q0 = dm_vec((size_t)n);
     w->qp = dm_vec((size_t)n);
-    w->work = dm_vec((size_t)(12 * mx + n));
-    w->ipiv = malloc((size_t)n * sizeof(int));
     w->P = dm_vec((size_t)m->n_elems);
-    w->tree = tree_use(m);
-    if (m->spatial && w->tree) {
-        if (!w->P || !w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp || !w->work ||
-            sp_kin_alloc(m, &w->sk, 0) || tree_alloc(m, &w->t)) {
-            eq_ws_free(w);
-            return SM_NOMEM;
-        }
-        return SM_OK;
-    }
-    if (m->spatial) {
-        if (!w->P || !w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp || !w->work || !w->ipiv ||
-            sp_kin_alloc(m, &w->sk, 0) || dm_alloc(&w->Kt, n, n) || dm_alloc(&w->H, n, n)) {
-            eq_ws_free(w);
-            return SM_NOMEM;
-        }
-        return SM_OK;
-    }
-    if (w->tree) {
-        if (!w->P || !w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp || !w->work ||
-            frames_kin_alloc_light(m, &w->kin) || tree_alloc(m, &w->t)) {
-            eq_ws_free(w);
-            return SM_NOMEM;
-        }
-        return SM_OK;
-    }
-    if (!w->P || !w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp || !w->work || !w->ipiv ||
-        frames_kin_alloc(m, &w->kin) || dm_alloc(&w->Kt, n, n) || dm_alloc(&w->M, n, n) ||
-        dm_alloc(&w->H, n, n) || dm_alloc(&w->W, n, 2 * m->n_mp)) {
+    if (!w->P || !w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp ||
+        smi_lin_new(m, SMI_USE_NEWTON, tree_use(m), &w->L) != SM_OK) {
         eq_ws_free(w);
         return SM_NOMEM;
     }
     return SM_OK;
 }
 
-/* g = sum m J' r at q (planar: also leaves the kinematics of q in w->kin). */
-static void eq_centrifugal(const sm_model *m, const double *q, eq_ws *w)
-{
-    if (m->spatial) {
-        sp_centrifugal(m, q, &w->sk, w->g);
-        return;
-    }
-    frames_eval(m, q, &w->kin);
-    if (w->tree)
-        tree_centrifugal(m, &w->kin, &w->t, w->g);
-    else
-        frames_centrifugal(m, &w->kin, w->g);
-}
-
-/* F(q) at s = Omega^2; leaves the kinematics of q in w->kin.  Returns ||F||. */
+/* F(q) at s = Omega^2; leaves the kinematics of q in w->L.  Returns ||F||. */
 static double eq_residual(const sm_model *m, const double *q, double s, eq_ws *w)
 {
     int n = m->n;
-    eq_centrifugal(m, q, w);
+    smi_lin_centrifugal(m, q, w->L, w->g);
     memset(w->F, 0, (size_t)n * sizeof(double));
     lin_elastic_force(m, q, w->F);
     if (m->opt.geometric_stiffening)
-        (m->spatial ? lin3_geometric_force : lin_geometric_force)(m, q, w->F);
+        m->kind->geometric_force(m, q, w->F);
     for (int i = 0; i < n; i++)
         w->F[i] -= s * w->g[i];
     return dm_norm(w->F, n);
-}
-
-/* Kt = K + df_g/dq - s (M* + H) at the kinematics in w->kin, then LU.
- * Returns SM_OK, SM_SINGULAR (an exactly zero pivot: no usable LU) or
- * SM_LAPACK_FAILED. */
-static int eq_tangent(const sm_model *m, const double *q, double s, eq_ws *w)
-{
-    int n = m->n;
-    if (w->tree) {
-        if (m->spatial)
-            tree3_assemble(m, q, &w->sk, s, 0, 0, 0, &w->t);
-        else
-            tree_assemble(m, q, &w->kin, s, 0, 0, &w->t);
-        return tree_factor(m, &w->t, 0);
-    }
-    if (m->spatial)
-        lin3_tangent(m, q, &w->sk, s, 0, &w->Kt, &w->H, w->work);
-    else
-        lin_tangent(m, q, &w->kin, s, 0, &w->Kt, &w->M, &w->H, &w->W, w->work);
-    return dm_lapack_status(LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, n, n, w->Kt.a, n, w->ipiv), SM_SINGULAR);
-}
-
-/* x = Kt^-1 x with the LU in w.  Returns SM_OK or SM_LAPACK_FAILED. */
-static int eq_lu_solve(const sm_model *m, eq_ws *w, int n, double *x)
-{
-    if (w->tree)
-        return tree_solve(m, &w->t, x);
-    return dm_lapack_status(LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', n, 1, w->Kt.a, n, w->ipiv, x, n),
-                            SM_LAPACK_FAILED);
-}
-
-/* Sign of det(Kt) from its LU factors: a change between two converged
- * states means a critical point (limit or bifurcation) lies between them. */
-static int eq_det_sign(const eq_ws *w, int n)
-{
-    if (w->tree)
-        return w->t.det_sign;
-    int sign = 1;
-    for (int i = 0; i < n; i++) {
-        double u = w->Kt.a[(size_t)i * n + i];
-        if (u < 0)
-            sign = -sign;
-        if (w->ipiv[i] != i + 1)
-            sign = -sign;
-    }
-    return sign;
 }
 
 /* Largest elastic axial strain |P_e| / EA over all elements at q; P: n_elems scratch. */
@@ -212,8 +109,8 @@ static int eq_progress(sm_progress *pr)
 /*
  * Newton-Raphson at fixed s from q (in/out).  Returns 1 converged, 0 not
  * (including an exactly singular tangent), SM_CANCELED, or SM_LAPACK_FAILED
- * when a factorisation or solve reports an error.  On return w->kin holds
- * the kinematics of q and w->Kt the LU of a tangent at an iterate of this
+ * when a factorisation or solve reports an error.  On return w->L holds
+ * the kinematics of q and the factors of a tangent at an iterate of this
  * call.
  *
  * The first iteration factors the tangent at the starting point (so the LU
@@ -237,7 +134,7 @@ static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progre
         if (have_lu) { /* chord step */
             for (int i = 0; i < n; i++)
                 w->dq[i] = -w->F[i];
-            if ((rc = eq_lu_solve(m, w, n, w->dq)) < 0)
+            if ((rc = smi_lin_solve(m, w->L, w->dq)) < 0)
                 return rc;
             step = dm_norm(w->dq, n);
             for (int i = 0; i < n; i++)
@@ -249,12 +146,12 @@ static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progre
                 r = eq_residual(m, q, s, w);
         }
         if (!have_lu) { /* full Newton step, damped: halve while the residual grows */
-            if ((rc = eq_tangent(m, q, s, w)) != SM_OK)
+            if ((rc = smi_lin_tangent(m, q, s, w->L)) != SM_OK)
                 return rc == SM_SINGULAR ? 0 : rc;
             have_lu = fresh = 1;
             for (int i = 0; i < n; i++)
                 w->dq[i] = -w->F[i];
-            if ((rc = eq_lu_solve(m, w, n, w->dq)) < 0)
+            if ((rc = smi_lin_solve(m, w->L, w->dq)) < 0)
                 return rc;
             step = dm_norm(w->dq, n);
             for (int tries = 0; tries < 8; tries++) {
@@ -291,7 +188,7 @@ static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progre
 static int eq_restart(const sm_model *m, const double *q, double s, eq_ws *w, int *have_lu)
 {
     eq_residual(m, q, s, w);
-    int rc = eq_tangent(m, q, s, w);
+    int rc = smi_lin_tangent(m, q, s, w->L);
     *have_lu = rc == SM_OK;
     return rc == SM_SINGULAR ? SM_OK : rc;
 }
@@ -315,13 +212,13 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
     double range = s_to - s_from;
     double hmax = from_rest ? range / (m->opt.min_increments > 0 ? m->opt.min_increments : 1) : range;
     double h = hmax, hmin = 1e-7 * fmax(s_to, 1e-12), s = s_from;
-    if (m->spatial && from_rest)
-        h = hmax / EQ_SPATIAL_FIRST;
+    if (m->kind->stiffened_start && from_rest)
+        h = hmax / EQ_STIFFENED_FIRST;
     const char *why = "";
     /* tangent at the start for the first predictor */
     if ((rc = eq_restart(m, q, s, &w, &have_lu)) < 0)
         goto fail;
-    int sign = have_lu ? eq_det_sign(&w, n) : 1;
+    int sign = have_lu ? smi_lin_det_sign(m, w.L) : 1;
     while (s < s_to) {
         if (incr++ >= EQ_MAX_INCREMENTS || w.iterations >= EQ_MAX_TOTAL_ITER) {
             why = "too many continuation steps";
@@ -330,23 +227,23 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
         double sn = s + h >= s_to - 1e-12 * s_to ? s_to : s + h;
         /* predictor: Kt dq = g ds */
         memcpy(w.q0, q, (size_t)n * sizeof(double));
-        eq_centrifugal(m, q, &w);
+        smi_lin_centrifugal(m, q, w.L, w.g);
         memcpy(w.qp, q, (size_t)n * sizeof(double));
         if (have_lu) {
             memcpy(w.dq, w.g, (size_t)n * sizeof(double));
-            if ((rc = eq_lu_solve(m, &w, n, w.dq)) < 0)
+            if ((rc = smi_lin_solve(m, w.L, w.dq)) < 0)
                 goto fail;
             for (int i = 0; i < n; i++)
                 w.qp[i] += (sn - s) * w.dq[i];
-            if (m->spatial && from_rest && s == 0.0) { /* the stiffened predictor */
-                int r2 = eq_tangent(m, w.qp, sn, &w);
+            if (m->kind->stiffened_start && from_rest && s == 0.0) { /* the stiffened predictor */
+                int r2 = smi_lin_tangent(m, w.qp, sn, w.L);
                 if (r2 < 0 && r2 != SM_SINGULAR) {
                     rc = r2;
                     goto fail;
                 }
                 if (r2 == SM_OK) {
                     memcpy(w.dq, w.g, (size_t)n * sizeof(double));
-                    if ((rc = eq_lu_solve(m, &w, n, w.dq)) < 0)
+                    if ((rc = smi_lin_solve(m, w.L, w.dq)) < 0)
                         goto fail;
                     for (int i = 0; i < n; i++)
                         w.qp[i] = q[i] + (sn - s) * w.dq[i];
@@ -387,7 +284,7 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
                             "structure's axial stiffness EA carries (frames are per element already)"
                           : "the deformation leaves the small-strain range (axial strain above 1 %): "
                             "the steady state runs away; use more frames";
-            } else if (eq_det_sign(&w, n) != sign) {
+            } else if (smi_lin_det_sign(m, w.L) != sign) {
                 /* A critical point lies inside the step.  Shrink the step until it is small;
                  * a converged corrector that stays on the predicted branch there has crossed
                  * a bifurcation of a branch that goes on (the symmetric steady state of a

@@ -120,7 +120,8 @@ struct sm_model {
     int n_mp;
     sm_mpoint *mp;      /* mass points */
     int clamp_node;     /* = 0 */
-    int spatial;        /* 1: DESIGN.md 7 (6 DOF per node, spatial.h) */
+    const struct smi_kind *kind; /* planar or spatial (kind.h): picked by mesh_build */
+    int spatial;        /* 1: DESIGN.md 7 (6 DOF per node, spatial.h); read only by the picker */
     int n_pt;           /* spatial: points = the FE nodes (0 .. n_nodes-1) + quadrature points */
     struct sp_point *pt; /* spatial: n_pt points (spatial.h) */
 };
@@ -175,6 +176,11 @@ int modes_build(sm_model *m, sm_progress_fn cb, void *user, sm_diag *diag);
  * returns *nm + *na.  No allocation, no status; cost O(1).
  */
 int modes_count(const sm_options *o, const sm_sub *b, int *nm, int *na);
+/** Basis, K_s, T_e, d_e of planar substructure b (the planar kind's basis; modes_build calls it
+ *  through m->kind).  SM_OK, SM_NOMEM, SM_SINGULAR or SM_LAPACK_FAILED. */
+int modes_planar_sub(const sm_model *m, sm_sub *b);
+/** The mass points m->mp of a planar model after every modes_planar_sub.  SM_OK or SM_NOMEM. */
+int modes_planar_points(sm_model *m);
 
 /* ------------------------------------------------------------ frames.c */
 /* Kinematic state at q: frames, point positions and Jacobians. */

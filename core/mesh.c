@@ -9,7 +9,7 @@
  * (substructures); a substructure's root is the near node of its first
  * element and its parent is the substructure holding that node.
  */
-#include "spatial.h"
+#include "kind.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -18,7 +18,14 @@
 
 #define MESH_MAX_ITEMS 1000000
 /* z of joint j (0 for a planar structure or without joint_z). */
-#define MESH_Z(st, j) ((st)->spatial && (st)->joint_z ? (st)->joint_z[j] : 0.0)
+/* a joint's z (0 without joint_z; a planar structure's are zero: its kind's check refused others) */
+#define MESH_Z(st, j) ((st)->joint_z ? (st)->joint_z[j] : 0.0)
+
+/* The one place that picks the structure kind (kind.h): spatial sections make a spatial model. */
+static const smi_kind *mesh_kind(const sm_structure *st)
+{
+    return st->spatial ? &smi_kind_spatial : &smi_kind_planar;
+}
 
 static int mesh_fail(sm_diag *d, sm_item item, int index, const char *field,
                      const char *msg)
@@ -31,11 +38,6 @@ static int mesh_fail(sm_diag *d, sm_item item, int index, const char *field,
         snprintf(d->message, sizeof d->message, "%s", msg);
     }
     return SM_INVALID_INPUT;
-}
-
-static int mesh_positive(double v)
-{
-    return isfinite(v) && v > 0.0;
 }
 
 /*
@@ -114,21 +116,9 @@ static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
     for (int j = 0; j < st->n_joints; j++)
         if (!isfinite(st->joint_xy[2 * j]) || !isfinite(st->joint_xy[2 * j + 1]))
             return mesh_fail(d, SM_ITEM_JOINT, j, "", "joint coordinates must be finite numbers");
-    int rc = st->spatial ? mesh3_check(st, o, d) : mesh3_check_planar(st, d);
+    int rc = mesh_kind(st)->check(st, o, d);
     if (rc < 0)
         return rc;
-    for (int s = 0; !st->spatial && s < st->n_sections; s++) {
-        const sm_section *c = &st->sections[s];
-        if (!mesh_positive(c->E))
-            return mesh_fail(d, SM_ITEM_SECTION, s, "E", "E must be a positive number (Pa)");
-        if (!mesh_positive(c->A))
-            return mesh_fail(d, SM_ITEM_SECTION, s, "A", "A must be a positive number (m^2)");
-        if (!mesh_positive(c->I))
-            return mesh_fail(d, SM_ITEM_SECTION, s, "I", "I must be a positive number (m^4)");
-        if (!mesh_positive(c->mu))
-            return mesh_fail(d, SM_ITEM_SECTION, s, "mass_per_length",
-                             "mass_per_length must be a positive number (kg/m)");
-    }
     long total = 0;
     double size = mesh_size(st);
     for (int i = 0; i < st->n_members; i++) {
@@ -146,7 +136,7 @@ static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
             return mesh_fail(d, SM_ITEM_MEMBER, i, "elements", "too many elements");
         double dx = st->joint_xy[2 * b->to] - st->joint_xy[2 * b->from];
         double dy = st->joint_xy[2 * b->to + 1] - st->joint_xy[2 * b->from + 1];
-        double dz = st->spatial && st->joint_z ? st->joint_z[b->to] - st->joint_z[b->from] : 0.0;
+        double dz = MESH_Z(st, b->to) - MESH_Z(st, b->from);
         double l = hypot(hypot(dx, dy), dz);
         if (b->from == b->to || !(l > 0.0))
             return mesh_fail(d, SM_ITEM_MEMBER, i, "", "zero-length member: its joints coincide");
@@ -285,7 +275,7 @@ static int mesh_nodes(sm_model *m, const sm_structure *st, const int *order, con
         double x0 = st->joint_xy[2 * a], y0 = st->joint_xy[2 * a + 1];
         double dx = st->joint_xy[2 * z] - x0, dy = st->joint_xy[2 * z + 1] - y0;
         double z0 = MESH_Z(st, a), dz = MESH_Z(st, z) - z0;
-        double len = st->spatial ? sqrt(dx * dx + dy * dy + dz * dz) : hypot(dx, dy), ang = atan2(dy, dx);
+        double len = m->kind->length(dx, dy, dz), ang = atan2(dy, dx);
         int prev = m->joint_node[a];
         for (int i = 1; i <= b->elements; i++) {
             sm_node *nd = &m->nodes[nn];
@@ -382,7 +372,7 @@ static int mesh_subs(sm_model *m, const sm_structure *st)
         sm_sub *b = &m->subs[k];
         b->elems = malloc((size_t)b->nel * sizeof(int));
         b->free_nodes = malloc((size_t)b->nel * sizeof(int));
-        b->ubar = malloc((size_t)b->nel * (m->spatial ? 3 : 2) * sizeof(double));
+        b->ubar = malloc((size_t)b->nel * m->kind->ubar_dim * sizeof(double));
         b->attach = malloc((size_t)b->nel * sizeof(int));
         if (!b->elems || !b->free_nodes || !b->ubar || !b->attach)
             return SM_NOMEM;
@@ -403,13 +393,6 @@ static int mesh_subs(sm_model *m, const sm_structure *st)
     for (int k = 0; k < ns; k++) {
         sm_sub *b = &m->subs[k];
         const sm_node *r = &m->nodes[b->root];
-        double c = cos(b->theta0), si = sin(b->theta0);
-        for (int i = 0; !m->spatial && i < b->nfree; i++) {
-            const sm_node *nd = &m->nodes[b->free_nodes[i]];
-            double dx = nd->x - r->x, dy = nd->y - r->y;
-            b->ubar[2 * i] = c * dx + si * dy; /* A(theta0)' (X - X_root) */
-            b->ubar[2 * i + 1] = -si * dx + c * dy;
-        }
         b->parent = r->sub;
         b->attach_local = r->local;
         if (b->parent >= 0) {
@@ -441,14 +424,15 @@ int mesh_build(sm_model *m, const sm_structure *st, sm_diag *d)
     if (rc < 0)
         goto done;
     m->spatial = st->spatial != 0;
+    m->kind = mesh_kind(st);
     rc = mesh_nodes(m, st, order, near);
-    if (rc == SM_OK && m->spatial)
-        rc = mesh3_elements(m, st, d);
+    if (rc == SM_OK && m->kind->elements)
+        rc = m->kind->elements(m, st, d);
     if (rc < 0)
         goto done;
     rc = mesh_subs(m, st);
-    if (rc == SM_OK && m->spatial)
-        mesh3_subs(m);
+    if (rc == SM_OK)
+        m->kind->subs(m);
 done:
     free(order);
     free(near);

@@ -234,42 +234,6 @@ int mesh3_check(const sm_structure *st, const sm_options *o, sm_diag *d)
     return SM_OK;
 }
 
-int mesh3_check_planar(const sm_structure *st, sm_diag *d)
-{
-    for (int j = 0; st->joint_z && j < st->n_joints; j++)
-        if (st->joint_z[j] != 0.0)
-            return mesh3_fail(d, SM_ITEM_JOINT, j, "z",
-                              "a joint out of the x-y plane needs spatial sections (EA, EI_flap, "
-                              "EI_edge, GJ, mass_per_length)");
-    for (int i = 0; i < st->n_members; i++) {
-        const sm_member *b = &st->members[i];
-        if (b->twist != 0.0)
-            return mesh3_fail(d, SM_ITEM_MEMBER, i, "twist_deg", "twist_deg needs spatial sections");
-        if (b->e3[0] != 0.0 || b->e3[1] != 0.0 || b->e3[2] != 0.0)
-            return mesh3_fail(d, SM_ITEM_MEMBER, i, "flap_direction", "flap_direction needs spatial sections");
-    }
-    for (int i = 0; i < st->n_point_masses; i++) {
-        const sm_point_mass *pm = &st->point_masses[i];
-        const double *I = pm->inertia;
-        if (I[0] != 0.0 || I[1] != 0.0 || I[2] != 0.0)
-            return mesh3_fail(d, SM_ITEM_POINT_MASS, i, "inertia", "a rotary inertia needs spatial sections");
-        if (pm->products[0] != 0.0 || pm->products[1] != 0.0 || pm->products[2] != 0.0)
-            return mesh3_fail(d, SM_ITEM_POINT_MASS, i, "products", "products of inertia need spatial sections");
-        if (pm->offset[0] != 0.0 || pm->offset[1] != 0.0 || pm->offset[2] != 0.0)
-            return mesh3_fail(d, SM_ITEM_POINT_MASS, i, "offset", "a point-mass offset needs spatial sections");
-    }
-    for (int i = 0; i < st->n_members; i++)
-        if (st->members[i].n_stations || st->members[i].station_mask)
-            return mesh3_fail(d, SM_ITEM_MEMBER, i, "stations", "stations need spatial sections");
-    for (int s = 0; s < st->n_sections; s++) {
-        const sm_section *c = &st->sections[s];
-        if (c->cg[0] != 0.0 || c->cg[1] != 0.0 || c->sc[0] != 0.0 || c->sc[1] != 0.0 || c->tc[0] != 0.0 ||
-            c->tc[1] != 0.0)
-            return mesh3_fail(d, SM_ITEM_SECTION, s, "cg_offset", "section offsets need spatial sections");
-    }
-    return SM_OK;
-}
-
 static double mesh3_norm(const double v[3])
 {
     return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);

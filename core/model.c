@@ -4,7 +4,7 @@
  * same mesh phase (model_mesh) without the component-mode bases and predicts
  * the sizes with modes_count.
  */
-#include "spatial.h"
+#include "kind.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -95,7 +95,7 @@ static void model_mesh_info(const sm_model *m, sm_model_info *info)
     info->nodes = m->n_nodes;
     info->elements = m->n_elems;
     info->frames = m->n_subs;
-    info->spatial = m->spatial;
+    info->spatial = m->kind->spatial;
     for (int s = 0; s < m->n_subs; s++)
         if (m->subs[s].nfree > info->max_frame_nodes)
             info->max_frame_nodes = m->subs[s].nfree;
@@ -144,8 +144,7 @@ int sm_structure_check(const sm_structure *st, const sm_options *opt, sm_model_i
     if (info) {
         model_mesh_info(m, info);
         for (int s = 0; s < m->n_subs; s++) {
-            int nm, na, k = m->spatial ? modes3_count(&m->opt, &m->subs[s], &nm, &na)
-                                       : modes_count(&m->opt, &m->subs[s], &nm, &na);
+            int nm, na, k = m->kind->count(&m->opt, &m->subs[s], &nm, &na);
             info->coordinates += k;
             if (k > info->max_frame_coordinates)
                 info->max_frame_coordinates = k;
@@ -201,7 +200,7 @@ int sm_model_member_nodes(const sm_model *m, int member, int cap, int *nodes, do
 {
     int ne = 0, n = 0;
 
-    if (!m->spatial || member < 0)
+    if (!m->kind->axes || member < 0)
         return SM_INVALID_INPUT;
     for (int e = 0; e < m->n_elems; e++)
         ne += m->elems[e].member == member;
@@ -236,7 +235,7 @@ int sm_model_member_nodes(const sm_model *m, int member, int cap, int *nodes, do
 
 int sm_model_member_axes(const sm_model *m, int member, double axes[9])
 {
-    if (!m->spatial || member < 0)
+    if (!m->kind->axes || member < 0)
         return SM_INVALID_INPUT;
     for (int e = 0; e < m->n_elems; e++)
         if (m->elems[e].member == member) {
@@ -248,7 +247,7 @@ int sm_model_member_axes(const sm_model *m, int member, double axes[9])
 
 int sm_model_node_axes(const sm_model *m, int node, double axes[9], int *member, double *s)
 {
-    if (!m->spatial || node < 0 || node >= m->n_nodes || m->nodes[node].member < 0)
+    if (!m->kind->axes || node < 0 || node >= m->n_nodes || m->nodes[node].member < 0)
         return SM_INVALID_INPUT;
     const sm_node *nd = &m->nodes[node];
     memcpy(axes, nd->ax, sizeof nd->ax);

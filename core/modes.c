@@ -25,7 +25,7 @@
  * bending block of G_e; and the mass points (nodes, or Gauss points of every
  * element for consistent mass, plus point masses).
  */
-#include "spatial.h"
+#include "kind.h"
 #include "lowmodes.h"
 
 #include <lapacke.h>
@@ -346,7 +346,7 @@ static int modes_elements(const sm_model *m, sm_sub *b)
 }
 
 /* Mass points: lumped nodes, or 4 Gauss points per element + point masses. */
-static int modes_mass_points(sm_model *m)
+int modes_planar_points(sm_model *m)
 {
     static const double gx[4] = {-0.86113631159405258, -0.33998104358485626,
                                  0.33998104358485626, 0.86113631159405258};
@@ -591,7 +591,7 @@ done:
 
 /* Basis, K_s, T_e and d_e of planar substructure b: sparse for a large frame keeping few modes
  * (lowmodes_use), else dense and complete. */
-static int modes_sub(const sm_model *m, sm_sub *b)
+int modes_planar_sub(const sm_model *m, sm_sub *b)
 {
     int D = 3 * b->nfree, nm, na, fallback = 0;
     modes_count(&m->opt, b, &nm, &na);
@@ -630,13 +630,13 @@ int modes_build(sm_model *m, sm_progress_fn cb, void *user, sm_diag *d)
             return SM_CANCELED;
         }
         sm_sub *b = &m->subs[s];
-        rc = m->spatial ? modes3_sub(m, b) : modes_sub(m, b); /* spatial: modes3.c */
+        rc = m->kind->basis(m, b);
         b->q0 = q0;
         q0 += b->m;
     }
     m->n = q0;
     if (rc == SM_OK)
-        rc = m->spatial ? modes3_points(m) : modes_mass_points(m);
+        rc = m->kind->points(m);
     if (rc < 0 && rc != SM_NOMEM)
         return modes_fail(d, rc, "could not compute the component modes of a substructure");
     if (rc == SM_NOMEM)

@@ -93,8 +93,6 @@ void fe3_geometric(const sm_elem *e, double g[144]);
 /** Spatial checks of st (sections, twist, flap direction, z, point-mass inertia, options),
  *  as mesh_check does for the planar data; the same diag conventions. */
 int mesh3_check(const sm_structure *st, const sm_options *o, sm_diag *d);
-/** Planar structure: the spatial-only fields must be absent (zero); SM_OK or SM_INVALID_INPUT. */
-int mesh3_check_planar(const sm_structure *st, sm_diag *d);
 /** Element axes and sections, nodal rotary inertia (after mesh_nodes).  Returns SM_OK or
  *  SM_INVALID_INPUT (a member without a usable flapwise direction: diag names it). */
 int mesh3_elements(sm_model *m, const sm_structure *st, sm_diag *d);

@@ -4,10 +4,9 @@
  * frozen), the eigen-analysis (eigen.c), mode shapes in the hub frame and
  * mode tracking across speeds by MAC (DESIGN.md 1.3-1.4).
  */
-#include "spatial.h"
+#include "linsys.h"
 
 #include <complex.h>
-#include <lapacke.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -52,142 +51,22 @@ void sm_result_free(sm_result *r)
     free(r);
 }
 
-/* Linearised matrices at q: M*, C* (coriolis), K* = K + Kg(P frozen) - s (M* + H): dense n x n,
- * or (tree != 0) the local blocks of tree.c with light kinematics (O(n) memory). */
-typedef struct sweep_lin {
-    int tree;           /* 1: tree form (t, light kin); 0: dense matrices */
-    sm_kin kin;         /* planar kinematics */
-    sp_kin sk;          /* spatial kinematics with J, W (m->spatial) */
-    dmat M, C, K, H, W, X; /* spatial: W is n x 6P scratch, X unused */
-    double *work;
-    tree_ws t;
-} sweep_lin;
-
-static void sweep_lin_free(sweep_lin *L)
-{
-    frames_kin_free(&L->kin);
-    sp_kin_free(&L->sk);
-    dm_free(&L->M);
-    dm_free(&L->C);
-    dm_free(&L->K);
-    dm_free(&L->H);
-    dm_free(&L->W);
-    dm_free(&L->X);
-    free(L->work);
-    tree_free(&L->t);
-}
-
-static int sweep_lin_alloc(const sm_model *m, sweep_lin *L, int tree)
-{
-    int n = m->n, mx = 1;
-    memset(L, 0, sizeof *L);
-    L->tree = tree;
-    for (int s = 0; s < m->n_subs; s++)
-        mx = m->subs[s].m > mx ? m->subs[s].m : mx;
-    L->work = dm_vec((size_t)(12 * mx + n));
-    if (m->spatial && tree) {
-        if (!L->work || sp_kin_alloc(m, &L->sk, 0) || tree_alloc(m, &L->t)) {
-            sweep_lin_free(L);
-            return SM_NOMEM;
-        }
-        return SM_OK;
-    }
-    if (m->spatial) {
-        if (!L->work || sp_kin_alloc(m, &L->sk, 1) || dm_alloc(&L->M, n, n) || dm_alloc(&L->C, n, n) ||
-            dm_alloc(&L->K, n, n) || dm_alloc(&L->H, n, n) || dm_alloc(&L->W, n, 6 * m->n_pt)) {
-            sweep_lin_free(L);
-            return SM_NOMEM;
-        }
-        return SM_OK;
-    }
-    if (tree) {
-        if (!L->work || frames_kin_alloc_light(m, &L->kin) || tree_alloc(m, &L->t)) {
-            sweep_lin_free(L);
-            return SM_NOMEM;
-        }
-        return SM_OK;
-    }
-    if (!L->work || frames_kin_alloc(m, &L->kin) || dm_alloc(&L->M, n, n) || dm_alloc(&L->C, n, n) ||
-        dm_alloc(&L->K, n, n) || dm_alloc(&L->H, n, n) || dm_alloc(&L->W, n, 2 * m->n_mp) ||
-        dm_alloc(&L->X, n, n)) {
-        sweep_lin_free(L);
-        return SM_NOMEM;
-    }
-    return SM_OK;
-}
-
-/* Linearise at q; returns 1 when the tree blocks are finite (always 1 for the dense form,
- * whose finiteness sweep_eigen_failed checks). */
-static int sweep_linearize(const sm_model *m, const double *q, double omega, sweep_lin *L)
-{
-    int n = m->n;
-    double s = omega * omega;
-    if (m->spatial && L->tree) /* K*, P frozen; M*; C* in the local blocks of tree3.c */
-        return tree3_assemble(m, q, &L->sk, s, 1, 1, m->opt.coriolis, &L->t);
-    if (m->spatial) { /* K*, P frozen; M*; C* (DESIGN.md 7.3) */
-        sp_eval(m, q, &L->sk);
-        lin3_tangent(m, q, &L->sk, s, 1, &L->K, &L->H, L->work);
-        lin3_mass(m, &L->sk, &L->M, &L->W);
-        if (m->opt.coriolis)
-            lin3_gyro(m, &L->sk, omega, &L->C, &L->W);
-    } else {
-        frames_eval(m, q, &L->kin);
-    }
-    if (L->tree)
-        return tree_assemble(m, q, &L->kin, s, 1, m->opt.coriolis, &L->t); /* K*, P frozen; M*; C* */
-    if (!m->spatial) {
-        lin_tangent(m, q, &L->kin, s, 1, &L->K, &L->M, &L->H, &L->W, L->work); /* K*, P frozen; M* */
-        if (m->opt.coriolis)
-            lin_gyro(m, &L->kin, omega, &L->C, &L->W, &L->X);
-    }
-    for (int j = 0; j < n; j++) /* symmetric up to round-off: make it exact */
-        for (int i = 0; i < j; i++)
-            DM(&L->K, i, j) = DM(&L->K, j, i) = 0.5 * (DM(&L->K, i, j) + DM(&L->K, j, i));
-    return 1;
-}
-
-/* Values per node in nodes and shapes: 3 planar (x, y, phi), 6 spatial (x, y, z, rx, ry, rz). */
-static int sweep_dof(const sm_model *m)
-{
-    return m->spatial ? 6 : 3;
-}
-
 /* 1 when component c of a nodal vector with dof values per node is a translation. */
 static int sweep_translation(int c, int dof)
 {
     return dof == 6 ? c % 6 < 3 : c % 3 != 2;
 }
 
-/* Nodal shapes (dx, dy, dphi) = J_k x in the hub frame (spatial: dx..dz, rx..rz); largest
- * translation = 1. */
-static void sweep_shapes(const sm_model *m, sweep_lin *L, const sm_eig_out *e, double *sr, double *si)
+/* Nodal shapes (the kind's node_dof values per node, hub frame) of the modes in e at the
+ * linearisation in L; largest translation = 1. */
+static void sweep_shapes(const sm_model *m, smi_lin *L, const sm_eig_out *e, double *sr, double *si)
 {
-    int n = m->n, nn = m->n_nodes, dof = sweep_dof(m);
-    const sm_kin *k = &L->kin;
+    int n = m->n, nn = m->n_nodes, dof = m->kind->node_dof;
     for (int j = 0; j < e->n_modes; j++) {
         const double *xr = e->xre + (size_t)j * n, *xi = e->xim + (size_t)j * n;
         double *yr = sr + (size_t)j * dof * nn, *yi = si + (size_t)j * dof * nn;
-        if (m->spatial && L->tree) {
-            tree3_nodal(m, &L->sk, &L->t, xr, yr);
-            tree3_nodal(m, &L->sk, &L->t, xi, yi);
-        } else if (m->spatial) {
-            lin3_nodal(m, &L->sk, xr, yr);
-            lin3_nodal(m, &L->sk, xi, yi);
-        } else if (L->tree) {
-            tree_nodal(m, k, &L->t, xr, yr);
-            tree_nodal(m, k, &L->t, xi, yi);
-        } else {
-            for (int c = 0; c < 3 * nn; c++) {
-                const double *jc = &DM(&k->Jn, 0, c);
-                double a = 0, b = 0;
-                for (int i = 0; i < n; i++) {
-                    a += jc[i] * xr[i];
-                    b += jc[i] * xi[i];
-                }
-                yr[c] = a;
-                yi[c] = b;
-            }
-        }
+        smi_lin_nodal(m, L, xr, yr);
+        smi_lin_nodal(m, L, xi, yi);
         double best = -1;
         double complex piv = 1;
         for (int c = 0; c < dof * nn; c++)
@@ -206,34 +85,18 @@ static void sweep_shapes(const sm_model *m, sweep_lin *L, const sm_eig_out *e, d
 }
 
 /* Fill equilibrium outputs of case c at q (kinematics of q in L). */
-static int sweep_equilibrium_out(const sm_model *m, const double *q, sweep_lin *L, sm_case *c)
+static int sweep_equilibrium_out(const sm_model *m, const double *q, smi_lin *L, sm_case *c)
 {
-    const sm_kin *k = &L->kin;
     c->n_nodes = m->n_nodes;
-    c->node_dof = sweep_dof(m);
+    c->node_dof = m->kind->node_dof;
     c->n_elements = m->n_elems;
     c->nodes = dm_vec((size_t)c->node_dof * m->n_nodes);
     c->axial_force = dm_vec((size_t)m->n_elems);
     if (!c->nodes || !c->axial_force)
         return SM_NOMEM;
     lin_axial_forces(m, q, c->axial_force);
-    double rot = 0;
     int at = -1;
-    if (m->spatial)
-        rot = lin3_nodes(m, &L->sk, c->nodes, &at); /* |psi|: rotation relative to the own frame */
-    else
-        memcpy(c->nodes, k->rn, 3 * (size_t)m->n_nodes * sizeof(double));
-    /* rotation of each node relative to its frame: phi_k - (theta_s - theta0_s) */
-    for (int s = 0; !m->spatial && s < m->n_subs; s++) {
-        const sm_sub *b = &m->subs[s];
-        for (int i = 0; i < b->nfree; i++) {
-            double p = k->rn[3 * b->free_nodes[i] + 2] - (k->theta[s] - b->theta0);
-            if (fabs(p) > rot) {
-                rot = fabs(p);
-                at = b->free_nodes[i];
-            }
-        }
-    }
+    double rot = smi_lin_nodes(m, L, c->nodes, &at); /* rotation relative to the own frame */
     c->max_frame_rotation = rot;
     c->warning[0] = '\0';
     if (c->converged && rot > SM_FRAME_ROTATION_LIMIT)
@@ -265,12 +128,12 @@ static int sweep_eigen_failed(sm_case *c, int rc, int finite)
 }
 
 /*
- * Linearisation and eigen-analysis at q into e, with the form of L; the tree form
+ * Linearisation and eigen-analysis at q into e, with the path of L; the tree path
  * falls back to the dense one (allocated here into *D, *use pointing at it) when
- * eig_solve_tree asks for it.  *finite: 0 when the matrices have non-finite entries.
+ * the tree eigen-analysis asks for it.  *finite: 0 when the matrices have non-finite entries.
  * Returns the status of the eigen-analysis (SM_NOMEM also for the fallback's allocation).
  */
-static int sweep_eigen(const sm_model *m, const double *q, sweep_lin *L, sweep_lin *D, sweep_lin **use,
+static int sweep_eigen(const sm_model *m, const double *q, smi_lin *L, smi_lin **D, smi_lin **use,
                        const sm_progress *pr, sm_case *c, sm_eig_out *e, int *finite)
 {
     int rc, fallback = 1;
@@ -278,23 +141,23 @@ static int sweep_eigen(const sm_model *m, const double *q, sweep_lin *L, sweep_l
     *use = L;
     *finite = 1;
     memset(e, 0, sizeof *e);
-    if (L->tree) {
-        int fin = sweep_linearize(m, q, c->omega, L);
+    if (smi_lin_is_tree(L)) {
+        int fin = smi_lin_linearize(m, q, c->omega, L);
         t1 = sweep_ms();
         c->t_linearize = t1 - t0;
-        if (fin && (rc = eig_solve_tree(m, &L->t, m->opt.coriolis, m->opt.modes, pr, e, &fallback)) < 0)
+        if (fin && (rc = smi_lin_eigen(m, L, pr, e, &fallback)) < 0)
             return rc;
         c->t_eigen = sweep_ms() - t1;
         if (!fallback)
             return SM_OK;
         int dmax = m->opt.max_dense_coordinates > 0 ? m->opt.max_dense_coordinates : SM_DENSE_MAX_DEFAULT;
         if (m->n > dmax) { /* the dense path would take minutes and gigabytes */
-            if (L->t.neg > 0)
+            if (smi_lin_negative(L) > 0)
                 snprintf(c->message, sizeof c->message,
                          "the steady state is unstable: K* has %d negative eigenvalues (structured "
                          "factorisation); the modes of an unstable state are found by the dense "
                          "eigen-analysis, which is limited to %d coordinates (this model has %d)",
-                         L->t.neg, dmax, m->n);
+                         smi_lin_negative(L), dmax, m->n);
             else
                 snprintf(c->message, sizeof c->message,
                          "the structured eigen-analysis cannot give these modes (K* singular, too few "
@@ -304,37 +167,36 @@ static int sweep_eigen(const sm_model *m, const double *q, sweep_lin *L, sweep_l
                          dmax, m->n);
             return SM_LIMIT;
         }
-        if ((rc = sweep_lin_alloc(m, D, 0)) < 0) /* the dense path decides */
+        if ((rc = smi_lin_new(m, SMI_USE_MODES, 0, D)) < 0) /* the dense path decides */
             return rc;
-        *use = D;
+        *use = *D;
         c->dense_fallback = 1;
         t0 = sweep_ms();
     }
-    sweep_linearize(m, q, c->omega, *use);
+    smi_lin_linearize(m, q, c->omega, *use);
     t1 = sweep_ms();
-    rc = eig_solve(m->n, &(*use)->M, &(*use)->C, &(*use)->K, m->opt.coriolis, m->opt.modes, e);
+    rc = smi_lin_eigen(m, *use, pr, e, &fallback);
     c->t_linearize += t1 - t0;
     c->t_eigen += sweep_ms() - t1;
     if (rc < 0)
-        *finite = dm_finite(&(*use)->K) && dm_finite(&(*use)->M) && dm_finite(&(*use)->C);
+        *finite = smi_lin_finite(*use);
     return rc;
 }
 
 /* Modes of case c at the equilibrium q; pr: the stop callback the tree path asks every few
  * Krylov vectors.  An eigen-analysis failure is reported on the case (sweep_eigen_failed); returns
  * SM_OK, SM_NOMEM or SM_CANCELED. */
-static int sweep_modes(const sm_model *m, const double *q, sweep_lin *L, const sm_progress *pr, sm_case *c)
+static int sweep_modes(const sm_model *m, const double *q, smi_lin *L, const sm_progress *pr, sm_case *c)
 {
     sm_eig_out e;
-    sweep_lin D, *use = L;
+    smi_lin *D = NULL, *use = L;
     int finite = 1;
-    memset(&D, 0, sizeof D);
     int rc = sweep_eigen(m, q, L, &D, &use, pr, c, &e, &finite);
     if (rc < 0) {
-        sweep_lin_free(&D);
+        smi_lin_free(D);
         return sweep_eigen_failed(c, rc, finite);
     }
-    int k = e.n_modes, nn = m->n_nodes * sweep_dof(m);
+    int k = e.n_modes, nn = m->n_nodes * m->kind->node_dof;
     c->n_modes = k;
     c->frequency = dm_vec((size_t)k);
     c->eig_re = dm_vec((size_t)k);
@@ -346,7 +208,7 @@ static int sweep_modes(const sm_model *m, const double *q, sweep_lin *L, const s
     if (!c->frequency || !c->eig_re || !c->eig_im || !c->mac_to_previous || !c->previous_index ||
         !c->shape_re || !c->shape_im) {
         eig_out_free(&e);
-        sweep_lin_free(&D);
+        smi_lin_free(D);
         return SM_NOMEM;
     }
     for (int j = 0; j < k; j++) {
@@ -370,7 +232,7 @@ static int sweep_modes(const sm_model *m, const double *q, sweep_lin *L, const s
                  "equilibrium found, unstable: a root has a positive real part %.3g (a dynamic "
                  "instability)", e.max_re);
     eig_out_free(&e);
-    sweep_lin_free(&D);
+    smi_lin_free(D);
     return SM_OK;
 }
 
@@ -434,17 +296,15 @@ static int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_p
     sm_result *r = calloc(1, sizeof *r);
     sweep_key *key = malloc((size_t)n_omegas * sizeof *key);
     double *q = dm_vec((size_t)n);
-    sweep_lin L;
-    int have_lin = 0;
+    smi_lin *L = NULL;
     if (!r || !key || !q)
         goto fail;
     r->cases = calloc((size_t)n_omegas, sizeof(sm_case));
     if (!r->cases)
         goto fail;
     r->n_cases = n_omegas;
-    if ((rc = sweep_lin_alloc(m, &L, tree_use(m))) < 0)
+    if ((rc = smi_lin_new(m, SMI_USE_MODES, tree_use(m), &L)) < 0)
         goto fail;
-    have_lin = 1;
     for (int i = 0; i < n_omegas; i++) {
         key[i].omega = omegas[i];
         key[i].index = i;
@@ -475,18 +335,15 @@ static int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_p
         c->iterations = eo.iterations;
         c->residual = eo.residual;
         c->last_omega = sqrt(eo.last_s);
-        if (m->spatial)
-            sp_eval(m, q, &L.sk);
-        else
-            frames_eval(m, q, &L.kin);
-        if ((rc = sweep_equilibrium_out(m, q, &L, c)) < 0)
+        smi_lin_eval(m, q, L);
+        if ((rc = sweep_equilibrium_out(m, q, L, c)) < 0)
             goto fail;
         if (!eo.converged) {
             c->status = SM_CASE_NO_EQUILIBRIUM;
             snprintf(c->message, sizeof c->message, "%s", eo.message);
             from_rest = 1;
         } else {
-            if ((rc = sweep_modes(m, q, &L, &pr, c)) < 0)
+            if ((rc = sweep_modes(m, q, L, &pr, c)) < 0)
                 goto fail;
             s_prev = s; /* tracking (track.c) runs once every speed is solved */
             from_rest = 0;
@@ -498,14 +355,13 @@ static int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_p
             goto fail;
         }
     }
-    sweep_lin_free(&L);
+    smi_lin_free(L);
     free(key);
     free(q);
     *out = r;
     return SM_OK;
 fail:
-    if (have_lin)
-        sweep_lin_free(&L);
+    smi_lin_free(L);
     free(key);
     free(q);
     sm_result_free(r);
@@ -517,38 +373,27 @@ fail:
 
 int sweep_lowest(const sm_model *m, double omega, sm_progress_fn cb, void *user, double *lambda)
 {
-    int n = m->n, rc, found = 0;
-    double *q = dm_vec((size_t)n), *w = dm_vec((size_t)n), vl = 0, vu = 0;
-    int *ifail = calloc((size_t)n, sizeof(int));
+    int n = m->n, rc;
+    double *q = dm_vec((size_t)n);
     sm_progress pr = {cb, user, 0, 1};
     sm_eq_out eo;
-    sweep_lin D;
-    memset(&D, 0, sizeof D);
+    smi_lin *D = NULL;
     *lambda = NAN;
     rc = SM_NOMEM;
-    if (!q || !w || !ifail)
+    if (!q)
         goto done;
     if ((rc = eq_solve(m, q, 0, omega * omega, 1, &pr, &eo)) < 0)
         goto done;
     rc = eo.canceled ? SM_CANCELED : SM_NO_EQUILIBRIUM;
     if (!eo.converged)
         goto done;
-    if ((rc = sweep_lin_alloc(m, &D, 0)) < 0)
+    if ((rc = smi_lin_new(m, SMI_USE_MODES, 0, &D)) < 0)
         goto done;
-    sweep_linearize(m, q, omega, &D);
-    /* the lowest eigenvalue of the symmetric K* (its sign change is that of det K*) */
-    rc = dm_lapack_status(LAPACKE_dsyevx(LAPACK_COL_MAJOR, 'N', 'I', 'L', n, D.K.a, n, vl, vu, 1, 1,
-                                         0.0, &found, w, NULL, 1, ifail),
-                          SM_LAPACK_FAILED);
-    if (rc == SM_OK && found == 1)
-        *lambda = w[0];
-    else if (rc == SM_OK)
-        rc = SM_LAPACK_FAILED;
+    smi_lin_linearize(m, q, omega, D);
+    rc = smi_lin_lowest(m, D, lambda);
 done:
-    sweep_lin_free(&D);
+    smi_lin_free(D);
     free(q);
-    free(w);
-    free(ifail);
     return rc;
 }
 

@@ -59,7 +59,7 @@
  * the dense cost again: the automatic choice (tree_use) keeps the dense path
  * for small models and large frames.
  */
-#include "internal.h"
+#include "kind.h"
 
 #include <lapacke.h>
 #include <math.h>
@@ -116,7 +116,7 @@ void tree_free(tree_ws *t)
 
 int tree_alloc(const sm_model *m, tree_ws *t)
 {
-    int S = m->n_subs, mx = 1, d = m->spatial ? 6 : 3;
+    int S = m->n_subs, mx = 1, d = m->kind->pose_dof;
     memset(t, 0, sizeof *t);
     t->S = S;
     t->n = m->n;
