@@ -24,6 +24,7 @@ required=(
   curl ca-certificates                     # clients, end-to-end tests
   nodejs npm chromium                      # web front end (clients/web) and its browser test (tests/web)
   clang libclang-rt-14-dev                 # CI fuzz step: libFuzzer (only Recommended by clang)
+  clang-format                             # CI format step: .ci/format-check (clang-format 14, git-clang-format)
 )
 # Optional: nice to have, a failure to install them is only a warning.
 # wrk: tests/bench/bench_http.sh; nginx: tests/deploy (deploy/nginx/spinmodal.conf in
