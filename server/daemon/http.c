@@ -1,22 +1,24 @@
 /*
  * http.c — the HTTP front of spinmodald (see http.h and server/DAEMON.md):
- * set-up, the handler, routing and the operational routes.  The other
- * files of the front are listed in http_internal.h.
+ * set-up, the handler and stop.  The routes are a table (http_routes.c);
+ * the other files of the front are listed in http_internal.h.
  *
  * How it fits: libmicrohttpd runs one thread per connection and calls
  * http_handler in three phases (libmicrohttpd's simplepost.c shape):
  *   1. headers received: *req_cls is NULL; allocate the request context
- *      and route it.  Only refusals of a body are answered here (401, 400
+ *      and route it (http_route_find: the table of http_routes.c).  Only refusals of a body are answered here (401, 400
  *      ?wait, 415, 413 by Content-Length, or any answer to a non-POST that
  *      carries a body): libmicrohttpd then closes the connection without
  *      reading the body.  Everything else waits for phase 3 so the
  *      connection stays alive;
- *   2. body data of POST /v1/analyses and /v1/validate: appended to the
+ *   2. body data of a POST to a route that reads one (its begin said
+ *      so: /v1/analyses, /v1/validate, /v1/import/{format}): appended to the
  *      context's buffer, capped at --max-body (over it: 413 at once, see
  *      http_early_too_large);
  *   3. request complete (*upload_data_size == 0): answer GET/HEAD/DELETE/
- *      OPTIONS, or validate the POST body with the codec, submit it to the
- *      job pool, optionally wait, answer.
+ *      OPTIONS (http_answer), or hand the POST body to the route's end
+ *      (validate it with the codec, submit it to the job pool, optionally
+ *      wait, answer).
  * http_completed (MHD_OPTION_NOTIFY_COMPLETED) counts the response in the
  * metrics, logs the `request` line and frees the context.
  *
@@ -34,7 +36,6 @@
 #include "http_internal.h"
 
 #include <errno.h>
-#include <limits.h>
 #include <netdb.h>
 #include <pthread.h>
 #include <stdarg.h>
@@ -43,284 +44,9 @@
 #include <string.h>
 #include <sys/socket.h>
 
-#include "import.h"
 #include "log.h"
 
-/* ------------------------------------------------------ operational routes */
-
-/*
- * GET /readyz: ready when the database takes a real write (store_health: the
- * file is still the one opened, a WAL frame can be written), the last write
- * of a job did not fail, every worker runs and the daemon is not stopping.
- * checks.database is "ok" or the kind of the failure (store_rc_name:
- * "full", "readonly", "gone", "corrupt", "busy", "db_timeout" ...;
- * "write_failed" when the probe passes but a job's result could not be
- * stored).  The probe has its own budget (store_settings.probe_timeout_ms,
- * 0.5 s): a stalled database answers 503 "db_timeout", never a hang.
- */
-static enum MHD_Result http_readyz(struct MHD_Connection *c, http_req *r)
-{
-    http_hdr retry = {MHD_HTTP_HEADER_RETRY_AFTER, HTTP_RETRY_FAULT};
-    jobs_stats s;
-    int db_rc = store_health(r->h->st), stopping = 1, writes_fail = 0;
-    const char *db = db_rc == STORE_OK ? "ok" : store_rc_name(db_rc);
-    char workers[48], detail[300];
-    codec_text b = {0};
-
-    memset(&s, 0, sizeof(s));
-    if (http_enter(r->h) == 0) {
-        jobs_get_stats(r->h->j, &s);
-        stopping = jobs_stopping(r->h->j);
-        http_leave(r->h);
-        writes_fail = s.store_failing || s.unrecorded > 0;
-    }
-    if (db_rc == STORE_OK && writes_fail)
-        db = "write_failed";
-    snprintf(workers, sizeof(workers), "%d/%d", s.workers_alive, s.workers);
-    if (strcmp(db, "ok") == 0 && !stopping && s.workers_alive == s.workers && s.workers > 0) {
-        codec_text_printf(&b, "{\"status\":\"ready\",\"checks\":{\"database\":\"ok\","
-                              "\"workers\":\"%s\"}}", workers);
-        return http_respond_buf(c, r, MHD_HTTP_OK, "application/json", &b, NULL, 0);
-    }
-    if (stopping)
-        snprintf(detail, sizeof(detail), "The daemon is stopping.");
-    else if (db_rc == STORE_TIMEOUT)   /* the probe's own budget passed (DESIGN §F) */
-        snprintf(detail, sizeof(detail), "The database did not answer the readiness probe "
-                                         "in time: %s.", store_strerror(db_rc));
-    else if (db_rc != STORE_OK)
-        snprintf(detail, sizeof(detail), "The database is not writable: %s.",
-                 store_strerror(db_rc));
-    else if (writes_fail)
-        snprintf(detail, sizeof(detail), "The database refused the last write of a job "
-                                         "(full disk or read-only); results are not stored.");
-    else
-        snprintf(detail, sizeof(detail), "A worker thread is gone.");
-    codec_text_printf(&b, "{\"type\":\"" HTTP_PROBLEMS "not-ready\",\"title\":\"Service "
-                          "Unavailable\",\"status\":503,\"detail\":\"%s\",", detail);
-    codec_text_printf(&b, "\"checks\":{\"database\":\"%s\",\"workers\":\"%s\"}}", db,
-                      workers);
-    if (stopping)
-        retry.value = HTTP_RETRY_BUSY;
-    return http_respond_buf(c, r, MHD_HTTP_SERVICE_UNAVAILABLE, "application/problem+json", &b,
-                            &retry, 1);
-}
-
-/*
- * Append the long-poll budget (http_guard.c) to the metrics text *text
- * (*len bytes, malloc'd): 0, or -1 when out of memory (*text then freed).
- */
-static int http_metrics_waiters(http *h, char **text, size_t *len)
-{
-    static const char fmt[] =
-        "# HELP spinmodal_http_waiters Long polls (?wait) waiting now.\n"
-        "# TYPE spinmodal_http_waiters gauge\n"
-        "spinmodal_http_waiters %d\n"
-        "# HELP spinmodal_http_waiters_limit Most long polls waiting at once (--max-waiters).\n"
-        "# TYPE spinmodal_http_waiters_limit gauge\n"
-        "spinmodal_http_waiters_limit %d\n"
-        "# HELP spinmodal_http_waiters_released_total Long polls answered early with the "
-        "job's current state because a newer one came over --max-waiters.\n"
-        "# TYPE spinmodal_http_waiters_released_total counter\n"
-        "spinmodal_http_waiters_released_total %llu\n";
-    unsigned long long released;
-    int waiting, cap, n;
-    char *grown;
-
-    http_waiter_counts(h, &waiting, &cap, &released);
-    n = snprintf(NULL, 0, fmt, waiting, cap, released);
-    grown = n < 0 ? NULL : realloc(*text, *len + (size_t)n + 1);
-    if (!grown) {
-        free(*text);
-        *text = NULL;
-        return -1;
-    }
-    snprintf(grown + *len, (size_t)n + 1, fmt, waiting, cap, released);
-    *text = grown;
-    *len += (size_t)n;
-    return 0;
-}
-
-/* GET /metrics */
-static enum MHD_Result http_metrics(struct MHD_Connection *c, http_req *r)
-{
-    metrics_gauges g;
-    jobs_stats s = {0};
-    long long counts[STORE_N_STATES];
-    char *text = NULL;
-    size_t len = 0;
-    int i, counted = store_count(r->h->st, counts) == STORE_OK;
-
-    for (i = 0; i < STORE_N_STATES; i++)
-        g.jobs[i] = counted ? counts[i] : -1;
-    if (http_enter(r->h) == 0) {
-        jobs_get_stats(r->h->j, &s);
-        http_leave(r->h);
-    } else if (counted) {
-        s.queued = (int)counts[STORE_QUEUED];
-    }
-    if (store_size(r->h->st, &g.store_live_bytes, &g.store_file_bytes) != STORE_OK)
-        g.store_live_bytes = g.store_file_bytes = -1;
-    g.queue_depth = counted ? (int)(counts[STORE_QUEUED] > INT_MAX ? INT_MAX : counts[STORE_QUEUED]) : s.queued;
-    g.workers = s.workers;
-    g.workers_busy = s.workers_busy;
-    if (metrics_render(r->h->mx, &g, &text, &len) || http_metrics_waiters(r->h, &text, &len))
-        return http_send_oom(c, r);
-    return http_respond(c, r, MHD_HTTP_OK, "text/plain; version=0.0.4", text, len, 1, NULL, 0);
-}
-
-/* OPTIONS: the CORS preflight. */
-static enum MHD_Result http_preflight(struct MHD_Connection *c, http_req *r)
-{
-    static const http_hdr hdrs[] = {
-        {MHD_HTTP_HEADER_ACCESS_CONTROL_ALLOW_METHODS, "GET, HEAD, POST, DELETE, OPTIONS"},
-        {"Access-Control-Allow-Headers", "Authorization, Content-Type"},
-        {"Access-Control-Max-Age", "600"}};
-
-    return http_respond(c, r, MHD_HTTP_NO_CONTENT, NULL, NULL, 0, 0, hdrs, 3);
-}
-
-/* ---------------------------------------------------------------- routing */
-
-/* Route r by its path; sets route, tmpl, file, id. */
-static void http_route_of(http_req *r, const char *url)
-{
-    const char *rest, *slash;
-
-    r->tmpl = "other";
-    if (strcmp(url, "/v1/analyses") == 0) {
-        r->route = R_ANALYSES;
-        r->tmpl = "/v1/analyses";
-    } else if (strcmp(url, "/v1/validate") == 0) {
-        r->route = R_VALIDATE;
-        r->tmpl = "/v1/validate";
-    } else if (strncmp(url, "/v1/analyses/", 13) == 0) {
-        rest = url + 13;
-        slash = strchr(rest, '/');
-        if (slash && strcmp(slash, "/result") != 0 && strcmp(slash, "/request") != 0)
-            return;
-        if (!slash) {
-            r->route = R_ANALYSIS;
-            r->tmpl = "/v1/analyses/{id}";
-        } else if (strcmp(slash, "/result") == 0) {
-            r->route = R_RESULT;
-            r->tmpl = "/v1/analyses/{id}/result";
-        } else {
-            r->route = R_REQUEST;
-            r->tmpl = "/v1/analyses/{id}/request";
-        }
-        r->id_ok = http_is_id(rest, slash ? (size_t)(slash - rest) : strlen(rest));
-        if (r->id_ok) {
-            memcpy(r->id, rest, 64);
-            r->id[64] = '\0';
-        }
-    } else if (strncmp(url, "/v1/import/", 11) == 0 && import_format_known(url + 11)) {
-        r->route = R_IMPORT;
-        r->tmpl = "/v1/import/{format}";
-    } else if (strcmp(url, "/livez") == 0) {
-        r->route = R_LIVEZ;
-        r->tmpl = "/livez";
-    } else if (strcmp(url, "/readyz") == 0) {
-        r->route = R_READYZ;
-        r->tmpl = "/readyz";
-    } else if (strcmp(url, "/metrics") == 0) {
-        r->route = R_METRICS;
-        r->tmpl = "/metrics";
-    } else if ((r->file = embedded_find(url)) != NULL) {
-        r->route = R_FILE;
-        r->tmpl = r->file->path;
-    }
-}
-
-static unsigned http_method_of(const char *m)
-{
-    static const struct {
-        const char *name;
-        unsigned bit;
-    } t[] = {{"GET", M_GET}, {"HEAD", M_HEAD}, {"POST", M_POST}, {"DELETE", M_DELETE},
-             {"OPTIONS", M_OPTIONS}};
-    size_t i;
-
-    for (i = 0; i < sizeof(t) / sizeof(t[0]); i++)
-        if (strcmp(m, t[i].name) == 0)
-            return t[i].bit;
-    return M_OTHER;
-}
-
-static unsigned http_route_methods(http_route route)
-{
-    switch (route) {
-    case R_ANALYSES:
-        return M_GET | M_HEAD | M_POST;
-    case R_VALIDATE:
-    case R_IMPORT:
-        return M_POST;
-    case R_ANALYSIS:
-        return M_GET | M_HEAD | M_DELETE;
-    case R_OTHER:
-        return 0;
-    default:
-        return M_GET | M_HEAD;
-    }
-}
-
-/* Answer a GET or HEAD of a known route. */
-static enum MHD_Result http_get(struct MHD_Connection *c, http_req *r)
-{
-    static const char livez[] = "{\"status\":\"ok\"}";
-
-    switch (r->route) {
-    case R_ANALYSES:
-        return http_list(c, r);
-    case R_ANALYSIS:
-        return http_get_analysis(c, r);
-    case R_RESULT:
-        return http_get_result(c, r);
-    case R_REQUEST:
-        return http_get_request(c, r);
-    case R_LIVEZ:
-        return http_respond(c, r, MHD_HTTP_OK, "application/json", (char *)livez,
-                            sizeof(livez) - 1, 0, NULL, 0);
-    case R_READYZ:
-        return http_readyz(c, r);
-    case R_METRICS:
-        return http_metrics(c, r);
-    case R_FILE:
-        return http_respond(c, r, MHD_HTTP_OK, r->file->content_type, (char *)r->file->data,
-                            r->file->len, 0, NULL, 0);
-    default:
-        return http_not_found(c, r, 0);
-    }
-}
-
-/* 1 for the routes whose reads need the token under --auth-reads (jobs, metrics). */
-static int http_read_needs_token(http_route route)
-{
-    return route == R_ANALYSES || route == R_ANALYSIS || route == R_RESULT ||
-           route == R_REQUEST || route == R_METRICS;
-}
-
-/* Answer a request other than a POST with a body (all of it is in). */
-static enum MHD_Result http_answer(struct MHD_Connection *c, http_req *r)
-{
-    unsigned allowed = http_route_methods(r->route);
-
-    if (r->method == M_OPTIONS && r->h->cors_origin && r->route != R_OTHER)
-        return http_preflight(c, r);
-    if (r->method == M_OPTIONS && strcmp(r->path, "*") == 0)
-        return http_not_allowed(c, r, M_GET | M_HEAD | M_POST | M_DELETE);
-    if (r->route == R_OTHER)
-        return http_not_found(c, r, 0);
-    if (!(allowed & r->method))
-        return http_not_allowed(c, r, allowed);
-    if ((r->method == M_GET || r->method == M_HEAD) && http_read_needs_token(r->route) &&
-        r->h->auth_reads && !http_authorized(r->h, c))
-        return http_unauthorized(c, r);
-    if (r->method == M_GET || r->method == M_HEAD)
-        return http_get(c, r);
-    if (!http_authorized(r->h, c))
-        return http_unauthorized(c, r);
-    return http_delete(c, r);
-}
+/* ------------------------------------------------------------ the handler */
 
 /* 1 when the request announces a body (Content-Length > 0 or Transfer-Encoding). */
 static int http_has_body(struct MHD_Connection *c)
@@ -344,10 +70,9 @@ static enum MHD_Result http_first(struct MHD_Connection *c, http_req *r)
 {
     enum MHD_Result q = MHD_YES;
 
-    if (r->method == M_POST &&
-        (r->route == R_ANALYSES || r->route == R_VALIDATE || r->route == R_IMPORT)) {
+    if (r->method == M_POST && r->def && r->def->begin) {
         r->collect = 1;
-        if (!(r->route == R_IMPORT ? http_import_begin(c, r, &q) : http_post_begin(c, r, &q)))
+        if (!r->def->begin(c, r, &q))
             return q;
         return MHD_YES;
     }
@@ -368,7 +93,7 @@ static http_req *http_req_new(http *h, const char *url, const char *method)
     r->method = http_method_of(method);
     http_sanitize(r->method_name, sizeof(r->method_name), method);
     http_sanitize(r->path, sizeof(r->path), url);
-    http_route_of(r, url);
+    http_route_find(r, url);
     return r;
 }
 
@@ -397,30 +122,9 @@ static enum MHD_Result http_handler(void *cls, struct MHD_Connection *c, const c
     }
     if (http_guard_answering(h, c))
         return MHD_NO;
-    if (r->collect && r->route == R_IMPORT)
-        return http_import_end(c, r);
-    return r->collect ? http_post_end(c, r) : http_answer(c, r);
+    return r->collect ? r->def->end(c, r) : http_answer(c, r);
 }
 
-static const char *http_method_label(unsigned m)
-{
-    switch (m) {
-    case M_GET:
-        return "GET";
-    case M_HEAD:
-        return "HEAD";
-    case M_POST:
-        return "POST";
-    case M_DELETE:
-        return "DELETE";
-    case M_OPTIONS:
-        return "OPTIONS";
-    default:
-        return "OTHER";
-    }
-}
-
-/* MHD_OPTION_NOTIFY_COMPLETED: count, log, free. */
 static void http_completed(void *cls, struct MHD_Connection *c, void **req_cls,
                            enum MHD_RequestTerminationCode toe)
 {

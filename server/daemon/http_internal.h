@@ -4,8 +4,12 @@
  *
  * The HTTP front is one module in five files:
  *   http.c           libmicrohttpd set-up and stop, the three-phase handler,
- *                    routing, the operational routes (/readyz, /metrics,
- *                    OPTIONS, embedded files), the job-pool guard;
+ *                    the job-pool guard;
+ *   http_routes.c    the route table http_routes[] {template, methods,
+ *                    handlers} (Redis's command table), the one lookup and
+ *                    the answers it gives (404, 405 + Allow, preflight), the
+ *                    operational routes (/livez, /readyz, /metrics,
+ *                    embedded files);
  *   http_analyses.c  the /v1/analyses routes and the end of a POST (validate,
  *                    submit, wait, answer);
  *   http_body.c      receiving a POST body: token, content type, size caps,
@@ -76,6 +80,38 @@ typedef enum http_route {
     R_IMPORT         /* /v1/import/{bmodes|elastodyn|csv} (http_import.c) */
 } http_route;
 
+/* Flags of a route (http_route_def.flags). */
+enum {
+    HTTP_ROUTE_READ_TOKEN = 1  /* GET and HEAD need the token under --auth-reads */
+};
+
+typedef struct http_req http_req;
+
+/* A handler: answer the request (queue a response). */
+typedef enum MHD_Result (*http_route_fn)(struct MHD_Connection *c, http_req *r);
+
+/* Phase 1 of a POST: 1 to read the body, or 0 with the answer queued in *q. */
+typedef int (*http_begin_fn)(struct MHD_Connection *c, http_req *r, enum MHD_Result *q);
+
+/*
+ * One route of http_routes[] (http_routes.c): its path template, the
+ * methods it allows and who answers each.  A template is literal but for
+ * at most one {param} segment: {id} takes any one segment (a job id:
+ * http_req.id_ok says whether it is one), {format} a name of the codec's
+ * import_formats[].  OPTIONS is answered for every route (the preflight
+ * under --cors-origin, 405 otherwise).
+ */
+typedef struct http_route_def {
+    const char *tmpl;        /* path template; also the route label of the metrics */
+    http_route route;        /* its id, for the code a route shares (R_ANALYSES ...) */
+    unsigned methods;        /* M_* bits allowed: the Allow header of a 405 */
+    unsigned flags;          /* HTTP_ROUTE_* */
+    http_route_fn get;       /* GET and HEAD (M_GET in methods) */
+    http_route_fn del;       /* DELETE, once the token is checked (M_DELETE in methods) */
+    http_begin_fn begin;     /* POST phase 1: token, query, type, size (M_POST in methods) */
+    http_route_fn end;       /* POST phase 3: the body is in */
+} http_route_def;
+
 /* State of the body of a POST. */
 enum { BODY_OK = 0, BODY_TOO_LARGE = 1, BODY_NOMEM = 2 };
 
@@ -118,10 +154,11 @@ struct http {
 };
 
 /* Per-request context (*req_cls), from the first call to http_completed. */
-typedef struct http_req {
+struct http_req {
     http *h;
     double t0;               /* monotonic s when the headers were received */
-    http_route route;
+    const http_route_def *def; /* its route (http_route_find), NULL = none: 404 */
+    http_route route;        /* def->route, R_OTHER without one */
     const char *tmpl;        /* route template for the metrics (static or embedded path) */
     const embedded_file *file; /* R_FILE */
     unsigned method;         /* M_* */
@@ -138,7 +175,7 @@ typedef struct http_req {
     int body_state;          /* BODY_* */
     int collect;             /* a POST whose body is read (phase 2) */
     int raw_answer;          /* answered on the socket by http_early_too_large */
-} http_req;
+};
 
 /* A response header. */
 typedef struct http_hdr {
@@ -304,6 +341,31 @@ int http_guard_start(http *h);
 
 /** Stop and join the guard thread (before MHD_stop_daemon); safe when not started. */
 void http_guard_stop(http *h);
+
+/* ---------------------------------------------------------- http_routes.c */
+
+/**
+ * Route r by url (decoded, NUL-terminated): sets def, route, tmpl (the
+ * template, an embedded file's path, or "other"), file, and id/id_ok for
+ * an {id} path.  The table is searched in order, then the embedded files.
+ */
+void http_route_find(http_req *r, const char *url);
+
+/** The route table (n entries into *n), for the tests; embedded files are not in it. */
+const http_route_def *http_route_table(size_t *n);
+
+/** M_* bit of a method name; M_OTHER when it is none of ours. */
+unsigned http_method_of(const char *name);
+
+/** The name of an M_* bit ("GET" ...), "OTHER" for M_OTHER: the metrics label. */
+const char *http_method_label(unsigned method);
+
+/**
+ * Answer a request other than a POST to a route that reads a body, once
+ * it is complete: the preflight, 404, 405 + Allow, 401, or the route's
+ * handler for its method.
+ */
+enum MHD_Result http_answer(struct MHD_Connection *c, http_req *r);
 
 /* ------------------------------------------------------------------ http.c */
 
