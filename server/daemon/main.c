@@ -581,13 +581,6 @@ static void main_fail(const char *what, const char *detail)
     log_event("error", "start_failed", "error", what, "detail", detail, (const char *)NULL);
 }
 
-/* Open the store and the metrics; 0 or EXIT_START. */
-/* 1 when the --db value is a PostgreSQL URI (it may hold a password: never logged). */
-static int main_is_uri(const char *db)
-{
-    return strncmp(db, "postgresql://", 13) == 0 || strncmp(db, "postgres://", 11) == 0;
-}
-
 /*
  * The store's error callback (on the failing thread, at the failure): log
  * the kind and SQLite's own text, count it by kind.  Never calls the store.
@@ -609,6 +602,7 @@ static void main_store_pruned(void *ctx, long long n)
     metrics_store_pruned(ctx, n);
 }
 
+/* Open the store and the metrics; 0 or EXIT_START. */
 static int main_open(const main_opts *o, main_daemon *d)
 {
     store_settings set;
@@ -641,7 +635,8 @@ static int main_open(const main_opts *o, main_daemon *d)
     }
     snprintf(n, sizeof(n), "%d", requeued);
     log_event("info", "recovered", "jobs", n, "backend", store_backend_name(d->st), "owner",
-              store_owner(d->st), "db", main_is_uri(o->db) ? NULL : o->db, (const char *)NULL);
+              store_owner(d->st), "db",
+              store_caps(d->st) & STORE_CAP_SECRET_PATH ? NULL : o->db, (const char *)NULL);
     return 0;
 }
 
@@ -697,7 +692,7 @@ static int main_serve(const main_opts *o, const char *token, main_daemon *d)
     jc.workers = (int)o->workers;
     jc.queue_max = (int)o->queue_max;
     jc.job_timeout = o->job_timeout;
-    jc.shared = strcmp(store_backend_name(d->st), "postgresql") == 0;
+    jc.shared = (store_caps(d->st) & STORE_CAP_SHARED) != 0;
     jc.lease = o->lease;
     jc.limits = hc.limits;
     rc = jobs_start(&d->j, d->st, d->mx, &jc);

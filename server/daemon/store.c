@@ -331,6 +331,11 @@ const char *store_backend_name(store *s)
     return s->be->name;
 }
 
+unsigned store_caps(store *s)
+{
+    return s->be->caps;
+}
+
 const char *store_owner(store *s)
 {
     return s->owner;

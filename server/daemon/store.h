@@ -311,8 +311,24 @@ void store_close(store *s);
  *  PostgreSQL: the table spinmodal_schema), as seen at open. */
 int store_schema_version(store *s);
 
-/** "sqlite" or "postgresql": the backend store_open_with chose. */
+/** "sqlite" or "postgresql": the backend store_open_with chose.  For the log
+ *  only: ask what a backend can do with store_caps, never its name. */
 const char *store_backend_name(store *s);
+
+/* What a backend can do (store_caps: a capability of the store, not a name
+ * to compare). */
+enum {
+    /* Several replicas share this store (PostgreSQL): a claim holds a lease
+     * the claimer renews (store_renew_lease, store_requeue_expired), and
+     * other replicas' submissions arrive without a signal to this process. */
+    STORE_CAP_SHARED = 1u << 0,
+    /* The path is a connection URI that may hold a password (PostgreSQL):
+     * never log it. */
+    STORE_CAP_SECRET_PATH = 1u << 1
+};
+
+/** The STORE_CAP_* bits of the backend store_open_with chose. */
+unsigned store_caps(store *s);
 
 /**
  * The owner id this store stamps on the jobs it claims (settings' owner,

@@ -619,6 +619,7 @@ static int pg_state_of(store *s, const char *id, store_state *state)
 
 const store_backend store_pg_backend = {
     .name = "postgresql",
+    .caps = STORE_CAP_SHARED | STORE_CAP_SECRET_PATH,
     .open = store_pg_open,
     .close = store_pg_close,
     .schema_version = store_pg_schema_version,

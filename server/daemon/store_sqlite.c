@@ -668,6 +668,7 @@ static int sq_state_of(store *s, const char *id, store_state *state)
 
 const store_backend store_sqlite_backend = {
     .name = "sqlite",
+    .caps = 0, /* one process, one file: not shared, the path is no secret */
     .open = store_sqlite_open,
     .close = store_sqlite_close,
     .schema_version = store_sqlite_schema_version,

@@ -166,6 +166,8 @@ static void test_lifecycle(const backend *b, store *s, const char *path)
     CHECK(store_schema_version(s) == 1, "fresh schema version 1, got %d", store_schema_version(s));
     CHECK(!strcmp(store_backend_name(s), b->pg ? "postgresql" : "sqlite"), "backend %s",
           store_backend_name(s));
+    CHECK(store_caps(s) == (b->pg ? STORE_CAP_SHARED | STORE_CAP_SECRET_PATH : 0u),
+          "capabilities %#x", store_caps(s));
     if (!b->pg)
         CHECK(raw_text(path, "PRAGMA journal_mode", buf, sizeof buf) == SQLITE_OK &&
                   !strcmp(buf, "wal"), "journal mode wal, got '%s'", buf);
