@@ -105,7 +105,7 @@ static int est_check_level(const sm_structure *st, const sm_options *opt,
     free(mem);
     if (rc != SM_OK)
         return rc;
-    dofs = (st->spatial ? 6 : 3) * info->max_frame_nodes;
+    dofs = info->node_dof * info->max_frame_nodes;
     if (est->max_elements > 0 && info->elements > est->max_elements)
         return est_fail(d, SM_LIMIT, "the model refined for the error estimate (%s) would have "
                         "%d FE elements, more than the limit of %d", level > 1 ? "h/4" : "h/2",
@@ -458,7 +458,7 @@ static int est_run(const sm_model *m, const sm_structure *st, const sm_options *
 
     sm_model_get_info(m, &ib);
     nb = ib.nodes;
-    len = (size_t)(st->spatial ? 6 : 3) * (size_t)nb;
+    len = (size_t)ib.node_dof * (size_t)nb;
     map = malloc((size_t)nb * sizeof *map);
     if (!map)
         return SM_NOMEM;

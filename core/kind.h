@@ -96,10 +96,31 @@ typedef struct smi_kind {
     /** nodes (node_dof n_nodes) = the steady-state positions and rotations at the kinematics
      *  in k; returns the largest rotation of a node relative to its frame, its node in *at. */
     double (*nodes)(const sm_model *m, void *k, double *nodes, int *at);
+
+    /* ---- mode labels (labels.c, DESIGN.md 9.1) ---- */
+    int label_bending;  /* 1: the bending slot is labelled "bending" (no edge / flap split) */
+    /** Element e's axes t, p2, p3 (hub frame) at the steady state of case c. */
+    void (*label_axes)(const sm_model *m, const sm_case *c, const sm_elem *e, double t[3],
+                       double p2[3], double p3[3]);
+    /** Node k of the real nodal shape s as a translation d and a rotation r in 3D. */
+    void (*label_node)(const double *s, int k, double d[3], double r[3]);
+    /** e += the rotary kinetic parts at one end of E (tx, r2, r3: its rotation about t, p2,
+     *  p3); NULL: the kind has no rotary inertia. */
+    void (*label_rotary)(const sm_elem *E, double tx, double r2, double r3,
+                         double e[SM_ENERGY_PARTS]);
+    /** e[5..7] += bending and torsion strain of E from its ends' motion. */
+    void (*label_strain)(const sm_elem *E, const double v[2], const double w[2], const double tx[2],
+                         const double r2[2], const double r3[2], double e[SM_ENERGY_PARTS]);
+    /** e += the point-mass rotary parts at the far node of element el for shape s; NULL: none. */
+    void (*label_point)(const sm_model *m, const sm_case *c, int el, const double *s,
+                        double e[SM_ENERGY_PARTS]);
 } smi_kind;
 
 extern const smi_kind smi_kind_planar;  /* kind_planar.c */
 extern const smi_kind smi_kind_spatial; /* kind_spatial.c */
+
+/** The kind of structure st (mesh.c: the one place that picks; mesh_build stores it in m->kind). */
+const smi_kind *smi_kind_of(const sm_structure *st);
 
 /** Free the matrices of D and zero it; safe on a zeroed one. */
 void smi_dense_free(smi_dense *D);

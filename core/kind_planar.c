@@ -10,6 +10,7 @@
  * the planar path made before the table existed, in the same order (planar answers are
  * byte-identical).
  */
+#include "element.h"
 #include "kind.h"
 
 #include <math.h>
@@ -235,6 +236,38 @@ static double planar_nodes(const sm_model *m, void *kin, double *nodes, int *at)
     return rot;
 }
 
+/* t along the deformed chord n1 -> n2, p2 the in-plane normal, p3 = z. */
+static void planar_label_axes(const sm_model *m, const sm_case *c, const sm_elem *e, double t[3],
+                              double p2[3], double p3[3])
+{
+    const double *a = c->nodes + (size_t)3 * e->n1, *b = c->nodes + (size_t)3 * e->n2;
+    double n;
+
+    (void)m;
+    t[0] = b[0] - a[0], t[1] = b[1] - a[1], t[2] = 0;
+    n = sqrt(smi_dot3(t, t));
+    for (int k = 0; k < 3; k++)
+        t[k] /= n;
+    p2[0] = -t[1], p2[1] = t[0], p2[2] = 0;
+    p3[0] = 0, p3[1] = 0, p3[2] = 1;
+}
+
+/* (dx, dy, dphi) -> (dx, dy, 0), (0, 0, dphi). */
+static void planar_label_node(const double *s, int k, double d[3], double r[3])
+{
+    d[0] = s[3 * (size_t)k], d[1] = s[3 * (size_t)k + 1], d[2] = 0;
+    r[0] = 0, r[1] = 0, r[2] = s[3 * (size_t)k + 2];
+}
+
+/* In-plane bending (EI) in the edge slot; no torsion. */
+static void planar_label_strain(const sm_elem *E, const double v[2], const double w[2],
+                                const double tx[2], const double r2[2], const double r3[2],
+                                double e[SM_ENERGY_PARTS])
+{
+    (void)w, (void)tx, (void)r2;
+    e[5] += smi_elem_bending_energy(E->EI, E->l, v[0], r3[0], v[1], r3[1]);
+}
+
 const smi_kind smi_kind_planar = {
     .name = "planar",
     .spatial = 0,
@@ -261,4 +294,10 @@ const smi_kind smi_kind_planar = {
     .tree_assemble = planar_tree_assemble,
     .nodal = planar_nodal,
     .nodes = planar_nodes,
+    .label_bending = 1,
+    .label_axes = planar_label_axes,
+    .label_node = planar_label_node,
+    .label_rotary = NULL,
+    .label_strain = planar_label_strain,
+    .label_point = NULL,
 };

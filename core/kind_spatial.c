@@ -8,6 +8,7 @@
  * complex step), lin3.c (f_g, tangent, M*, C*, nodal outputs), tree3.c (the block form).
  * Each entry makes the calls the spatial path made before the table, in the same order.
  */
+#include "element.h"
 #include "kind.h"
 #include "spatial.h"
 
@@ -102,6 +103,93 @@ static double spatial_nodes(const sm_model *m, void *k, double *nodes, int *at)
     return lin3_nodes(m, k, nodes, at);
 }
 
+/* v rotated by the rotation vector psi (Rodrigues): v cos + (k x v) sin + k (k.v)(1 - cos). */
+static void spatial_rotate(const double psi[3], double v[3])
+{
+    double th = sqrt(smi_dot3(psi, psi));
+    if (!(th > 0))
+        return;
+    double k[3] = {psi[0] / th, psi[1] / th, psi[2] / th}, kv = smi_dot3(k, v), cs = cos(th), sn = sin(th);
+    double x[3] = {k[1] * v[2] - k[2] * v[1], k[2] * v[0] - k[0] * v[2], k[0] * v[1] - k[1] * v[0]};
+    for (int i = 0; i < 3; i++)
+        v[i] = v[i] * cs + x[i] * sn + k[i] * kv * (1 - cs);
+}
+
+/* t along the deformed chord n1 -> n2, p2 the rest p2 turned by the mean rotation of the two
+ * nodes and made normal to t, p3 = t x p2. */
+static void spatial_label_axes(const sm_model *m, const sm_case *c, const sm_elem *e, double t[3],
+                               double p2[3], double p3[3])
+{
+    const double *a = c->nodes + (size_t)6 * e->n1, *b = c->nodes + (size_t)6 * e->n2;
+    double psi[3], n, d;
+
+    (void)m;
+    t[0] = b[0] - a[0], t[1] = b[1] - a[1], t[2] = b[2] - a[2];
+    n = sqrt(smi_dot3(t, t));
+    for (int k = 0; k < 3; k++)
+        t[k] /= n;
+    for (int k = 0; k < 3; k++) {
+        p2[k] = e->ax[3 + k];
+        psi[k] = 0.5 * (a[3 + k] + b[3 + k]);
+    }
+    spatial_rotate(psi, p2);
+    d = smi_dot3(p2, t);
+    for (int k = 0; k < 3; k++)
+        p2[k] -= d * t[k];
+    n = sqrt(smi_dot3(p2, p2));
+    for (int k = 0; k < 3; k++)
+        p2[k] /= n;
+    p3[0] = t[1] * p2[2] - t[2] * p2[1];
+    p3[1] = t[2] * p2[0] - t[0] * p2[2];
+    p3[2] = t[0] * p2[1] - t[1] * p2[0];
+}
+
+static void spatial_label_node(const double *s, int k, double d[3], double r[3])
+{
+    memcpy(d, s + 6 * (size_t)k, 3 * sizeof(double));
+    memcpy(r, s + 6 * (size_t)k + 3, 3 * sizeof(double));
+}
+
+/* Half the section's rotary inertia at each end: i_flap + i_edge on tx, i_flap on p2.r,
+ * i_edge on p3.r. */
+static void spatial_label_rotary(const sm_elem *E, double tx, double r2, double r3,
+                                 double e[SM_ENERGY_PARTS])
+{
+    e[3] += 0.5 * E->l * (E->i_flap + E->i_edge) * tx * tx;
+    e[2] += 0.5 * E->l * E->i_flap * r2 * r2;
+    e[1] += 0.5 * E->l * E->i_edge * r3 * r3;
+}
+
+/* Edge (v' = p3.r), flap (w' = -p2.r) and torsion. */
+static void spatial_label_strain(const sm_elem *E, const double v[2], const double w[2],
+                                 const double tx[2], const double r2[2], const double r3[2],
+                                 double e[SM_ENERGY_PARTS])
+{
+    e[5] += smi_elem_bending_energy(E->EI_edge, E->l, v[0], r3[0], v[1], r3[1]);
+    e[6] += smi_elem_bending_energy(E->EI_flap, E->l, w[0], -r2[0], w[1], -r2[1]);
+    e[7] += smi_elem_bar_energy(E->GJ, E->l, tx[0], tx[1]);
+}
+
+/* Point-mass rotary inertia of the far node of element el in the axes (t, p2, p3): its
+ * diagonal. */
+static void spatial_label_point(const sm_model *m, const sm_case *c, int el, const double *s,
+                                double e[SM_ENERGY_PARTS])
+{
+    const sm_elem *E = &m->elems[el];
+    const double *P = m->nodes[E->n2].point_rot;
+    double t[3], p2[3], p3[3], d[3], r[3], *ax[3] = {t, p2, p3};
+    int slot[3] = {3, 2, 1}; /* about t: torsion; about p2: flap; about p3: edge */
+
+    spatial_label_axes(m, c, E, t, p2, p3);
+    spatial_label_node(s, E->n2, d, r);
+    for (int a = 0; a < 3; a++) {
+        double Pa[3], ra = smi_dot3(ax[a], r);
+        for (int i = 0; i < 3; i++)
+            Pa[i] = P[i] * ax[a][0] + P[i + 3] * ax[a][1] + P[i + 6] * ax[a][2];
+        e[slot[a]] += smi_dot3(ax[a], Pa) * ra * ra; /* (a' P a) (a.r)^2 */
+    }
+}
+
 const smi_kind smi_kind_spatial = {
     .name = "spatial",
     .spatial = 1,
@@ -128,4 +216,10 @@ const smi_kind smi_kind_spatial = {
     .tree_assemble = spatial_tree_assemble,
     .nodal = spatial_nodal,
     .nodes = spatial_nodes,
+    .label_bending = 0,
+    .label_axes = spatial_label_axes,
+    .label_node = spatial_label_node,
+    .label_rotary = spatial_label_rotary,
+    .label_strain = spatial_label_strain,
+    .label_point = spatial_label_point,
 };

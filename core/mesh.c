@@ -22,7 +22,7 @@
 #define MESH_Z(st, j) ((st)->joint_z ? (st)->joint_z[j] : 0.0)
 
 /* The one place that picks the structure kind (kind.h): spatial sections make a spatial model. */
-static const smi_kind *mesh_kind(const sm_structure *st)
+const smi_kind *smi_kind_of(const sm_structure *st)
 {
     return st->spatial ? &smi_kind_spatial : &smi_kind_planar;
 }
@@ -116,7 +116,7 @@ static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
     for (int j = 0; j < st->n_joints; j++)
         if (!isfinite(st->joint_xy[2 * j]) || !isfinite(st->joint_xy[2 * j + 1]))
             return mesh_fail(d, SM_ITEM_JOINT, j, "", "joint coordinates must be finite numbers");
-    int rc = mesh_kind(st)->check(st, o, d);
+    int rc = smi_kind_of(st)->check(st, o, d);
     if (rc < 0)
         return rc;
     long total = 0;
@@ -424,7 +424,7 @@ int mesh_build(sm_model *m, const sm_structure *st, sm_diag *d)
     if (rc < 0)
         goto done;
     m->spatial = st->spatial != 0;
-    m->kind = mesh_kind(st);
+    m->kind = smi_kind_of(st);
     rc = mesh_nodes(m, st, order, near);
     if (rc == SM_OK && m->kind->elements)
         rc = m->kind->elements(m, st, d);

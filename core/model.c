@@ -96,6 +96,7 @@ static void model_mesh_info(const sm_model *m, sm_model_info *info)
     info->elements = m->n_elems;
     info->frames = m->n_subs;
     info->spatial = m->kind->spatial;
+    info->node_dof = m->kind->node_dof;
     for (int s = 0; s < m->n_subs; s++)
         if (m->subs[s].nfree > info->max_frame_nodes)
             info->max_frame_nodes = m->subs[s].nfree;

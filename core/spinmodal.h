@@ -297,6 +297,7 @@ typedef struct sm_model_info {
                             problem has ~3x that many DOF); free nodes: the frame's root node,
                             clamped in its basis, is not counted, so the DOF are exactly 3x */
     int spatial;        /* 1 for a spatial model (6 DOF per node), 0 planar */
+    int node_dof;       /* values per node in nodes and mode shapes: 3 planar, 6 spatial */
     int structured;     /* 1 when the solves take the tree-structured path (cost ~ linear in
                            the size; sm_options.solver, or the automatic choice: at least 200
                            coordinates, frames of at most 40, 8 x modes <= coordinates and at
