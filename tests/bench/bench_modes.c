@@ -1,7 +1,7 @@
 /*
  * bench_modes.c — the model build of one large frame keeping few modes (issue 10): the dense
  * complete component-mode decomposition (sm_options.solver = SM_SOLVER_DENSE, the path of
- * every frame before core/lowmodes.c) against the sparse path (the default), as ratios measured
+ * every frame before core/solve/lowmodes.c) against the sparse path (the default), as ratios measured
  * in one run.
  *
  * One clamped cantilever in a single frame of D = 300, 600, 1200, 2400 DOF (planar: D/3

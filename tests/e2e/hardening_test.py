@@ -490,7 +490,7 @@ def scenario_db_faults(exe, tmp):
 
 # Five 1200-DOF frames keeping 160 modes each: more than D/8, so each frame's component modes
 # come from the dense complete eigen-solve (~0.5 s a frame; a frame keeping few modes takes the
-# sparse path of core/lowmodes.c in milliseconds and would leave no build to stop).
+# sparse path of core/solve/lowmodes.c in milliseconds and would leave no build to stop).
 HEAVY = (b'{"structure":{"joints":{"O":[0,0],"T":[60,0]},"sections":{"s":{"E":7e10,"A":4e-4,'
          b'"I":2e-7,"mass_per_length":1.2}},"members":[{"id":"m","from":"O","to":"T",'
          b'"section":"s","elements":2000}],"clamp":"O"},"frames":{"elements_per_frame":400},'
