@@ -32,7 +32,7 @@
 
 #include "spinmodal.h"
 
-#define CONFIG_TOKEN_MAX 4096   /* bytes of a token file */
+#define CONFIG_TOKEN_MAX 4096 /* bytes of a token file */
 
 /* The flags, in --help order. */
 enum {
@@ -65,11 +65,11 @@ enum {
 };
 
 typedef struct config_flag {
-    const char *name;   /* without the leading -- */
-    const char *env;    /* environment variable */
-    const char *arg;    /* argument name in --help */
-    const char *def;    /* default in --help */
-    const char *help;   /* one line */
+    const char *name; /* without the leading -- */
+    const char *env;  /* environment variable */
+    const char *arg;  /* argument name in --help */
+    const char *def;  /* default in --help */
+    const char *help; /* one line */
 } config_flag;
 
 static const config_flag config_flags[F_N] = {
@@ -428,8 +428,9 @@ static int config_waiters(config_opts *o)
     }
     if (o->max_waiters <= o->max_connections / 2)
         return 0;
-    fprintf(stderr, "spinmodald: --max-waiters needs at most half of --max-connections (%ld), "
-                    "not '%ld'.\nTry 'spinmodald --help'.\n",
+    fprintf(stderr,
+            "spinmodald: --max-waiters needs at most half of --max-connections (%ld), "
+            "not '%ld'.\nTry 'spinmodald --help'.\n",
             o->max_connections / 2, o->max_waiters);
     return CONFIG_EXIT_USAGE;
 }

@@ -15,26 +15,26 @@ enum { CONFIG_EXIT_START = 1, CONFIG_EXIT_USAGE = 64 };
 
 /* The effective settings. */
 typedef struct config_opts {
-    char host[256];          /* listen address, without brackets */
-    int port;                /* 0..65535 */
-    int ipv6;                /* host was given in [brackets] */
+    char host[256]; /* listen address, without brackets */
+    int port;       /* 0..65535 */
+    int ipv6;       /* host was given in [brackets] */
     const char *db;
     long workers, queue_max, max_body, max_elements, max_speeds, max_coordinates, max_frame_dofs;
-    double job_timeout;      /* s, > 0 */
-    double shutdown_grace;   /* s, >= 0 */
-    double retain_age;       /* s, 0 = no age bound */
-    const char *replica_id;  /* NULL = generated */
-    double lease;            /* s, PostgreSQL claims */
-    double db_timeout;       /* s, deadline of one store call */
-    long long retain_bytes;  /* bytes, 0 = no size bound */
+    double job_timeout;         /* s, > 0 */
+    double shutdown_grace;      /* s, >= 0 */
+    double retain_age;          /* s, 0 = no age bound */
+    const char *replica_id;     /* NULL = generated */
+    double lease;               /* s, PostgreSQL claims */
+    double db_timeout;          /* s, deadline of one store call */
+    long long retain_bytes;     /* bytes, 0 = no size bound */
     long long max_result_bytes; /* estimated bytes of a result document, 0 = no limit */
-    const char *token_file;  /* NULL = no auth */
-    int auth_reads;          /* 1: reads need the token too */
-    const char *cors_origin; /* NULL = no CORS */
-    long per_client;         /* connections per IP address, 0 = no limit */
-    long max_connections;    /* open connections, >= 32 */
-    long max_waiters;        /* waiting long polls, <= max_connections / 2; -1 = a quarter */
-    double request_deadline; /* s, > 0 */
+    const char *token_file;     /* NULL = no auth */
+    int auth_reads;             /* 1: reads need the token too */
+    const char *cors_origin;    /* NULL = no CORS */
+    long per_client;            /* connections per IP address, 0 = no limit */
+    long max_connections;       /* open connections, >= 32 */
+    long max_waiters;           /* waiting long polls, <= max_connections / 2; -1 = a quarter */
+    double request_deadline;    /* s, > 0 */
     log_format format;
 } config_opts;
 

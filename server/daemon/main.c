@@ -115,8 +115,8 @@ static int main_open(const config_opts *o, main_daemon *d)
     }
     snprintf(n, sizeof(n), "%d", requeued);
     log_event("info", "recovered", "jobs", n, "backend", store_backend_name(d->st), "owner",
-              store_owner(d->st), "db",
-              store_caps(d->st) & STORE_CAP_SECRET_PATH ? NULL : o->db, (const char *)NULL);
+              store_owner(d->st), "db", store_caps(d->st) & STORE_CAP_SECRET_PATH ? NULL : o->db,
+              (const char *)NULL);
     return 0;
 }
 

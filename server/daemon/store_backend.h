@@ -22,8 +22,8 @@
  * of the public functions of the same name in store.h.  open sets s->impl
  * (NULL on failure, after freeing what it made); close frees it. */
 typedef struct store_backend {
-    const char *name;   /* "sqlite", "postgresql": for the log only */
-    unsigned caps;      /* STORE_CAP_* (store.h): what callers may ask instead of the name */
+    const char *name; /* "sqlite", "postgresql": for the log only */
+    unsigned caps;    /* STORE_CAP_* (store.h): what callers may ask instead of the name */
     int (*open)(store *s, const store_settings *set, int *requeued, char *err, size_t errlen);
     void (*close)(store *s);
     int (*schema_version)(store *s);
