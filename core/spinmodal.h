@@ -601,6 +601,98 @@ int sm_estimate(const sm_model *m, const sm_structure *st, const sm_options *opt
                 const double *omegas, int n_omegas, const sm_estimate_options *est,
                 sm_progress_fn cb, void *user, sm_result *res, sm_diag *diag);
 
+/* ------------------------------------------------ ElastoDyn mode shapes */
+
+/** A fitted mode below this share of its bending strain energy in the selected direction is
+ *  fitted with a warning (DESIGN §B). */
+#define SM_ED_CLEAN 0.9
+
+/** One ElastoDyn polynomial (DESIGN §B "ElastoDyn polynomial fit"): phi(x) = sum over
+ *  k = 2..6 of coef[k-2] x^k, x from the flexible root (0) to the tip (1). */
+typedef struct sm_ed_fit {
+    int mode;                 /* index of the fitted mode in its case; -1: no mode qualified */
+    int direction;            /* 0: direction a (blade flap, tower fore-aft), 1: direction b */
+    double coef[5];           /* C2..C6, C6 = 1 - (C2 + ... + C5): phi(0) = phi'(0) = 0, phi(1) = 1 */
+    double tip;               /* the signed tip displacement the shape was divided by (units of
+                                 the input) */
+    double share;             /* the direction's share of the mode's bending strain energy
+                                 (NaN when no energy was given) */
+    int warning;              /* 1 when share < SM_ED_CLEAN */
+    double rms, max_residual; /* residuals phi(x_j) - y_j/tip over the nodes (root included) */
+    double tip_slope_fe;      /* d(y/tip)/dx at the tip from the FE rotations, NaN when not given */
+    double tip_slope_fit;     /* phi'(1) = sum k C_k */
+    double tip_slope_error;   /* (tip_slope_fit - tip_slope_fe) / |tip_slope_fe|, NaN when not
+                                 given */
+} sm_ed_fit;
+
+/**
+ * Fit one shape: y[0..n) at x[0..n) (x in [0, 1], the last node the tip, x = 1), tip_slope
+ * dy/dx at the tip in the units of y per unit x (NaN: unknown).  Normalises by the signed
+ * tip value y[n-1] and solves the unweighted least squares on the basis x^k - x^6 (k = 2..5)
+ * with right-hand side y/tip - x^6.  fit->mode, direction, share and warning are left for
+ * the caller (set to -1, 0, NaN, 0).  Returns SM_OK, SM_INVALID_INPUT (n < 4, x outside
+ * [0, 1] or the last x not 1, a zero or non-finite tip value), SM_NOMEM or SM_LAPACK_FAILED.
+ */
+int sm_elastodyn_fit(int n, const double *x, const double *y, double tip_slope, sm_ed_fit *fit);
+
+/** phi(x) of a fit's coefficients (C2..C6); *slope (may be NULL) receives phi'(x). */
+double sm_elastodyn_eval(const double coef[5], double x, double *slope);
+
+/** The modes of one case along one flexible member, projected on two bending directions a
+ *  and b (blade: flap and edge in the principal axes; tower: fore-aft and side-side).
+ *  All arrays borrowed. */
+typedef struct sm_ed_shapes {
+    int n_modes;              /* modes of the case, ascending frequency */
+    int n_nodes;              /* nodes along the member, root first, >= 4 */
+    const double *x;          /* n_nodes: distance from the flexible root / flexible length */
+    const double *re;         /* n_modes * 2 * n_nodes: displacement of mode k in direction d
+                                 at node j is re[(2k + d) n_nodes + j] */
+    const double *im;         /* the same imaginary parts (Coriolis), or NULL */
+    const double *slope_re;   /* n_modes * 2: d(displacement)/dx at the tip, [2k + d], or NULL */
+    const double *slope_im;   /* the same imaginary parts, or NULL */
+    const double *energy;     /* n_modes * SM_ENERGY_PARTS (sm_case.energy) */
+    int part[2];              /* the energy slot (SM_MODE_EDGE or SM_MODE_FLAP) of a and b */
+} sm_ed_shapes;
+
+/**
+ * Select and fit (DESIGN §B): fits[0 .. want[0]) are the want[0] lowest modes whose kinetic
+ * energy in direction a exceeds that in b, fits[want[0] .. want[0] + want[1]) the want[1]
+ * lowest with b above a; a mode whose kinetic bending (a + b) is below its axial plus
+ * torsion is no candidate (torsion and axial modes are excluded by energy).  A complex mode
+ * is turned so that its tip displacement is real: y = Re(z / z_tip) x |z_tip|.  A slot with
+ * no qualifying mode has mode -1.  Returns SM_OK or the first failure of sm_elastodyn_fit
+ * (SM_INVALID_INPUT also for want outside 0..8 or a bad part).
+ */
+int sm_elastodyn_fit_modes(const sm_ed_shapes *s, const int want[2], sm_ed_fit *fits);
+
+/**
+ * Project one mode shape on a member's principal axes (DESIGN.md 9.3): rows[6 j .. 6 j + 6)
+ * the displacement and small rotation (hub frame) of the member's node j (n nodes, root
+ * first), ax the member's axes without twist [e1 | e2 | e3] (sm_model_member_axes),
+ * twist[j] the structural twist there (rad about e1), length the member's length.  out[j]
+ * receives the flap displacement p3.u and out[n + j] the edge displacement p2.u, with
+ * p2 = cos t e2 + sin t e3, p3 = -sin t e2 + cos t e3; slope[0], slope[1] the tip slopes
+ * d(flap)/dx = -L p2.r and d(edge)/dx = L p3.r per unit x = s (the twist rate times the
+ * displacement left out).  All arrays borrowed.
+ */
+void sm_elastodyn_project(int n, const double ax[9], const double *twist, double length,
+                          const double *rows, double *out, double slope[2]);
+
+/** The blade's three ElastoDyn shapes, in this order in sm_elastodyn_blade's fits. */
+enum { SM_ED_FLAP1, SM_ED_FLAP2, SM_ED_EDGE1, SM_ED_BLADE_FITS };
+
+/**
+ * BldFl1Sh, BldFl2Sh, BldEdgSh of case c (a case of sm_solve(m, ...) with mode shapes and
+ * labels) along member `member` of the spatial model m, its `from` joint the flexible root:
+ * each node's displacement projected on its principal axes (p3 flap, p2 edge: the member's
+ * axes turned by the structural twist at the node, as ElastoDyn's shapes are), the tip
+ * slopes from the rotations, then sm_elastodyn_fit_modes with want {2, 1}.  Returns SM_OK,
+ * SM_INVALID_INPUT (planar model, no such member, a case without shapes or energies, fewer
+ * than 4 nodes), SM_NOMEM or a failure of sm_elastodyn_fit.
+ */
+int sm_elastodyn_blade(const sm_model *m, const sm_case *c, int member,
+                       sm_ed_fit fits[SM_ED_BLADE_FITS]);
+
 #ifdef __cplusplus
 }
 #endif
