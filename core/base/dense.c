@@ -71,3 +71,20 @@ int dm_lapack_status(int info, int on_positive)
         return SM_NOMEM;
     return info < 0 ? SM_LAPACK_FAILED : on_positive;
 }
+
+int dm_sytrf_negative(int n, const double *A, const int *ipiv)
+{
+    int neg = 0;
+    for (int k = 0; k < n; k++) {
+        double a = A[(size_t)k * n + k];
+        if (ipiv[k] > 0 || k + 1 == n) {
+            neg += a < 0;
+        } else {
+            double b = A[(size_t)k * n + k + 1], c = A[(size_t)(k + 1) * n + k + 1];
+            double det = a * c - b * b;
+            neg += det < 0 ? 1 : (a < 0 ? 2 : 0);
+            k++;
+        }
+    }
+    return neg;
+}

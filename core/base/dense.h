@@ -39,4 +39,9 @@ int dm_finite(const dmat *m);
  */
 int dm_lapack_status(int info, int on_positive);
 
+/** Negative eigenvalues of a symmetric n x n matrix from its Bunch-Kaufman factors (LAPACK dsytrf,
+ *  lower, column-major A with its ipiv): Sylvester's law of inertia; a 2x2 pivot block counts by
+ *  its determinant.  The one inertia count of the core (eigen.c, tree.c). */
+int dm_sytrf_negative(int n, const double *A, const int *ipiv);
+
 #endif

@@ -1,11 +1,11 @@
 /*
- * rot3.c — 3x3 rotations for the spatial path (spatial.h): the exponential
+ * rot3.c — 3x3 rotations (rot3.h), real and complex: the exponential
  * map Lambda(psi) = exp(skew psi) of DESIGN.md 7.2 and its left tangent T
  * (d Lambda = skew(T d psi) Lambda), written so that every function is
  * analytic in psi (powers of psi.psi, no conjugates, series near zero):
  * frames3.c differentiates the kinematics by complex steps through them.
  */
-#include "spatial.h"
+#include "rot3.h"
 
 #include <math.h>
 #include <string.h>

@@ -20,6 +20,7 @@
 #define SM_INTERNAL_H
 
 #include "spinmodal.h"
+#include "csym.h"
 #include "dense.h"
 
 /* FE node. */
@@ -30,7 +31,7 @@ typedef struct sm_node {
     int sub;            /* substructure that holds it as a free node, -1 for the clamp */
     int local;          /* free-node index within that substructure, -1 for the clamp */
     int joint;          /* joint index, -1 for member-interior nodes */
-    /* spatial models (m->spatial) */
+    /* spatial kind only */
     double z;           /* undeformed z, hub frame */
     double rot[9];      /* lumped rotary inertia tensor about the node, hub axes at rest, kg m^2
                            (section tributaries + point-mass inertia), column-major 3x3 */
@@ -121,7 +122,6 @@ struct sm_model {
     sm_mpoint *mp;      /* mass points */
     int clamp_node;     /* = 0 */
     const struct smi_kind *kind; /* planar or spatial (kind.h): picked by mesh_build */
-    int spatial;        /* 1: DESIGN.md 7 (6 DOF per node, spatial.h); read only by the picker */
     int n_pt;           /* spatial: points = the FE nodes (0 .. n_nodes-1) + quadrature points */
     struct sp_point *pt; /* spatial: n_pt points (spatial.h) */
 };
@@ -176,6 +176,10 @@ int modes_build(sm_model *m, sm_progress_fn cb, void *user, sm_diag *diag);
  * returns *nm + *na.  No allocation, no status; cost O(1).
  */
 int modes_count(const sm_options *o, const sm_sub *b, int *nm, int *na);
+/** *K, *M = Kbar and Mbar of planar substructure b (lumped mass = the node masses on u, v) in
+ *  their sparse pattern, entry for entry the matrices of the dense path.  SM_OK or SM_NOMEM;
+ *  K, M owned by the caller (csym_free, also after a failure). */
+int modes_frame_csym(const sm_model *m, const sm_sub *b, csym *K, csym *M);
 /** Basis, K_s, T_e, d_e of planar substructure b (the planar kind's basis; modes_build calls it
  *  through m->kind).  SM_OK, SM_NOMEM, SM_SINGULAR or SM_LAPACK_FAILED. */
 int modes_planar_sub(const sm_model *m, sm_sub *b);
@@ -346,6 +350,9 @@ void tree_apply(const sm_model *m, tree_ws *t, int which, const double *x, doubl
 /** u (d S) = the frame pose increments dy/dq x (forward recursion along the tree, links of the
  *  last assembly). */
 void tree_forward(const sm_model *m, const tree_ws *t, const double *x, double *u);
+/** y += the adjoint recursion of the tree's links applied to v (d S; destroyed): the transpose of
+ *  tree_forward, for products and right-hand sides (tree.c; the planar blocks use it). */
+void tree_adjoint(const sm_model *m, const tree_ws *t, double *v, double *y);
 /** d (3 n_nodes) = nodal (dx, dy, dphi) = J_k x in the hub frame at the kinematics k. */
 void tree_nodal(const sm_model *m, const sm_kin *k, tree_ws *t, const double *x, double *d);
 
@@ -416,9 +423,14 @@ int track_assign(int nr, int nc, const double *mac, int *match);
 /** Tracking of the sweep r (ord: the n case indices in ascending speed; shapes present):
  *  mac_to_previous, previous_index, tracked_index, track_flag, track_partner.  SM_OK or SM_NOMEM. */
 int track_sweep(sm_result *r, const int *ord, int n);
-/** Solve at one speed with shapes kept and labels (sweep.c, for the refinement of critical
- *  speeds; no tracking).  *out owned by the caller.  Returns as sm_solve. */
-int sweep_single(const sm_model *m, double omega, sm_progress_fn cb, void *user, sm_result **out);
+/** Every speed of omegas (n_omegas >= 1, finite, >= 0; else SM_INVALID_INPUT in diag): the
+ *  equilibrium, modes and nodal shapes of each, kept; no labels, tracking or refinements
+ *  (solve/sweep.c; sm_solve adds them).  *out owned by the caller.  Returns as sm_solve. */
+int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress_fn cb, void *user,
+              sm_result **out, sm_diag *diag);
+/** ord (n case indices) = the speeds of omegas in ascending order, ties in input order.
+ *  SM_OK or SM_NOMEM. */
+int sweep_order(const double *omegas, int n, int *ord);
 /** Critical speeds of the tracked sweep r for m->opt.engine_orders into r->critical (cb, user:
  *  the caller's cancel callback, asked between refining solves).  SM_OK, SM_NOMEM, SM_CANCELED. */
 int crit_find(const sm_model *m, sm_result *r, const int *ord, int n, sm_progress_fn cb, void *user);

@@ -423,7 +423,6 @@ int mesh_build(sm_model *m, const sm_structure *st, sm_diag *d)
     rc = mesh_walk(st, order, near, d);
     if (rc < 0)
         goto done;
-    m->spatial = st->spatial != 0;
     m->kind = smi_kind_of(st);
     rc = mesh_nodes(m, st, order, near);
     if (rc == SM_OK && m->kind->elements)

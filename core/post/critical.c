@@ -7,7 +7,7 @@
  * between consecutive speeds of the sweep (both solved, stable, without a
  * validity warning, no failed speed between them) where g = w - n Omega
  * changes sign, the crossing is interpolated linearly and then refined by
- * solving the model at single speeds (sweep_single, from rest with
+ * solving the model at single speeds (crit_single, from rest with
  * continuation) inside the bracket: regula falsi with the Illinois
  * modification, the mode at each trial speed being the one of largest MAC to
  * the line's mode at the nearer end of the bracket.  It stops when
@@ -36,6 +36,17 @@ typedef struct crit_ctx {
     int total;                /* speeds of the sweep */
     int canceled;
 } crit_ctx;
+
+/* Solve at one speed with shapes kept and labels (no tracking); *out owned by the caller. */
+static int crit_single(const sm_model *m, double omega, sm_progress_fn cb, void *user, sm_result **out)
+{
+    int rc = sweep_run(m, &omega, 1, cb, user, out, NULL);
+    if (rc == SM_OK && (rc = lab_case(m, &(*out)->cases[0])) < 0) {
+        sm_result_free(*out);
+        *out = NULL;
+    }
+    return rc;
+}
 
 static int crit_cb(void *user, int done, int total)
 {
@@ -67,7 +78,7 @@ static int crit_usable(const sm_case *c)
 static int crit_eval(crit_ctx *x, double om, const sm_case *ref, int rj, double *w, sm_critical *cr, int *ok)
 {
     sm_result *r = NULL;
-    int rc = sweep_single(x->m, om, crit_cb, x, &r), best = -1;
+    int rc = crit_single(x->m, om, crit_cb, x, &r), best = -1;
     double bm = -1;
 
     *ok = 0;

@@ -47,28 +47,14 @@ static int eig_inertia(int n, double *A, int *neg_out)
     *neg_out = 0;
     if (n == 0)
         return SM_OK;
-    int *ipiv = malloc((size_t)n * sizeof(int)), neg = 0;
+    int *ipiv = malloc((size_t)n * sizeof(int));
     if (!ipiv)
         return SM_NOMEM;
     int rc = dm_lapack_status(LAPACKE_dsytrf(LAPACK_COL_MAJOR, 'L', n, A, n, ipiv), SM_OK);
-    if (rc < 0) {
-        free(ipiv);
-        return rc;
-    }
-    for (int k = 0; k < n; k++) {
-        double a = A[(size_t)k * n + k];
-        if (ipiv[k] > 0 || k + 1 == n) {
-            neg += a < 0;
-        } else {
-            double b = A[(size_t)k * n + k + 1], c = A[(size_t)(k + 1) * n + k + 1];
-            double det = a * c - b * b;
-            neg += det < 0 ? 1 : (a < 0 ? 2 : 0);
-            k++;
-        }
-    }
+    if (rc == SM_OK)
+        *neg_out = dm_sytrf_negative(n, A, ipiv);
     free(ipiv);
-    *neg_out = neg;
-    return SM_OK;
+    return rc;
 }
 
 /* *neg = negative eigenvalue count of symmetric A; *chol receives 1 and the

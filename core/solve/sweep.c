@@ -1,8 +1,9 @@
 /*
- * sweep.c — sm_solve: speeds in ascending order with continuation
+ * sweep.c — the speeds of a solve in ascending order with continuation
  * (equilibrium.c), linearisation at each equilibrium (M*, C*, K* with P
- * frozen), the eigen-analysis (eigen.c), mode shapes in the hub frame and
- * mode tracking across speeds by MAC (DESIGN.md 1.3-1.4).
+ * frozen), the eigen-analysis (eigen.c), mode shapes in the hub frame
+ * (DESIGN.md 1.3-1.4).  sm_solve (post/solve.c) adds labels, tracking,
+ * critical and divergence speeds on top; nothing here calls post/.
  */
 #include "linsys.h"
 
@@ -251,7 +252,7 @@ static int sweep_key_cmp(const void *a, const void *b)
 }
 
 /* The speeds of omegas in ascending order (ties in input order) into ord (n case indices). */
-static int sweep_order(const double *omegas, int n, int *ord)
+int sweep_order(const double *omegas, int n, int *ord)
 {
     sweep_key *key = malloc((size_t)(n ? n : 1) * sizeof *key);
     if (!key)
@@ -268,7 +269,7 @@ static int sweep_order(const double *omegas, int n, int *ord)
 }
 
 /* Every speed of omegas: equilibrium, modes and nodal shapes (kept), no tracking. */
-static int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress_fn cb, void *user,
+int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress_fn cb, void *user,
                      sm_result **out, sm_diag *diag)
 {
     sm_diag scratch;
@@ -395,70 +396,4 @@ done:
     smi_lin_free(D);
     free(q);
     return rc;
-}
-
-int sweep_single(const sm_model *m, double omega, sm_progress_fn cb, void *user, sm_result **out)
-{
-    int rc = sweep_run(m, &omega, 1, cb, user, out, NULL);
-    if (rc == SM_OK && (rc = lab_case(m, &(*out)->cases[0])) < 0) {
-        sm_result_free(*out);
-        *out = NULL;
-    }
-    return rc;
-}
-
-/* DESIGN.md 9.1 on a solved sweep: labels, tracking, critical speeds (shapes still present). */
-static int sweep_trust(const sm_model *m, sm_result *r, const double *omegas, int n, sm_progress_fn cb,
-                       void *user)
-{
-    int *ord = malloc((size_t)(n ? n : 1) * sizeof(int)), rc = SM_NOMEM;
-    if (!ord || sweep_order(omegas, n, ord) < 0)
-        goto done;
-    for (int i = 0; i < n; i++)
-        if ((rc = lab_case(m, &r->cases[i])) < 0)
-            goto done;
-    if ((rc = track_sweep(r, ord, n)) < 0)
-        goto done;
-    /* the refinements are extra solves: a stop (cancel, time limit, shutdown) ends them and keeps
-     * what the sweep found */
-    if ((rc = crit_find(m, r, ord, n, cb, user)) == SM_OK)
-        rc = div_find(m, r, ord, n, cb, user);
-    if (rc == SM_CANCELED) {
-        r->refine_stopped = 1;
-        rc = SM_OK;
-    }
-done:
-    free(ord);
-    return rc;
-}
-
-int sm_solve(const sm_model *m, const double *omegas, int n_omegas, sm_progress_fn cb, void *user,
-             sm_result **out, sm_diag *diag)
-{
-    sm_result *r = NULL;
-    int rc = sweep_run(m, omegas, n_omegas, cb, user, &r, diag);
-    if (rc < 0)
-        return rc;
-    if ((rc = sweep_trust(m, r, omegas, n_omegas, cb, user)) < 0) {
-        sm_result_free(r);
-        if (diag) {
-            memset(diag, 0, sizeof *diag);
-            diag->item_index = -1;
-            diag->status = rc;
-            snprintf(diag->message, sizeof diag->message, "%s", sm_strerror(rc));
-        }
-        return rc;
-    }
-    if (!m->opt.mode_shapes || !m->opt.coriolis)
-        for (int i = 0; i < n_omegas; i++) {
-            sm_case *c = &r->cases[i];
-            if (!m->opt.mode_shapes) {
-                free(c->shape_re);
-                c->shape_re = NULL;
-            }
-            free(c->shape_im);
-            c->shape_im = NULL;
-        }
-    *out = r;
-    return SM_OK;
 }

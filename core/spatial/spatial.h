@@ -5,7 +5,7 @@
  * elements, substructures, attachments) and adds, per node, 6 DOF (u, v, w
  * and the small rotation psi, frame coordinates) and rotary inertia.  The
  * modules:
- *   rot3.c    3x3 rotations: Rodrigues exp, its left tangent, log (complex, so
+ *   rot3.c    (base/rot3.h) 3x3 rotations: Rodrigues exp, its left tangent, log (complex, so
  *             that every kinematic quantity is analytic in q)
  *   fe3.c     space-frame element matrices (stiffness, consistent mass, geometric)
  *   mesh3.c   checks of the spatial input, element axes, nodal rotary inertia,
@@ -29,12 +29,7 @@
 
 #include "internal.h"
 
-#include <complex.h>
-/* complex.h's I would clash with the field I of sm_section and sp_point: the imaginary unit is
- * written _Complex_I in the spatial files. */
-#undef I
-
-typedef double complex sp_cx;
+#include "rot3.h"
 
 /* A point that a frame carries: an FE node (shapes, lumped mass) or a quadrature point. */
 typedef struct sp_point {
@@ -57,26 +52,6 @@ typedef struct sp_point {
     const double *N;    /* 6 x m_s rows (u, v, w, psi_x, psi_y, psi_z), column stride ldn */
     int ldn;
 } sp_point;
-
-/* ------------------------------------------------------------- rot3.c */
-/** L = Lambda(psi) = exp(skew psi) and T = its left tangent (d Lambda = skew(T d psi) Lambda);
- *  T may be NULL.  Analytic in psi (series near zero), so complex steps go through. */
-void rot3_exp(const sp_cx psi[3], sp_cx L[9], sp_cx T[9]);
-/** c = a b (3x3). */
-void rot3_mul(const sp_cx a[9], const sp_cx b[9], sp_cx c[9]);
-/** c = a' b (3x3). */
-void rot3_tmul(const sp_cx a[9], const sp_cx b[9], sp_cx c[9]);
-/** y = a x (3x3 times 3). */
-void rot3_mv(const sp_cx a[9], const sp_cx x[3], sp_cx y[3]);
-/** y = a' x. */
-void rot3_tmv(const sp_cx a[9], const sp_cx x[3], sp_cx y[3]);
-/** c = a x b. */
-void rot3_cross(const sp_cx a[3], const sp_cx b[3], sp_cx c[3]);
-/** Rotation vector (rad) of the real rotation matrix R (log map), |v| <= pi. */
-void rot3_log(const double R[9], double v[3]);
-/** Real 3x3 helpers: c = a b, c = a' b. */
-void rot3_mul_r(const double a[9], const double b[9], double c[9]);
-void rot3_tmul_r(const double a[9], const double b[9], double c[9]);
 
 /* -------------------------------------------------------------- fe3.c */
 /* Element DOF order: u1 v1 w1 tx1 ty1 tz1 u2 v2 w2 tx2 ty2 tz2 in the element's principal axes
@@ -106,6 +81,9 @@ int modes3_count(const sm_options *o, const sm_sub *b, int *nm, int *na);
 /** Basis, K_s, T_e and d_e of spatial substructure b (modes_build calls it per substructure).
  *  Returns SM_OK, SM_NOMEM, SM_SINGULAR or SM_LAPACK_FAILED. */
 int modes3_sub(const sm_model *m, sm_sub *b);
+/** *K, *M = Kbar and Mbar of spatial substructure b in their sparse pattern, entry for entry the
+ *  matrices of the dense path.  SM_OK or SM_NOMEM; K, M owned by the caller (csym_free). */
+int modes3_frame_csym(const sm_model *m, const sm_sub *b, csym *K, csym *M);
 /** The points m->pt of a spatial model, after every modes3_sub.  SM_OK or SM_NOMEM. */
 int modes3_points(sm_model *m);
 
@@ -141,6 +119,21 @@ typedef struct sp_kin {
 int sp_kin_alloc(const sm_model *m, sp_kin *k, int jac);
 /** Free and zero k; safe on a zeroed one. */
 void sp_kin_free(sp_kin *k);
+/* frames3.c's complex-state pieces that hessian3.c perturbs (not for other files). */
+/** w, psi (and with want_L Lambda(psi), T(psi)) of point pi at complex q. */
+void sp_point_state(const sm_model *m, sp_kin *k, int pi, const sp_cx *q, int want_L, sp_cx w[3],
+                    sp_cx psi[3], sp_cx L[9], sp_cx T[9]);
+/** The pose (R, A) of frame s from its parent's at complex q. */
+void sp_pose(const sm_model *m, sp_kin *k, int s, const sp_cx *q);
+/** The subtree wrench of frame s (points of s and the wrenches of its children). */
+void sp_frame_wrench(const sm_model *m, sp_kin *k, int s, const sp_cx *q);
+/** The contribution of point p of frame b (pose A, T, offset aw; force F, moment Mo) to gs and
+ *  to the frame's wrench Fs, Ms. */
+void sp_apply(const sm_sub *b, const sp_point *p, const sp_cx A[9], const sp_cx T[9], const sp_cx aw[3],
+              const sp_cx F[3], const sp_cx Mo[3], sp_cx *gs, sp_cx *Fs, sp_cx *Ms);
+/** g at the complex q of k (k->cq), into k->cg: poses, then wrenches leaves first. */
+void sp_centrifugal_c(const sm_model *m, sp_kin *k);
+
 /** Poses and points at q (real); with k->jac also JRT and JW. */
 void sp_eval(const sm_model *m, const double *q, sp_kin *k);
 /** g (n) = d T0~/dq, T0~ = sum_p 1/2 m_p |P r_p|^2 + 1/2 e_z' A_p I_p A_p' e_z (DESIGN.md 7.3):

@@ -34,6 +34,7 @@
  */
 #include "testutil.h"
 
+#include "kind.h"
 #include "spatial.h"
 #include "lowmodes.h"
 
@@ -194,7 +195,7 @@ static int frame_quality(const sm_model *m, const sm_sub *b, quality *qu)
     csym_ldl F = {0};
     dmat Ks = {0};
     int D = b->N.rows, nm, na, rc = -1, fb = 0;
-    if (m->spatial)
+    if (m->kind->spatial)
         modes3_count(&m->opt, b, &nm, &na);
     else
         modes_count(&m->opt, b, &nm, &na);
@@ -204,7 +205,7 @@ static int frame_quality(const sm_model *m, const sm_sub *b, quality *qu)
     double *mu = calloc((size_t)p, sizeof(double)), *Z = calloc((size_t)D * (na ? na : 1), sizeof(double));
     memset(qu, 0, sizeof *qu);
     if (!Kx || !y || !Mx || !X || !mu || !Z ||
-        (m->spatial ? modes3_frame_csym(m, b, &K, &M) : modes_frame_csym(m, b, &K, &M)) ||
+        (m->kind->spatial ? modes3_frame_csym(m, b, &K, &M) : modes_frame_csym(m, b, &K, &M)) ||
         csym_factor(&K, &F) || lowmodes_project(&K, &b->N, &Ks) ||
         lowmodes_solve(&K, &F, &M, nm + 1, X, mu, &fb) || fb)
         goto done;
@@ -235,9 +236,9 @@ static int frame_quality(const sm_model *m, const sm_sub *b, quality *qu)
     for (int i = 0; i < b->m; i++)
         for (int j = 0; j < b->m; j++)
             qu->kerr = fmax(qu->kerr, fabs(DM(&Ks, i, j) - DM(&b->K, i, j)) / sqrt(DM(&Ks, i, i) * DM(&Ks, j, j)));
-    if (na > 0 && (m->spatial || m->opt.mass == SM_MASS_CONSISTENT)) { /* E: unit loads at the attachments */
+    if (na > 0 && (m->kind->spatial || m->opt.mass == SM_MASS_CONSISTENT)) { /* E: unit loads at the attachments */
         for (int a = 0; a < na; a++)
-            Z[(size_t)D * a + (m->spatial ? 6 * b->attach[a / 6] + a % 6 : 3 * b->attach[a] + 2)] = 1.0;
+            Z[(size_t)D * a + (m->kind->spatial ? 6 * b->attach[a / 6] + a % 6 : 3 * b->attach[a] + 2)] = 1.0;
         if (csym_solve_refined(&K, &F, na, Z, D))
             goto done;
         qu->stat = span_distance(D, b->m, b->N.a, na, Z);
@@ -291,7 +292,7 @@ static void compare_frames(const sm_model *ms, const sm_model *md, dense_err *de
     for (int b = 0; b < ms->n_subs; b++) {
         const sm_sub *bs = &ms->subs[b], *bd = &md->subs[b];
         int D = bs->N.rows, nm, na;
-        if (ms->spatial)
+        if (ms->kind->spatial)
             modes3_count(&ms->opt, bs, &nm, &na);
         else
             modes_count(&ms->opt, bs, &nm, &na);
@@ -299,7 +300,7 @@ static void compare_frames(const sm_model *ms, const sm_model *md, dense_err *de
         quality qs = {1, 1, 1, 1, 1}, qd = {1, 1, 1, 1, 1};
         int ok = frame_quality(ms, bs, &qs) == 0 && frame_quality(md, bd, &qd) == 0;
         double tol = fmax(1e-10, (qs.defect + qd.defect) / (1 - qs.rho)), attach = 0, amax = 0;
-        for (int j = nm; !ms->spatial && ms->opt.mass == SM_MASS_LUMPED && j < bs->m; j++)
+        for (int j = nm; !ms->kind->spatial && ms->opt.mass == SM_MASS_LUMPED && j < bs->m; j++)
             for (int r = 0; r < D; r++) {
                 attach = fmax(attach, fabs(DM(&bs->N, r, j) - DM(&bd->N, r, j)));
                 amax = fmax(amax, fabs(DM(&bd->N, r, j)));
@@ -331,7 +332,7 @@ static int accurate_ks(sm_model *md)
         sm_sub *bd = &md->subs[b];
         csym K = {0}, M = {0};
         dmat Ks = {0};
-        int rc = md->spatial ? modes3_frame_csym(md, bd, &K, &M) : modes_frame_csym(md, bd, &K, &M);
+        int rc = md->kind->spatial ? modes3_frame_csym(md, bd, &K, &M) : modes_frame_csym(md, bd, &K, &M);
         if (rc == SM_OK)
             rc = lowmodes_project(&K, &bd->N, &Ks);
         csym_free(&K);

@@ -19,7 +19,8 @@
  * row k of L from the triangular solve L D l_k = A(0:k-1, k).  No pivoting: A
  * is positive definite (Kbar of a clamped frame), a pivot <= 0 says it is not.
  */
-#include "lowmodes.h"
+#include "csym.h"
+#include "spinmodal.h"
 
 #include <math.h>
 #include <stdlib.h>
