@@ -21,6 +21,7 @@
 
 #include "cli_import.h"
 #include "codec.h"
+#include "elastodyn.h"
 #include "spinmodal.h"
 
 /* OpenBLAS: the program chooses its BLAS threads (weak: a reference BLAS links too). */
@@ -53,6 +54,7 @@ static const char cli_usage_text[] =
     "       spinmodal import bmodes|elastodyn|csv FILE [--tip-radius R] [--hub-radius H]\n"
     "                        [--rpm SPEEDS] [--bmodes-mesh K] [--allow-outside] [--pretty] [--full]\n"
     "       spinmodal export spanwise|bmodes RESULT|-\n"
+    "       spinmodal export elastodyn RESULT|- [--case K] [--patch DECK]\n"
     "       spinmodal --help | --version\n";
 
 static void cli_help(void)
@@ -70,7 +72,11 @@ static void cli_help(void)
            "                   speed, a list or START:STOP:COUNT; import --help lists all\n"
            "  export spanwise|bmodes RESULT|-  span-wise mode shapes of a spatial result:\n"
            "                   CSV (s, span_m along the member, flap, edge, twist ...)\n"
-           "                   or BModes' table\n\n"
+           "                   or BModes' table\n"
+           "  export elastodyn RESULT|- [--case K] [--patch DECK]  ElastoDyn blade\n"
+           "                   mode-shape coefficients (BldFl1Sh, BldFl2Sh, BldEdgSh) with\n"
+           "                   the fit report; --patch: DECK with them replaced (case K,\n"
+           "                   default 1), every other byte as it was\n\n"
            "options:\n"
            "  --csv            print the frequency table as CSV instead of JSON\n"
            "  --table          print an aligned table: speed (rad/s, rpm), mode,\n"
@@ -419,6 +425,110 @@ done:
     return rc;
 }
 
+/* Write out[n] to stdout and free it; CLI_OK or CLI_FAILED. */
+static int cli_put(char *out, size_t n)
+{
+    int e = fwrite(out, 1, n, stdout) != n || fflush(stdout);
+
+    free(out);
+    return e ? CLI_FAILED : CLI_OK;
+}
+
+/* The result document at path ("-" = stdin) into *doc; CLI_OK or CLI_FAILED (said why). */
+static int cli_load_result(const char *path, json_t **doc)
+{
+    json_error_t jerr;
+    char *text = NULL;
+    size_t len = 0;
+    int e = cli_read(path, (size_t)1 << 31, &text, &len);
+
+    *doc = NULL;
+    if (e) {
+        fprintf(stderr, "spinmodal: %s: %s\n", path, strerror(e));
+        return CLI_FAILED;
+    }
+    *doc = json_loadb(text, len, 0, &jerr);
+    free(text);
+    if (!*doc) {
+        fprintf(stderr, "spinmodal: %s:%d: not a result document: %s\n", path, jerr.line,
+                jerr.text);
+        return CLI_FAILED;
+    }
+    return CLI_OK;
+}
+
+/* The deck at deck_path with case ci's blade coefficients of doc (elastodyn_patch.c). */
+static int cli_patch_deck(const json_t *doc, long ci, const char *deck_path, char *why,
+                          size_t whycap, char **out, size_t *n)
+{
+    sm_ed_fit fits[SM_ED_BLADE_FITS];
+    char v[CODEC_ED_BLADE_VALUES][CODEC_ED_TEXT];
+    const char *vp[CODEC_ED_BLADE_VALUES];
+    char *deck = NULL;
+    size_t dlen = 0;
+    int st, e, i;
+
+    st = codec_elastodyn_case(doc, (size_t)ci - 1, fits, why, whycap);
+    for (i = 0; st == SM_OK && i < SM_ED_BLADE_FITS; i++)
+        if (fits[i].mode < 0) {
+            snprintf(why, whycap, "case %ld: no mode for %.8s: ask for more modes", ci,
+                     codec_ed_blade_names[5 * i]);
+            st = SM_INVALID_INPUT;
+        }
+    if (st)
+        return st;
+    e = cli_read(deck_path, (size_t)1 << 26, &deck, &dlen);
+    if (e) {
+        snprintf(why, whycap, "%s: %s", deck_path, strerror(e));
+        return SM_INVALID_INPUT;
+    }
+    codec_elastodyn_blade_values(fits, v);
+    for (i = 0; i < CODEC_ED_BLADE_VALUES; i++)
+        vp[i] = v[i];
+    st = codec_elastodyn_patch(out, n, deck, dlen, codec_ed_blade_names, vp,
+                               CODEC_ED_BLADE_VALUES, why, whycap);
+    free(deck);
+    return st;
+}
+
+/* spinmodal export elastodyn RESULT|- [--case K] [--patch DECK]: the coefficients' text
+ * (codec_result_elastodyn, what ?format=elastodyn serves) or the patched DECK. */
+static int cli_export_elastodyn(int argc, char **argv)
+{
+    const char *deck = NULL, *path = NULL;
+    char *out = NULL, why[512] = "", *end;
+    long ci = 1;
+    size_t n = 0;
+    json_t *doc;
+    int i, st;
+
+    for (i = 3; i < argc; i++) {
+        if (!strcmp(argv[i], "--patch") && i + 1 < argc)
+            deck = argv[++i];
+        else if (!strcmp(argv[i], "--case") && i + 1 < argc) {
+            ci = strtol(argv[++i], &end, 10);
+            if (*end || ci < 1 || ci > 1000000)
+                return cli_usage("--case takes a case number from 1");
+        } else if (!path && (argv[i][0] != '-' || !strcmp(argv[i], "-")))
+            path = argv[i];
+        else
+            return cli_usage("export elastodyn takes RESULT|- [--case K] [--patch DECK]");
+    }
+    if (!path)
+        return cli_usage("export elastodyn takes a result file (or -)");
+    if (cli_load_result(path, &doc))
+        return CLI_FAILED;
+    st = deck ? cli_patch_deck(doc, ci, deck, why, sizeof why, &out, &n)
+              : codec_result_elastodyn(&out, &n, doc, why, sizeof why);
+    json_decref(doc);
+    if (st) {
+        fprintf(stderr, "spinmodal: %s: %s\n", st == SM_NOMEM ? "export" : path,
+                st == SM_NOMEM ? "out of memory" : why);
+        return CLI_FAILED;
+    }
+    return cli_put(out, n);
+}
+
 /* spinmodal export spanwise|bmodes RESULT|-: codec_result_spanwise of a result document. */
 static int cli_export_main(int argc, char **argv)
 {
@@ -428,6 +538,8 @@ static int cli_export_main(int argc, char **argv)
     size_t len = 0, n = 0;
     int bmodes, st, e;
 
+    if (argc >= 3 && !strcmp(argv[2], "elastodyn"))
+        return cli_export_elastodyn(argc, argv);
     if (argc != 4)
         return cli_usage("export takes a format (spanwise or bmodes) and a result file (or -)");
     if (strcmp(argv[2], "spanwise") && strcmp(argv[2], "bmodes"))

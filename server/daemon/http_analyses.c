@@ -10,6 +10,7 @@
  * is validated once by the codec; the model is built by the worker that
  * runs the job, never here.
  */
+#include "elastodyn.h"
 #include "http_internal.h"
 
 #include <limits.h>
@@ -197,7 +198,9 @@ enum MHD_Result http_get_analysis(struct MHD_Connection *c, http_req *r)
  * The stored result document text[len] as span-wise shapes (codec_result_spanwise: bmodes 0
  * CSV, 1 the BModes-style table; 409 for a result without them: planar, or without mode
  * shapes) or, bmodes 2, its critical speeds (codec_critical_speeds_csv: the header alone
- * without engine_orders); takes text.
+ * without engine_orders), or, bmodes 3, the ElastoDyn blade coefficients
+ * (codec_result_elastodyn, text; 409 no-elastodyn-shapes without a blade's shapes and
+ * energies); takes text.
  */
 static enum MHD_Result http_spanwise(struct MHD_Connection *c, http_req *r, char *text,
                                      size_t len, int bmodes)
@@ -207,10 +210,14 @@ static enum MHD_Result http_spanwise(struct MHD_Connection *c, http_req *r, char
     size_t n = 0;
     int st = !doc          ? SM_NOMEM
              : bmodes == 2 ? codec_critical_speeds_csv(&out, &n, doc)
+             : bmodes == 3 ? codec_result_elastodyn(&out, &n, doc, why, sizeof why)
                            : codec_result_spanwise(&out, &n, doc, bmodes, why, sizeof why);
 
     json_decref(doc);
     free(text);
+    if (st == SM_INVALID_INPUT && bmodes == 3)
+        return http_problem(c, r, MHD_HTTP_CONFLICT, "no-elastodyn-shapes",
+                            "No ElastoDyn Shapes", why, NULL, 0);
     if (st == SM_INVALID_INPUT)
         return http_problem(c, r, MHD_HTTP_CONFLICT, "no-spanwise-shapes",
                             "No Span-wise Shapes", why, NULL, 0);
@@ -218,11 +225,12 @@ static enum MHD_Result http_spanwise(struct MHD_Connection *c, http_req *r, char
         return http_problem(c, r, MHD_HTTP_SERVICE_UNAVAILABLE, "out-of-memory",
                             "Out Of Memory", "The shapes could not be written.", NULL, 0);
     return http_respond(c, r, MHD_HTTP_OK,
-                        bmodes == 1 ? "text/plain; charset=utf-8" : "text/csv; charset=utf-8",
+                        bmodes == 1 || bmodes == 3 ? "text/plain; charset=utf-8"
+                                                   : "text/csv; charset=utf-8",
                         out, n, 1, NULL, 0);
 }
 
-/* GET /v1/analyses/{id}/result[?format=json|csv|spanwise|bmodes|critical] */
+/* GET /v1/analyses/{id}/result[?format=json|csv|spanwise|bmodes|critical|elastodyn] */
 enum MHD_Result http_get_result(struct MHD_Connection *c, http_req *r)
 {
     const char *format = NULL;
@@ -230,7 +238,8 @@ enum MHD_Result http_get_result(struct MHD_Connection *c, http_req *r)
     store_job jb;
     char *text;
     size_t len;
-    int csv = 0, rc, shapes = -1; /* -1 no, 0 span-wise CSV, 1 BModes table, 2 critical */
+    int csv = 0, rc, shapes = -1; /* -1 no, 0 span-wise CSV, 1 BModes table, 2 critical,
+                                     3 ElastoDyn */
 
     if (!r->id_ok)
         return http_not_found(c, r, 1);
@@ -243,9 +252,11 @@ enum MHD_Result http_get_result(struct MHD_Connection *c, http_req *r)
             shapes = 1;
         else if (format && !strcmp(format, "critical"))
             shapes = 2;
+        else if (format && !strcmp(format, "elastodyn"))
+            shapes = 3;
         else if (!format || (!csv && strcmp(format, "json") != 0))
             return http_bad_query(c, r, "format",
-                                  "must be json, csv, spanwise, bmodes or critical");
+                                  "must be json, csv, spanwise, bmodes, critical or elastodyn");
     }
     rc = http_job_read(r->h, r->id, csv ? STORE_WITH_CSV : STORE_WITH_RESULT, &jb);
     if (rc != JOBS_OK) {

@@ -1,0 +1,389 @@
+/*
+ * elastodyn_text.c — ElastoDyn blade mode-shape coefficients from a result document
+ * (DESIGN.md 9.3): GET .../result?format=elastodyn and `spinmodal export elastodyn`.
+ *
+ * How it fits: a spatial result with mode shapes carries under "model.members" each
+ * member's FE nodes (root first), span fractions, twist and axes without twist (result.c),
+ * and each mode its shape and energy split (labels).  This file gathers the blade member's
+ * node rows of every mode, lets the core project them on the principal axes
+ * (sm_elastodyn_project) and select and fit (sm_elastodyn_fit_modes, want {2, 1}: the
+ * numerics are the core's, DESIGN §B), then writes the ElastoDyn lines.  It reads nothing but
+ * the document, so the daemon (from the stored result) and the CLI give the same bytes, and
+ * elastodyn_patch.c writes the same values into a deck.  Helpers are edt_*.
+ */
+#include "codec_internal.h"
+#include "elastodyn.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *const codec_ed_blade_names[CODEC_ED_BLADE_VALUES] = {
+    "BldFl1Sh(2)", "BldFl1Sh(3)", "BldFl1Sh(4)", "BldFl1Sh(5)", "BldFl1Sh(6)",
+    "BldFl2Sh(2)", "BldFl2Sh(3)", "BldFl2Sh(4)", "BldFl2Sh(5)", "BldFl2Sh(6)",
+    "BldEdgSh(2)", "BldEdgSh(3)", "BldEdgSh(4)", "BldEdgSh(5)", "BldEdgSh(6)",
+};
+
+/* The deck name, the NREL description and the direction word of each blade fit. */
+static const struct {
+    const char *name, *what, *dir;
+} edt_blade[SM_ED_BLADE_FITS] = {
+    {"BldFl1Sh", "Flap mode 1", "flap"},
+    {"BldFl2Sh", "Flap mode 2", "flap"},
+    {"BldEdgSh", "Edge mode 1", "edge"},
+};
+
+/* What codec_elastodyn_case reads out of a document (borrowed pointers, owned arrays). */
+typedef struct edt_input {
+    const json_t *layout; /* the blade member's layout */
+    int n;                /* its nodes */
+    double ax[9], length;
+    double *x, *twist;    /* n each */
+} edt_input;
+
+static void edt_input_clear(edt_input *in)
+{
+    free(in->x);
+    free(in->twist);
+    memset(in, 0, sizeof *in);
+}
+
+static int edt_err(char *err, size_t errcap, const char *msg)
+{
+    if (err && errcap)
+        snprintf(err, errcap, "%s", msg);
+    return SM_INVALID_INPUT;
+}
+
+/* The blade member's layout: id "blade", else the only member. */
+static const json_t *edt_member(const json_t *result)
+{
+    const json_t *mems = json_object_get(json_object_get(result, "model"), "members"), *lay;
+    size_t i;
+
+    json_array_foreach(mems, i, lay) {
+        const char *id = json_string_value(json_object_get(lay, "id"));
+        if (id && !strcmp(id, "blade"))
+            return lay;
+    }
+    return json_array_size(mems) == 1 ? json_array_get(mems, 0) : NULL;
+}
+
+/* The member's nodes, span fractions, twists (rad), axes and length into *in. */
+static int edt_layout(const json_t *result, edt_input *in, char *err, size_t errcap)
+{
+    const json_t *lay;
+    int j;
+
+    memset(in, 0, sizeof *in);
+    if (!json_is_true(json_object_get(json_object_get(result, "model"), "spatial")))
+        return edt_err(err, errcap, "ElastoDyn coefficients need a spatial result with mode "
+                                    "shapes (\"mode_shapes\": true)");
+    lay = edt_member(result);
+    if (!lay)
+        return edt_err(err, errcap, "ElastoDyn coefficients need a blade: the blade form or a "
+                                    "structure of one member, with mode shapes");
+    in->layout = lay;
+    in->n = (int)json_array_size(json_object_get(lay, "nodes"));
+    if (in->n < 4 || (int)json_array_size(json_object_get(lay, "s")) != in->n)
+        return edt_err(err, errcap, "the blade has fewer than 4 nodes: no polynomial fit");
+    in->x = malloc((size_t)in->n * sizeof *in->x);
+    in->twist = malloc((size_t)in->n * sizeof *in->twist);
+    if (!in->x || !in->twist)
+        return SM_NOMEM;
+    for (j = 0; j < in->n; j++) {
+        in->x[j] = json_number_value(json_array_get(json_object_get(lay, "s"), (size_t)j));
+        in->twist[j] = CODEC_RAD_PER_DEG * json_number_value(json_array_get(
+                                               json_object_get(lay, "twist_deg"), (size_t)j));
+    }
+    in->x[in->n - 1] = 1.0;
+    for (j = 0; j < 9; j++)
+        in->ax[j] = json_number_value(json_array_get(json_object_get(lay, "axes"), (size_t)j));
+    in->length = json_number_value(json_object_get(lay, "length"));
+    return SM_OK;
+}
+
+/* The energy split of a mode ({"kinetic": {...}, "strain": {...}}) into e[SM_ENERGY_PARTS];
+ * 0 when it has none. */
+static int edt_energy(const json_t *mode, double *e)
+{
+    static const char *const parts[4] = {"axial", "edge", "flap", "torsion"};
+    const json_t *en = json_object_get(mode, "energy");
+    const json_t *kin = json_object_get(en, "kinetic"), *str = json_object_get(en, "strain");
+    int p;
+
+    if (!json_is_object(kin) || !json_is_object(str))
+        return 0;
+    for (p = 0; p < 4; p++) {
+        e[p] = json_number_value(json_object_get(kin, parts[p]));
+        e[4 + p] = json_number_value(json_object_get(str, parts[p]));
+    }
+    return 1;
+}
+
+/* One shape part ([[dx..rz] per model node]) on the member's nodes, projected (core). */
+static void edt_project(const edt_input *in, const json_t *part, double *rows, double *out,
+                        double slope[2])
+{
+    const json_t *nodes = json_object_get(in->layout, "nodes");
+    int j, c;
+
+    for (j = 0; j < in->n; j++) {
+        const json_t *row = json_array_get(
+            part, (size_t)json_integer_value(json_array_get(nodes, (size_t)j)));
+        for (c = 0; c < 6; c++)
+            rows[6 * j + c] = json_number_value(json_array_get(row, (size_t)c));
+    }
+    sm_elastodyn_project(in->n, in->ax, in->twist, in->length, rows, out, slope);
+}
+
+/* Buffers of one case's sm_ed_shapes (owned). */
+typedef struct edt_bufs {
+    double *rows, *re, *im, *sr, *si, *energy;
+} edt_bufs;
+
+static void edt_bufs_free(edt_bufs *b)
+{
+    free(b->rows), free(b->re), free(b->im), free(b->sr), free(b->si), free(b->energy);
+}
+
+/* Fill the shapes of case cs's modes into b and s; SM_INVALID_INPUT when a mode lacks its
+ * shape or energy. */
+static int edt_shapes(const edt_input *in, const json_t *modes, edt_bufs *b, sm_ed_shapes *s,
+                      int *has_im)
+{
+    size_t nm = json_array_size(modes), k, n = (size_t)in->n;
+    const json_t *mode, *shape;
+
+    b->rows = malloc(6 * n * sizeof(double));
+    b->re = malloc(nm * 2 * n * sizeof(double));
+    b->im = calloc(nm * 2 * n, sizeof(double));
+    b->sr = malloc(nm * 2 * sizeof(double));
+    b->si = calloc(nm * 2, sizeof(double));
+    b->energy = malloc(nm * SM_ENERGY_PARTS * sizeof(double));
+    if (!b->rows || !b->re || !b->im || !b->sr || !b->si || !b->energy)
+        return SM_NOMEM;
+    *has_im = 0;
+    json_array_foreach(modes, k, mode) {
+        shape = json_object_get(mode, "shape");
+        if (!json_is_array(json_object_get(shape, "re")) ||
+            !edt_energy(mode, b->energy + k * SM_ENERGY_PARTS))
+            return SM_INVALID_INPUT;
+        edt_project(in, json_object_get(shape, "re"), b->rows, b->re + 2 * k * n, b->sr + 2 * k);
+        if (json_is_array(json_object_get(shape, "im"))) {
+            edt_project(in, json_object_get(shape, "im"), b->rows, b->im + 2 * k * n,
+                        b->si + 2 * k);
+            *has_im = 1;
+        }
+    }
+    *s = (sm_ed_shapes){(int)nm, in->n, in->x, b->re, *has_im ? b->im : NULL, b->sr,
+                        *has_im ? b->si : NULL, b->energy, {SM_MODE_FLAP, SM_MODE_EDGE}};
+    return SM_OK;
+}
+
+/* Fits of case cs given the layout. */
+static int edt_case_fits(const edt_input *in, const json_t *cs, sm_ed_fit *fits, char *err,
+                         size_t errcap)
+{
+    static const int want[2] = {2, 1};
+    const json_t *modes = json_object_get(cs, "modes");
+    edt_bufs b = {NULL, NULL, NULL, NULL, NULL, NULL};
+    sm_ed_shapes s;
+    int rc, has_im;
+
+    if (!json_array_size(modes))
+        return edt_err(err, errcap, "the case has no modes");
+    rc = edt_shapes(in, modes, &b, &s, &has_im);
+    if (rc == SM_INVALID_INPUT)
+        edt_err(err, errcap, "a mode has no shape or energy split (\"mode_shapes\": true; a "
+                             "spatial result)");
+    else if (rc == SM_OK) {
+        rc = sm_elastodyn_fit_modes(&s, want, fits);
+        if (rc == SM_INVALID_INPUT)
+            edt_err(err, errcap, "a fitted mode has a zero tip displacement");
+    }
+    edt_bufs_free(&b);
+    return rc;
+}
+
+int codec_elastodyn_case(const json_t *result, size_t ci, sm_ed_fit fits[SM_ED_BLADE_FITS],
+                         char *err, size_t errcap)
+{
+    const json_t *cs = json_array_get(json_object_get(result, "cases"), ci);
+    edt_input in;
+    int rc;
+
+    if (err && errcap)
+        err[0] = '\0';
+    if (!cs)
+        return edt_err(err, errcap, "no such case in the result");
+    rc = edt_layout(result, &in, err, errcap);
+    if (rc == SM_OK)
+        rc = edt_case_fits(&in, cs, fits, err, errcap);
+    edt_input_clear(&in);
+    return rc;
+}
+
+void codec_elastodyn_format(const double coef[5], char text[5][CODEC_ED_TEXT])
+{
+    double big = 0, scale;
+    long long n[5], sum = 0, unit, a;
+    int d, k;
+
+    for (k = 0; k < 5; k++)
+        big = fmax(big, fabs(coef[k]));
+    /* d decimals: 7 significant digits on the largest (|C| < 1e15: a fit gives ~1e2) */
+    d = big > 0 && big < 1e15 ? 6 - (int)floor(log10(big)) : 6;
+    d = d < 0 ? 0 : d > 12 ? 12 : d;
+    scale = pow(10, d);
+    unit = llround(scale);
+    for (k = 0; k < 4; k++) {
+        n[k] = llround(coef[k] * scale); /* C_k in units of 10^-d */
+        sum += n[k];
+    }
+    n[4] = unit - sum;                   /* C6 = 1 - (C2 + ... + C5), exact in decimal */
+    for (k = 0; k < 5; k++) {
+        a = n[k] < 0 ? -n[k] : n[k];
+        if (d)
+            snprintf(text[k], CODEC_ED_TEXT, "%s%lld.%0*lld", n[k] < 0 ? "-" : "", a / unit, d,
+                     a % unit);
+        else
+            snprintf(text[k], CODEC_ED_TEXT, "%lld", n[k]);
+    }
+}
+
+void codec_elastodyn_blade_values(const sm_ed_fit fits[SM_ED_BLADE_FITS],
+                                  char values[CODEC_ED_BLADE_VALUES][CODEC_ED_TEXT])
+{
+    int f;
+
+    for (f = 0; f < SM_ED_BLADE_FITS; f++)
+        codec_elastodyn_format(fits[f].coef, values + 5 * f);
+}
+
+/* A number for a comment line, "n/a" when not finite. */
+static void edt_num(FILE *f, const char *fmt, double v)
+{
+    if (isfinite(v))
+        fprintf(f, fmt, v + 0.0);
+    else
+        fputs("n/a", f);
+}
+
+/* The report line(s) and the five coefficient lines of fit i of a case's modes. */
+static void edt_write_fit(FILE *f, const json_t *modes, int i, const sm_ed_fit *fit)
+{
+    const json_t *md = json_array_get(modes, (size_t)(fit->mode < 0 ? 0 : fit->mode));
+    char text[5][CODEC_ED_TEXT];
+    int k;
+
+    if (fit->mode < 0) {
+        fprintf(f, "! %s: no %s-dominated mode among the %zu computed: ask for more modes "
+                   "(\"modes\")\n",
+                edt_blade[i].name, edt_blade[i].dir, json_array_size(modes));
+        return;
+    }
+    fprintf(f, "! %s: mode %d (%.6g Hz, %s): %s share of the bending strain energy ",
+            edt_blade[i].name, fit->mode + 1,
+            json_number_value(json_object_get(md, "frequency_hz")),
+            json_string_value(json_object_get(md, "label")) ? json_string_value(
+                                                                 json_object_get(md, "label"))
+                                                           : "unlabelled",
+            edt_blade[i].dir);
+    edt_num(f, "%.2f %%", 100 * fit->share);
+    fprintf(f, "; rms residual %.3e, largest %.3e (of tip); tip slope FE ", fit->rms,
+            fit->max_residual);
+    edt_num(f, "%.6g", fit->tip_slope_fe);
+    fprintf(f, ", fit %.6g, error ", fit->tip_slope_fit);
+    edt_num(f, "%.3g %%", 100 * fit->tip_slope_error);
+    fputc('\n', f);
+    if (fit->warning) {
+        fprintf(f, "! warning: %s: mode %d is not clean: %s carries ", edt_blade[i].name,
+                fit->mode + 1, edt_blade[i].dir);
+        edt_num(f, "%.2f %%", 100 * fit->share);
+        fprintf(f, " of its bending strain energy (below %.0f %%); fitted anyway\n",
+                100 * SM_ED_CLEAN);
+    }
+    codec_elastodyn_format(fit->coef, text);
+    for (k = 0; k < 5; k++)
+        fprintf(f, "%14s   %s(%d) - %-11s, coeff of x^%d\n", text[k], edt_blade[i].name, k + 2,
+                k ? "" : edt_blade[i].what, k + 2);
+}
+
+/* The header lines of the document. */
+static void edt_header(FILE *f, const json_t *result, const edt_input *in)
+{
+    const json_t *solver = json_object_get(result, "solver");
+    const char *id = json_string_value(json_object_get(in->layout, "id"));
+
+    fprintf(f, "! spinmodal %s ElastoDyn blade mode-shape coefficients (DESIGN.md 9.3)\n"
+               "! request %s\n"
+               "! member %s (%.6g m): x = s from its root joint (the flexible root), shapes in "
+               "the principal axes (flap p3, edge p2, with the structural twist), divided by "
+               "the tip value; least squares on x^k - x^6 (k = 2..5), C6 = 1 - (C2 + ... + "
+               "C5)\n"
+               "! flap 1, flap 2: the two lowest modes with more flapwise than edgewise "
+               "kinetic energy; edge 1: the lowest with more edgewise\n",
+            json_string_value(json_object_get(solver, "version")),
+            json_string_value(json_object_get(solver, "request_sha256")), id ? id : "0",
+            in->length);
+}
+
+/* rpm of a case: its "rpm", else omega x 60 / 2 pi. */
+static double edt_rpm(const json_t *cs)
+{
+    const json_t *rpm = json_object_get(cs, "rpm");
+
+    return json_is_number(rpm)
+               ? json_number_value(rpm)
+               : json_number_value(json_object_get(cs, "omega")) * 60 / CODEC_TWO_PI;
+}
+
+int codec_result_elastodyn(char **out, size_t *len, const json_t *result, char *err,
+                           size_t errcap)
+{
+    const json_t *cases = json_object_get(result, "cases"), *cs;
+    sm_ed_fit fits[SM_ED_BLADE_FITS];
+    char *buf = NULL;
+    size_t n = 0, ci;
+    edt_input in;
+    FILE *f = NULL;
+    int rc, i;
+
+    *out = NULL;
+    if (err && errcap)
+        err[0] = '\0';
+    rc = edt_layout(result, &in, err, errcap);
+    if (rc == SM_OK && !json_array_size(cases))
+        rc = edt_err(err, errcap, "the result has no cases");
+    if (rc == SM_OK && !(f = open_memstream(&buf, &n)))
+        rc = SM_NOMEM;
+    if (rc)
+        goto done;
+    edt_header(f, result, &in);
+    json_array_foreach(cases, ci, cs) {
+        fprintf(f, "!\n! case %zu of %zu: %.6g rpm (%.6g rad/s), %s\n", ci + 1,
+                json_array_size(cases), edt_rpm(cs),
+                json_number_value(json_object_get(cs, "omega")),
+                json_string_value(json_object_get(cs, "status")));
+        if (!json_array_size(json_object_get(cs, "modes"))) {
+            fputs("! no modes at this speed\n", f);
+            continue;
+        }
+        rc = edt_case_fits(&in, cs, fits, err, errcap);
+        if (rc)
+            break;
+        for (i = 0; i < SM_ED_BLADE_FITS; i++)
+            edt_write_fit(f, json_object_get(cs, "modes"), i, &fits[i]);
+    }
+    if (rc) {
+        fclose(f);
+        free(buf);
+        goto done;
+    }
+    rc = codec_memstream_done(f, &buf, &n, out, len);
+done:
+    edt_input_clear(&in);
+    return rc;
+}
