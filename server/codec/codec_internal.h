@@ -9,6 +9,8 @@
  *   section.c   a section in its planar or spatial forms             sec_
  *   station.c   section properties along a member (stations)         stn_
  *   blade.c     the "blade" form expanded to a structure             blade_
+ *   tower.c     the "tower" form expanded to a structure; which form a
+ *               request has and its pointers                          tower_
  *   speeds.c    analysis.omega / analysis.rpm: numbers, lists, ranges spd_
  *   warn.c      unit-slip warnings of a valid request: the thresholds,
  *               the list, single-field checks                        warn_
@@ -340,6 +342,36 @@ json_t *blade_validate(val_ctx *v, const json_t *root, json_t *canon);
  */
 char *blade_pointer(const char *p);
 
+/* ======================================================== tower.c: tower_ */
+
+/** The form of a request (tower_form): "structure", "blade" or "tower". */
+enum { CODEC_FORM_STRUCTURE = 0, CODEC_FORM_BLADE = 1, CODEC_FORM_TOWER = 2 };
+
+/**
+ * Check root's "tower" (DESIGN.md 8.5), write its canonical copy (defaults
+ * written out) into canon["tower"] and return the canonical structure it
+ * stands for (new reference), or NULL.  Errors point into /tower.
+ */
+json_t *tower_validate(val_ctx *v, const json_t *root, json_t *canon);
+
+/**
+ * A tower does not spin: an error at /analysis/omega (or rpm) when a speed
+ * of the canonical request canon (borrowed, analysis checked) is not 0.
+ */
+void tower_check_speeds(val_ctx *v, const json_t *canon);
+
+/** The pointer p of a tower's expanded structure moved into /tower; malloc'd, NULL = NOMEM. */
+char *tower_pointer(const char *p);
+
+/** CODEC_FORM_* of a canonical (or input) request object (borrowed). */
+int tower_form(const json_t *canon);
+
+/**
+ * p moved into the form's object (blade_pointer, tower_pointer) or copied for the structure
+ * form; malloc'd, NULL when out of memory.
+ */
+char *tower_form_pointer(int form, const char *p);
+
 /* ====================================================== speeds.c: spd_ */
 
 /** analysis.omega or analysis.rpm (exactly one) of an (borrowed) checked into can. */
@@ -390,7 +422,8 @@ const char *warn_g(char buf[32], double x);
 typedef struct warn_list {
     json_t *arr;   /* [{"pointer", "message"}] */
     json_t *seen;  /* pointer -> true: one warning per pointer, the first */
-    int blade;     /* 1: pointers into the expanded structure move into /blade */
+    int blade;     /* CODEC_FORM_*: pointers into the expanded structure move into /blade
+                      (1) or /tower (2) */
     int nomem;     /* an allocation failed */
 } warn_list;
 

@@ -1,6 +1,7 @@
 /*
  * import_bmodes.c — BModes v3 input (NREL): the .bmi main file and the
- * section-properties file it names, into the blade form (spec 12 section 6).
+ * section-properties file it names, into the blade form (spec 12 section 6) or, for a tower
+ * (beam_type 2, tow_support 0), the tower form (DESIGN.md 8.5).
  *
  * The .bmi is read by position, line after line, in the order of BModes.f90
  * (its main program: ReadCom skips a line, ReadVar takes the first token of
@@ -16,8 +17,14 @@
  * iyz/ixy/izx_tip -> products [I12, I23, I31] (x = lag axis 3, y = flap
  * axis 2, z = span axis 1); every station property times its multiplier.
  * nselt and el_loc are kept in "source" only: the blade gets
- * IMPORT_ELEMENTS equal elements.  Towers (beam_type 2) and hub_conn other
- * than 1 are refused.
+ * IMPORT_ELEMENTS equal elements.  hub_conn other than 1 is refused.
+ *
+ * Towers (bm_tower, bm_tower_doc): radius -> height, hub_rad -> base_height,
+ * the sections as BModes reads a tower's (symmetric: edge = flap, twists and
+ * offsets 0), the top mass in tower axes (fa, ss, up) = BModes' tower-top
+ * (x, y, z): offset [cm_loc, 0, cm_axial], inertia [ixx, iyy, izz],
+ * products [ixy, iyz, izx]; speed 0.  tow_support 1 (guy wires) and 2
+ * (offshore) are refused at their line (bm_support).
  */
 #include "import_internal.h"
 #include "codec.h"
@@ -101,6 +108,11 @@ typedef struct bm_main {
     char sec_raw[256];  /* as written, for the loader */
     int sec_line;       /* line of sec_props_file in the .bmi */
     double mult[10]; /* sec_mass .. tc_offst multipliers, file order */
+    int tower;          /* beam_type 2 (DESIGN.md 8.5) */
+    int speed_line;     /* line of rot_rpm */
+    int beam_line;      /* line of beam_type */
+    unsigned tw_zeroed; /* tower: columns (1 << column) the file gives and BModes overwrites */
+    int tw_zeroed_line; /* the first line with one of them */
 } bm_main;
 
 static const char *const bm_mult_names[10] = {
@@ -127,14 +139,15 @@ static int bm_general(bm_in *b, bm_main *m)
     if ((st = bm_com(b, "blank line")) || (st = bm_com(b, "general parameters")) ||
         (st = bm_tok(b, "Echo", &t)) || (st = bm_int(b, "beam_type", 1, 9, &m->beam_type)))
         return st;
-    if (m->beam_type == 2)
-        return imp_fail(b->d, b->file, b->r.line, "beam_type",
-                        "towers are not supported yet (beam_type 2); only blades (1)");
-    if (m->beam_type != 1)
+    m->tower = m->beam_type == 2;
+    m->beam_line = b->r.line;
+    if (m->beam_type != 1 && m->beam_type != 2)
         return imp_fail(b->d, b->file, b->r.line, "beam_type",
                         "must be 1 (blade) or 2 (tower) (%ld)", m->beam_type);
-    if ((st = bm_num(b, "rot_rpm", IMP_NONNEG, &m->rot_rpm)) ||
-        (st = bm_num(b, "rpm_mult", IMP_NONNEG, &m->rpm_mult)))
+    if ((st = bm_num(b, "rot_rpm", IMP_NONNEG, &m->rot_rpm)))
+        return st;
+    m->speed_line = b->r.line;
+    if ((st = bm_num(b, "rpm_mult", IMP_NONNEG, &m->rpm_mult)))
         return st;
     m->rpm = m->rot_rpm * m->rpm_mult; /* BModes.f90: romg = rot_rpm * rpm_mult */
     if (!imp_finite(m->rpm))
@@ -258,8 +271,86 @@ static int bm_mesh(bm_in *b, bm_main *m, json_t *el_loc)
     return SM_OK;
 }
 
+/*
+ * A tower's row as BModes reads it (BModes.f90:667-677): twists and offsets zero, the s-s
+ * (edge) inertia and stiffness the f-a (flap) ones, before the multipliers (so edge_stff_mult
+ * and lag_iner_mult still apply).  m->tw_zeroed records the columns this changed.
+ */
+static void bm_tower_row(bm_main *m, double raw[BM_COLUMNS], int line)
+{
+    static const int zero[] = {1, 2, 10, 11, 12}; /* str_tw, tw_iner, cg, sc, tc_offst */
+    unsigned before = m->tw_zeroed;
+    size_t k;
+
+    for (k = 0; k < sizeof(zero) / sizeof(zero[0]); k++) {
+        if (raw[zero[k]] != 0.0)
+            m->tw_zeroed |= 1u << zero[k];
+        raw[zero[k]] = 0.0;
+    }
+    if (raw[5] != raw[4]) /* edge_iner := flp_iner */
+        m->tw_zeroed |= 1u << 5;
+    if (raw[7] != raw[6]) /* edge_stff := flp_stff */
+        m->tw_zeroed |= 1u << 7;
+    raw[5] = raw[4];
+    raw[7] = raw[6];
+    if (!before && m->tw_zeroed)
+        m->tw_zeroed_line = line;
+}
+
+/*
+ * A tower's support (BModes.f90:503-612, read after el_loc): tow_support 0 (none) is imported;
+ * 1 (tension guy wires) and 2 (monopile or floating platform) need elastic supports that the
+ * solver does not have yet and are refused at that line.  A blade has no such lines.
+ */
+static int bm_support(bm_in *b, const bm_main *m)
+{
+    imp_tok t[2];
+    double x;
+    long ts;
+    int st;
+
+    if (!m->tower) { /* a tower's file given as a blade: its support lines follow el_loc */
+        while (imp_next(&b->r))
+            if (imp_split(b->r.s, b->r.n, ",", t, 2) >= 2 && t[1].n >= 11 &&
+                !strncmp(t[1].s, "tow_support", 11))
+                return imp_fail(b->d, b->file, b->r.line, "tow_support", "a tower's support "
+                                "line, but beam_type (line %d) is 1 (blade): this is a tower "
+                                "file; give beam_type 2 to import it as a tower",
+                                m->beam_line);
+        return SM_OK;
+    }
+    t[0].n = 0; /* ReadCom, ReadCom, ReadVar: the first token of the next line */
+    if (imp_next(&b->r) && imp_next(&b->r) && imp_next_nonblank(&b->r))
+        imp_split(b->r.s, b->r.n, ",", t, 1);
+    else
+        b->r.line++;
+    if (t[0].n == 0 || imp_number(&t[0], &x))
+        return imp_fail(b->d, b->file, b->r.line, "tow_support", "missing: beam_type (line %d) "
+                        "is 2 (tower), and a tower's file goes on after el_loc with its support "
+                        "lines (tow_support, BModes.f90:503), a number here; a blade's file has "
+                        "none: give beam_type 1 to import it as a blade", m->beam_line);
+    if (x != floor(x) || x < 0.0 || x > 2.0)
+        return imp_fail(b->d, b->file, b->r.line, "tow_support",
+                        "must be an integer in [0, 2] (%.15g)", x);
+    ts = (long)x;
+    if (ts == 1)
+        return imp_fail(b->d, b->file, b->r.line, "tow_support", "1 (tension guy wires) is not "
+                        "supported yet: the wires are springs on the tower (n_attachments, "
+                        "n_wires, node_attach, wire_stfness, th_wire) and the solver has no "
+                        "elastic supports yet (issue 25); tow_support 0 imports the tower "
+                        "without them");
+    if (ts == 2)
+        return imp_fail(b->d, b->file, b->r.line, "tow_support", "2 (offshore support: "
+                        "monopile or floating platform) is not supported yet: the platform's "
+                        "mass, hydrodynamic and mooring matrices and the distributed soil "
+                        "springs need elastic supports and a free base, which the solver does "
+                        "not have yet (issue 25); tow_support 0 imports the tower clamped at "
+                        "its base");
+    return SM_OK;
+}
+
 /* The section-properties file into t, multipliers applied. */
-static int bm_sections(bm_in *b, const bm_main *m, imp_table *t)
+static int bm_sections(bm_in *b, bm_main *m, imp_table *t)
 {
     static const char *const col[BM_COLUMNS] = {
         "sec_loc",   "str_tw",    "tw_iner",  "mass_den", "flp_iner", "edge_iner", "flp_stff",
@@ -271,6 +362,7 @@ static int bm_sections(bm_in *b, const bm_main *m, imp_table *t)
     /* multiplier of each column: index into m->mult, -1 = none */
     static const int mult[BM_COLUMNS] = {-1, -1, -1, 0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
     imp_tok tok[BM_COLUMNS + 1];
+    double raw[BM_COLUMNS];
     long n_secs, i;
     int st, c, n;
 
@@ -295,11 +387,15 @@ static int bm_sections(bm_in *b, const bm_main *m, imp_table *t)
         if (!(s = imp_table_add(t)))
             return SM_NOMEM;
         s->line = b->r.line;
+        for (c = 0; c < BM_COLUMNS; c++)
+            if ((st = imp_value(b->d, b->file, b->r.line, col[c], &tok[c], imp_key_kind(key[c]),
+                                &raw[c])))
+                return st;
+        if (m->tower)
+            bm_tower_row(m, raw, b->r.line);
         for (c = 0; c < BM_COLUMNS; c++) {
             int kind = imp_key_kind(key[c]);
-            double v;
-            if ((st = imp_value(b->d, b->file, b->r.line, col[c], &tok[c], kind, &v)))
-                return st;
+            double v = raw[c];
             if (mult[c] >= 0)
                 v *= m->mult[mult[c]];
             if ((st = imp_check(b->d, b->file, b->r.line, col[c], kind, v)))
@@ -373,6 +469,134 @@ static int bm_blade(const bm_main *m, const import_options *o, imp_blade *bl, js
     return bad ? SM_NOMEM : SM_OK;
 }
 
+/*
+ * A tower (beam_type 2, DESIGN.md 8.5): the length and modes into bl (the blade document is
+ * built first and turned into the tower form by bm_tower_doc), and the warnings of what BModes
+ * itself overwrites for a tower.  A tower does not spin: an rpm option is refused.
+ */
+static int bm_tower(const bm_main *m, const import_options *o, imp_blade *bl, json_t *warn,
+                    import_diag *d, const char *file)
+{
+    static const char *const names[] = {"sec_loc",  "str_tw",   "tw_iner",   "mass_den",
+                                        "flp_iner", "edge_iner", "flp_stff", "edge_stff",
+                                        "tor_stff", "axial_stff", "cg_offst", "sc_offst",
+                                        "tc_offst"};
+    char cols[160];
+    size_t len = 0;
+    int bad = 0, c;
+
+    if (!isnan(o->rpm))
+        return imp_fail(d, file, 0, "rpm", "a tower does not spin: the rotor speed option "
+                        "does not apply to a tower (beam_type 2)");
+    bl->length = m->radius - m->hub_rad;
+    bl->hub_radius = m->hub_rad;
+    bl->rpm = 0.0;
+    bl->modes = (int)m->modepr;
+    if (o->max_modes > 0 && bl->modes > o->max_modes) {
+        bad |= imp_warn(warn, "/analysis/modes", "modepr %d is above the limit of %d modes: "
+                        "analysis.modes = %d", bl->modes, o->max_modes, o->max_modes);
+        bl->modes = o->max_modes;
+    }
+    if (m->rpm != 0.0)
+        bad |= imp_warn(warn, "/analysis/omega", "%s:%d: rot_rpm x rpm_mult = %g rpm is not used: "
+                        "a tower does not spin (BModes sets its speed to 0, BModes.f90:436)",
+                        file, m->speed_line, m->rpm);
+    if (m->precone != 0.0 || m->bl_thp != 0.0)
+        bad |= imp_warn(warn, "/tower", "precone %g and bl_thp %g degrees are not used: BModes "
+                        "sets them to zero for a tower", m->precone, m->bl_thp);
+    if (m->tip[1] != m->tip[2] || m->tip[2] != 0.0)
+        bad |= imp_warn(warn, "/tower/top_mass/offset", "top_mass.offset = [cm_loc, 0, "
+                        "cm_axial] = [%g, 0, %g] m as the file's comments define them; BModes "
+                        "v3.00 itself reads cm_axial into cm_loc (BModes.f90:448-449), so its "
+                        "own numbers are for the offset [%g, 0, 0] (the option bmodes_mesh "
+                        "uses that, to reproduce them)", m->tip[1], m->tip[2], m->tip[2]);
+    for (c = 0; c < BM_COLUMNS && m->tw_zeroed; c++)
+        if ((m->tw_zeroed & (1u << c)) && len < sizeof(cols))
+            len += (size_t)snprintf(cols + len, sizeof(cols) - len, "%s%s", len ? ", " : "",
+                                    names[c]);
+    if (m->tw_zeroed)
+        bad |= imp_warn(warn, "/tower/stations", "%s:%d: %s not used: BModes reads a tower's "
+                        "sections as symmetric, with twists and offsets zero and the s-s "
+                        "(edge) inertia and stiffness equal to the f-a (flap) ones "
+                        "(BModes.f90:667-677), and so does the import", m->sec_file,
+                        m->tw_zeroed_line, cols);
+    return bad ? SM_NOMEM : SM_OK;
+}
+
+/* JSON reals of the n numbers x, rounded as printed; NULL when out of memory. */
+static json_t *bm_vec(const double *x, int n)
+{
+    json_t *a = json_array();
+    int i;
+
+    for (i = 0; a && i < n; i++)
+        if (json_array_append_new(a, json_real(imp_round(x[i])))) {
+            json_decref(a);
+            return NULL;
+        }
+    return a;
+}
+
+/*
+ * doc's blade request made a tower (DESIGN.md 8.5): height = radius, base_height = hub_rad
+ * (BModes' rigid base), the elements, section and stations as they are; the top mass in tower
+ * axes (fa, ss, up) = BModes' tower-top (x, y, z): offset [cm_loc, 0, cm_axial], inertia
+ * [ixx, iyy, izz], products [ixy, iyz, izx] (the tensor's off-diagonal entries: BldVib.f90:
+ * 685-709 adds them to the mass matrix as such); analysis.omega [0] instead of rpm.  0 or -1
+ * (memory).
+ */
+static int bm_tower_doc(json_t *doc, const bm_main *m)
+{
+    json_t *req = json_object_get(doc, "request"), *bl = json_object_get(req, "blade");
+    json_t *an = json_object_get(req, "analysis"), *tw = json_object(), *top = NULL;
+    const char *const keep[] = {"elements", "section", "stations"};
+    double off[3] = {m->tip[1], 0.0, m->tip[2]};
+    double prod[3] = {m->tip[6], m->tip[8], m->tip[7]}; /* ixy, iyz, izx */
+    int bad = !tw || !bl || !an, k, i;
+
+    bad = bad || json_object_set_new(tw, "height", json_real(imp_round(m->radius))) ||
+          json_object_set_new(tw, "base_height", json_real(imp_round(m->hub_rad)));
+    for (k = 0; !bad && k < 3; k++)
+        if (json_object_get(bl, keep[k]))
+            bad |= json_object_set(tw, keep[k], json_object_get(bl, keep[k]));
+    for (i = 0; !bad && i < 9 && !top; i++)
+        if (i != 2 && m->tip[i] != 0.0) { /* a top mass given (cm_axial alone offsets nothing) */
+            top = json_pack("{s:f, s:o, s:o, s:o}", "mass", imp_round(m->tip[0]), "offset",
+                            bm_vec(off, 3), "inertia", bm_vec(m->tip + 3, 3), "products",
+                            bm_vec(prod, 3));
+            bad |= !top || json_object_set_new(tw, "top_mass", top);
+        }
+    if (bad) {
+        json_decref(tw);
+        return -1;
+    }
+    if (json_object_set_new(req, "tower", tw) || json_object_del(req, "blade") ||
+        json_object_del(an, "rpm") || json_object_set_new(an, "omega", json_pack("[f]", 0.0)))
+        return -1; /* set_new took tw */
+    return 0;
+}
+
+/*
+ * Option bmodes_mesh on a tower: BModes' own model takes the top mass's offset as BModes reads
+ * it, [cm_axial, 0, 0] (BModes.f90:448-449 reads cm_axial into cm_loc and leaves cm_axial 0).
+ * 0 or -1 (memory).
+ */
+static int bm_tower_own_offset(json_t *doc, const bm_main *m)
+{
+    json_t *top = json_object_get(json_object_get(json_object_get(doc, "request"), "tower"),
+                                  "top_mass");
+    double off[3] = {m->tip[2], 0.0, 0.0};
+
+    if (!top || (m->tip[1] == m->tip[2] && m->tip[2] == 0.0))
+        return 0;
+    if (json_object_set_new(top, "offset", bm_vec(off, 3)))
+        return -1;
+    return imp_warn(json_object_get(doc, "input_warnings"), "/tower/top_mass/offset",
+                    "BModes' own model: top_mass.offset = [%g, 0, 0] m, the offset BModes v3.00 "
+                    "computes with (it reads cm_axial = %g into cm_loc = %g)", m->tip[2],
+                    m->tip[2], m->tip[1]);
+}
+
 /* "source": what the .bmi said that the request does not carry. */
 static json_t *bm_source(const bm_main *m, const char *bmi, json_t *el_loc)
 {
@@ -393,8 +617,10 @@ static json_t *bm_source(const bm_main *m, const char *bmi, json_t *el_loc)
         bad |= json_object_set_new(src, "nselt", json_integer(m->nselt));
         bad |= json_object_set(src, "el_loc", el_loc);
         bad |= json_object_set_new(src, "note", json_string(
-            "BModes' element boundaries (nselt, el_loc) are not used: the blade is meshed "
-            "with blade.elements equal elements"));
+            m->tower ? "BModes' element boundaries (nselt, el_loc) are not used: the tower is "
+                       "meshed with tower.elements equal elements"
+                     : "BModes' element boundaries (nselt, el_loc) are not used: the blade is "
+                       "meshed with blade.elements equal elements"));
     }
     json_decref(mult);
     if (bad) {
@@ -495,7 +721,7 @@ fail:
 
 /*
  * Option bmodes_mesh = k: doc's request becomes BModes' own model in the structure form: the
- * blade as the codec expands it (DESIGN.md 8.1), cut at BModes' element boundaries el_loc into
+ * blade (or tower) as the codec expands it (DESIGN.md 8.1, 8.5), cut at BModes' element boundaries el_loc into
  * nselt uniform members (two equal stations each) with the properties sampled at the element
  * midpoints, k FE elements each.  SM_OK, SM_NOMEM, SM_INVALID_INPUT (d) when the blade is not a
  * valid request.
@@ -508,6 +734,7 @@ static int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *fil
     codec_request *r = NULL;
     codec_limits lim;
     const json_t *ex, *mem, *sts, *root, *tip;
+    const char *rname, *tname, *secname;
     size_t n = json_array_size(el_loc), i, c;
     int rc = SM_NOMEM;
 
@@ -516,7 +743,8 @@ static int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *fil
         return SM_NOMEM;
     rc = codec_request_from_json(&r, req, &lim, errs);
     if (rc == SM_INVALID_INPUT) {
-        rc = imp_fail(d, file, 0, "bmodes_mesh", "the blade is not a valid request (%s: %s)",
+        rc = imp_fail(d, file, 0, "bmodes_mesh", "the %s is not a valid request (%s: %s)",
+                      json_object_get(req, "tower") ? "tower" : "blade",
                       codec_errors_pointer(errs, 0), codec_errors_message(errs, 0));
         goto done;
     }
@@ -526,10 +754,13 @@ static int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *fil
     ex = codec_request_structure_json(r);
     mem = json_array_get(json_object_get(ex, "members"), 0);
     sts = json_object_get(mem, "stations");
-    root = json_object_get(json_object_get(ex, "joints"), "root");
-    tip = json_object_get(json_object_get(ex, "joints"), "tip");
+    rname = json_string_value(json_object_get(mem, "from")); /* blade: root, tower: base */
+    tname = json_string_value(json_object_get(mem, "to"));   /* blade: tip, tower: top */
+    secname = json_string_value(json_object_get(mem, "section"));
+    root = json_object_get(json_object_get(ex, "joints"), rname);
+    tip = json_object_get(json_object_get(ex, "joints"), tname);
     st = json_pack("{s:{}, s:O, s:[], s:s, s:O}", "joints", "sections",
-                   json_object_get(ex, "sections"), "members", "clamp", "root",
+                   json_object_get(ex, "sections"), "members", "clamp", rname,
                    "point_masses", json_object_get(ex, "point_masses"));
     if (!st)
         goto done;
@@ -549,7 +780,7 @@ static int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *fil
             }
         }
         if (i == 0 || i + 1 == n)
-            snprintf(name, sizeof name, "%s", i == 0 ? "root" : "tip");
+            snprintf(name, sizeof name, "%s", i == 0 ? rname : tname);
         else
             snprintf(name, sizeof name, "x%zu", i);
         if (json_object_set_new(joints, name, json_pack("[f, f, f]", p[0], p[1], p[2])))
@@ -568,7 +799,10 @@ static int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *fil
                               "request carries (%s)", i, x0, x, IMP_MAX_ABS_TEXT);
                 goto done;
             }
-            snprintf(from, sizeof from, i == 1 ? "root" : "x%zu", i - 1);
+            if (i == 1)
+                snprintf(from, sizeof from, "%s", rname);
+            else
+                snprintf(from, sizeof from, "x%zu", i - 1);
             snprintf(id, sizeof id, "e%zu", i);
             for (h = 0; mid && h < 2; h++) { /* the member uniform: two equal stations */
                 two[h] = json_pack("{s:f}", "s", (double)h);
@@ -577,7 +811,7 @@ static int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *fil
             }
             if (two[0] && two[1])
                 m = json_pack("{s:s, s:s, s:s, s:s, s:i, s:O, s:O, s:[O, O]}", "id", id, "from",
-                              from, "to", name, "section", "blade", "elements", k,
+                              from, "to", name, "section", secname, "elements", k,
                               "flap_direction", json_object_get(mem, "flap_direction"),
                               "twist_deg", json_object_get(mem, "twist_deg"), "stations",
                               two[0], two[1]);
@@ -591,7 +825,8 @@ static int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *fil
     pms = json_object_get(st, "point_masses");
     if (!json_array_size(pms))
         json_object_del(st, "point_masses");
-    if (json_object_set(req, "structure", st) || json_object_del(req, "blade") ||
+    if (json_object_set(req, "structure", st) ||
+        json_object_del(req, json_object_get(req, "tower") ? "tower" : "blade") ||
         imp_warn(warn, "/structure", "BModes' own model (bmodes_mesh %d): its %zu elements as uniform members "
                        "with the properties at their midpoints (BModes.f90:1110), %d FE elements "
                        "each, which reproduces BModes' numbers; without the option the "
@@ -612,23 +847,25 @@ done:
 }
 
 /*
- * After bm_own_mesh: the warnings' pointers into the blade form point into the structure that
- * replaced it (/blade/section/K -> /structure/sections/blade/K, any other /blade... ->
- * /structure), and "warnings" gets the message of the one bm_own_mesh added.  0, -1 (memory).
+ * After bm_own_mesh: the warnings' pointers into the blade (tower) form point into the
+ * structure that replaced it (/blade/section/K -> /structure/sections/blade/K, any other
+ * /blade... -> /structure; /tower likewise), and "warnings" gets the message of the one
+ * bm_own_mesh added.  0, -1 (memory).
  */
-static int bm_mesh_warnings(json_t *doc)
+static int bm_mesh_warnings(json_t *doc, int tower)
 {
-    static const char sec[] = "/blade/section/";
+    const char *form = tower ? "/tower" : "/blade", *name = form + 1;
+    size_t fn = strlen(form);
     json_t *w;
     size_t i;
     char p[160];
 
     json_array_foreach(json_object_get(doc, "input_warnings"), i, w) {
         const char *ptr = json_string_value(json_object_get(w, "pointer"));
-        if (!ptr || strncmp(ptr, "/blade", 6) || (ptr[6] != '/' && ptr[6] != '\0'))
+        if (!ptr || strncmp(ptr, form, fn) || (ptr[fn] != '/' && ptr[fn] != '\0'))
             continue;
-        if (!strncmp(ptr, sec, sizeof(sec) - 1))
-            snprintf(p, sizeof(p), "/structure/sections/blade/%s", ptr + sizeof(sec) - 1);
+        if (!strncmp(ptr + fn, "/section/", 9))
+            snprintf(p, sizeof(p), "/structure/sections/%s/%s", name, ptr + fn + 9);
         else
             snprintf(p, sizeof(p), "/structure");
         if (json_object_set_new(w, "pointer", json_string(p)))
@@ -659,7 +896,8 @@ int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void
     if ((st = imp_option(d, bmi->name, "rpm", o->rpm)) || (st = imp_encoding(d, bmi, &body)))
         goto done;
     bm_init(&b, &body, d);
-    if ((st = bm_general(&b, &m)) || (st = bm_props(&b, &m)) || (st = bm_mesh(&b, &m, el_loc)))
+    if ((st = bm_general(&b, &m)) || (st = bm_props(&b, &m)) ||
+        (st = bm_mesh(&b, &m, el_loc)) || (st = bm_support(&b, &m)))
         goto done;
     why[0] = '\0';
     st = load(ctx, m.sec_raw, &sf, why, sizeof(why));
@@ -677,16 +915,19 @@ int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void
     if ((st = imp_encoding(d, &sf, &sf)))
         goto done;
     bm_init(&b, &sf, d);
-    if ((st = bm_sections(&b, &m, &t)) || (st = bm_blade(&m, o, &bl, warn)))
+    if ((st = bm_sections(&b, &m, &t)) ||
+        (st = m.tower ? bm_tower(&m, o, &bl, warn, d, bmi->name) : bm_blade(&m, o, &bl, warn)))
         goto done;
     src = bm_source(&m, bmi->name, el_loc);
     /* BModes has no tension-torsion (Wagner) term (DESIGN.md 8.2): the request switches it
      * off so that it is BModes' model, and says how to put it back */
     sec = json_pack("{s:f}", "ip_over_a", 0.0);
-    if (!sec || imp_warn(warn, "/blade/section/ip_over_a", "blade.section.ip_over_a = 0: BModes has no tension-torsion "
+    if (!sec || imp_warn(warn, m.tower ? "/tower/section/ip_over_a" : "/blade/section/ip_over_a",
+                         "%s.section.ip_over_a = 0: BModes has no tension-torsion "
                                "(Wagner) stiffness, so the import leaves it out to reproduce "
                                "BModes; delete ip_over_a to include it (it raises the first "
-                               "torsion frequency, ~1.4 %% on BModes' Test01)")) {
+                               "torsion frequency, ~1.4 %% on BModes' Test01)",
+                         m.tower ? "tower" : "blade")) {
         json_decref(sec);
         json_decref(src);
         st = SM_NOMEM;
@@ -695,10 +936,14 @@ int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void
     *out = imp_document(&bl, &t, sec, warn, src);
     warn = NULL;
     st = *out ? SM_OK : SM_NOMEM;
+    if (!st && m.tower && bm_tower_doc(*out, &m))
+        st = SM_NOMEM;
+    if (!st && m.tower && o->bmodes_mesh > 0 && bm_tower_own_offset(*out, &m))
+        st = SM_NOMEM;
     if (!st && o->bmodes_mesh > 0) {
         st = bm_own_mesh(*out, el_loc, o->bmodes_mesh, bmi->name, d,
                          json_object_get(*out, "input_warnings"));
-        if (!st && bm_mesh_warnings(*out))
+        if (!st && bm_mesh_warnings(*out, m.tower))
             st = SM_NOMEM;
     }
     if (st && *out) {

@@ -190,7 +190,8 @@ static void plaus_member_fill(plaus_ctx *c, size_t i, plaus_member *pm)
     pm->q[PQ_EI_FLAP] = c->st->spatial ? s->EI_flap : s->E * s->I;
     pm->q[PQ_EI_EDGE] = c->st->spatial ? s->EI_edge : NAN;
     if (c->w->blade)
-        snprintf(pm->name, sizeof(pm->name), "the blade");
+        snprintf(pm->name, sizeof(pm->name), "the %s",
+                 c->w->blade == CODEC_FORM_TOWER ? "tower" : "blade");
     else
         snprintf(pm->name, sizeof(pm->name), "member %zu%s%.60s%s", i, id ? " ('" : "",
                  id ? json_string_value(id) : "", id ? "')" : "");
@@ -223,7 +224,7 @@ static void plaus_member_done(plaus_member *pm)
 static char *plaus_length_ptr(const plaus_ctx *c, int j)
 {
     if (c->w->blade)
-        return strdup("/blade/length");
+        return strdup(c->w->blade == CODEC_FORM_TOWER ? "/tower/height" : "/blade/length");
     return err_ptr_key("/structure/joints", codec_request_joint_name(c->r, j));
 }
 

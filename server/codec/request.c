@@ -29,7 +29,8 @@ struct codec_request {
     json_t *canon;              /* canonical request, defaults applied */
     json_t *structure;          /* canonical structure of the model: canon's, or the one its
                                    "blade" stands for (blade.c) */
-    int blade;                  /* 1 for the blade form: pointers move into /blade */
+    int blade;                  /* CODEC_FORM_*: the blade (1) and tower (2) forms move
+                                   pointers into /blade, /tower (tower_form_pointer) */
     json_t *warnings;           /* input_warnings (warn.c), an array, maybe empty */
     char *canon_text;           /* its sorted compact dump */
     char *name;                 /* the request's "name" (not in canon), or NULL */
@@ -490,7 +491,7 @@ static const char *req_spatial_range(const sm_section *c, double lmin, double lm
 int req_error(const codec_request *r, codec_errors *errs, const char *ptr, const char *fmt,
               ...)
 {
-    char *moved = r->blade ? blade_pointer(ptr) : NULL;
+    char *moved = r->blade ? tower_form_pointer(r->blade, ptr) : NULL;
     va_list ap;
     int rc;
 
@@ -655,7 +656,7 @@ static int req_from_json(codec_request **out, const json_t *root, const codec_li
         goto fail;
     r->canon = canon;
     r->structure = structure;
-    r->blade = json_object_get(canon, "blade") != NULL;
+    r->blade = tower_form(r->canon);
     canon = structure = NULL;
     r->canon_text = json_dumps(r->canon, CODEC_DUMP_CANON);
     if (!r->canon_text || req_keep_name(r, root))

@@ -285,6 +285,8 @@ static json_t *res_member_id(const codec_request *r, int i)
 
     if (json_object_get(canon, "blade"))
         return json_string("blade");
+    if (json_object_get(canon, "tower"))
+        return json_string("tower");
     return id ? json_deep_copy(id) : json_null();
 }
 

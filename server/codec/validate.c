@@ -785,7 +785,8 @@ static void val_name(val_ctx *v, const json_t *root)
  */
 static json_t *val_document(val_ctx *v, const json_t *root, json_t **structure)
 {
-    static const char *const keys[] = {"structure", "blade", "frames", "analysis", "name", NULL};
+    static const char *const keys[] = {"structure", "blade", "tower", "frames", "analysis",
+                                       "name", NULL};
     json_t *canon;
 
     if (!json_is_object(root)) {
@@ -798,7 +799,12 @@ static json_t *val_document(val_ctx *v, const json_t *root, json_t **structure)
         v->nomem = 1;
         return NULL;
     }
-    if (json_object_get(root, "blade") && json_object_get(root, "structure")) {
+    if (json_object_get(root, "tower") &&
+        (json_object_get(root, "blade") || json_object_get(root, "structure"))) {
+        field_error(v, "/tower", "give one of 'structure', 'blade' and 'tower', not several");
+    } else if (json_object_get(root, "tower")) {
+        *structure = tower_validate(v, root, canon);
+    } else if (json_object_get(root, "blade") && json_object_get(root, "structure")) {
         field_error(v, "/blade", "give either 'structure' or 'blade', not both");
     } else if (json_object_get(root, "blade")) {
         *structure = blade_validate(v, root, canon);
@@ -808,6 +814,8 @@ static json_t *val_document(val_ctx *v, const json_t *root, json_t **structure)
     }
     val_frames(v, root, canon);
     val_analysis(v, root, canon);
+    if (json_object_get(canon, "tower"))
+        tower_check_speeds(v, canon); /* a tower does not spin (tower.c) */
     val_name(v, root);
     if (json_object_get(canon, "analysis") && *structure)
         size_check(v, canon, *structure); /* the result's size (size.c) */

@@ -72,7 +72,7 @@ static int warn_seen(warn_list *w, const char *p)
 
 void warn_vadd(warn_list *w, const char *ptr, const char *fmt, va_list ap)
 {
-    char *q = ptr && w->blade ? blade_pointer(ptr) : NULL, *msg;
+    char *q = ptr && w->blade ? tower_form_pointer(w->blade, ptr) : NULL, *msg;
     const char *p = w->blade ? q : ptr;
 
     if (!p) {
@@ -309,7 +309,7 @@ json_t *warn_collect(const codec_request *r)
 {
     warn_list w = {json_array(), json_object(), 0, 0};
 
-    w.blade = json_object_get(codec_request_canonical(r), "blade") != NULL;
+    w.blade = tower_form(codec_request_canonical(r)); /* CODEC_FORM_*: pointers move */
     if (!w.arr || !w.seen)
         w.nomem = 1;
     else

@@ -320,9 +320,12 @@ static void test_bmodes_bad(void)
 
     bad_bmodes_main("main truncated", cut(bmi, 20),
                     "T.bmi:21: cm_axial: the file ends here (truncated?): this line is missing");
-    bad_bmodes_main("tower", edit(bmi, 6, "1 ", "2 "),
-                    "T.bmi:6: beam_type: towers are not supported yet (beam_type 2); only "
-                    "blades (1)");
+    /* a blade's file given as a tower's (DESIGN.md 8.5): no support lines after el_loc */
+    bad_bmodes_main("blade as tower", edit(bmi, 6, "1 ", "2 "),
+                    "T.bmi:51: tow_support: missing: beam_type (line 6) is 2 (tower), and a "
+                    "tower's file goes on after el_loc with its support lines (tow_support, "
+                    "BModes.f90:503), a number here; a blade's file has none: give beam_type 1 "
+                    "to import it as a blade");
     bad_bmodes_main("hub_conn", edit(bmi, 13, "1 ", "2 "),
                     "T.bmi:13: hub_conn: only 1 (cantilevered) is supported (2)");
     bad_bmodes_main("rot_rpm", edit(bmi, 7, "60.0", "sixty"),
@@ -341,13 +344,16 @@ static void test_bmodes_bad(void)
                  "T.bmi:31: sec_props_file: cannot read \"blade_sec_props.dat\": No such file "
                  "or directory");
     json_decref(doc);
-    /* towers: the real Test03 */
+    /* towers (DESIGN.md 8.5): the real Test03 is the tower form; its frequencies are
+     * tests/cli/tower_test.py's */
     {
         char *t3 = slurp("bmodes_certtest/Test03_tower.bmi");
         char *ts = slurp("bmodes_certtest/tower_sec_props.dat");
-        expect_error("Test03", bmodes(&doc, "Test03_tower.bmi", t3, ts, &d), &d,
-                     "Test03_tower.bmi:6: beam_type: towers are not supported yet (beam_type "
-                     "2); only blades (1)");
+        if (bmodes(&doc, "Test03_tower.bmi", t3, ts, &d) != SM_OK ||
+            !json_object_get(json_object_get(doc, "request"), "tower"))
+            fail("Test03: expected the tower form (%s)", d.text);
+        json_decref(doc);
+        doc = NULL;
         free(t3), free(ts);
     }
     free(sec);

@@ -1,0 +1,174 @@
+#!/usr/bin/env python3
+"""Towers (DESIGN.md 8.5): the tower form and BModes' tower import, through the CLI.
+
+Usage: tower_test.py SPINMODAL REFERENCE_BLADES_DIR
+
+- BModes CertTest Test03 (a 82.39 m tower, top mass with c.m. offset and inertia products)
+  through `import bmodes --bmodes-mesh 8` (BModes' 12 elements as uniform members, 8 FE
+  elements each) against BModes' published frequencies (certtest_frequencies.csv).
+- The conventions, pinned against runs of BModes v3.00 (old-NWTC/BModes, built by
+  /tmp/bm/build_bmodes.sh; the numbers are written below): the same model without bending
+  rotary inertia (BModes has none) within 0.05 % on every bending mode, and doubling ixx_tip
+  (BModes' "tower s-s" moment, about the fore-aft x axis) lowers the mode BModes prints in
+  its "s-s" column and ours labels "edge" (side-side), not the fore-aft one.
+- Bad files: a tower file given as a blade and the reverse, guy wires (tow_support 1), a
+  rotor speed for a tower: each refused with FILE:LINE: FIELD.
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+FAILURES = []
+
+# BModes v3.00 on Test03 (Hz, modes 1-10), our runs: as filed, and with ixx_tip doubled
+BMODES_TEST03 = [0.420735734343209, 0.420985220562332, 1.95733294568696, 2.47182299334414,
+                 2.53921233537667, 5.14123465107359, 5.29577035601647, 10.0012162373898,
+                 11.1065523589314, 11.1149237762459]
+BMODES_TEST03_IXX2 = [0.417214839448905, 0.420735734343209, 1.95731249749742,
+                      2.12566616817704, 2.47182299334414, 4.65511872540179, 5.14123465107359,
+                      10.0012162373898, 10.8807764106990, 11.1065523589314]
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what)
+    if not cond:
+        FAILURES.append(what)
+    return cond
+
+
+def run(exe, args, cwd=None):
+    p = subprocess.run([exe] + args, capture_output=True, timeout=120, cwd=cwd)
+    return p.returncode, p.stdout.decode("utf-8", "replace"), p.stderr.decode("utf-8", "replace")
+
+
+def published(ref):
+    import csv
+    with open(os.path.join(ref, "bmodes_certtest", "certtest_frequencies.csv")) as f:
+        return [float(r["freq_Hz"]) for r in csv.DictReader(f) if r["test"] == "Test03_tower"][:10]
+
+
+def solve(exe, req, tmp, name):
+    path = os.path.join(tmp, name + ".json")
+    with open(path, "w") as f:
+        json.dump(req, f)
+    rc, out, err = run(exe, ["solve", path])
+    if not check(rc == 0, "%s: solved (%s)" % (name, err.strip()[:200])):
+        return []
+    return json.loads(out)["cases"][0]["modes"]
+
+
+def own_model(exe, bmi):
+    rc, out, err = run(exe, ["import", "bmodes", "--bmodes-mesh", "8", bmi])
+    check(rc == 0, "Test03 --bmodes-mesh 8 imported (%s)" % err.strip()[-200:])
+    return json.loads(out) if rc == 0 else {}
+
+
+def test03(exe, ref, tmp):
+    bmi = os.path.join(ref, "bmodes_certtest", "Test03_tower.bmi")
+    rc, out, err = run(exe, ["import", "bmodes", bmi])
+    req = json.loads(out) if rc == 0 else {}
+    tw = req.get("tower", {})
+    check(rc == 0 and "blade" not in req and tw.get("height") == 82.39 and
+          tw.get("base_height") == 0 and req["analysis"].get("omega") == [0],
+          "Test03: the tower form, height 82.39 m, speed 0")
+    check(tw.get("top_mass") == {"mass": 78055.8, "offset": [-3.3, 0, 1.1],
+                                 "inertia": [2960437, 3253223, 3264220],
+                                 "products": [0, 0, -18400]},
+          "Test03: top mass in tower axes (fa, ss, up): offset [cm_loc, 0, cm_axial], inertia "
+          "[ixx, iyy, izz], products [ixy, iyz, izx]")
+    check("reads cm_axial into cm_loc" in err, "Test03: the warning names BModes' cm_axial slip")
+    own = own_model(exe, bmi)
+    pm = own.get("structure", {}).get("point_masses", [{}])[0]
+    check(pm.get("offset") == [0, 0, 1.1] and pm.get("products") == [0, -18400, 0],
+          "own model: offset [cm_axial, 0, 0] as BModes reads it, along hub z (fore-aft)")
+    modes = solve(exe, own, tmp, "test03_own")
+    pub = published(ref)
+    for i, (m, b) in enumerate(zip(modes[:10], pub)):
+        e = 100 * (m["frequency_hz"] / b - 1)
+        tol = 0.5 if i < 8 else 0.8
+        check(abs(e) <= tol, "Test03 mode %2d (%s): %.5f Hz, BModes published %.5f Hz: %+.3f %% "
+              "(within %g %%)" % (i + 1, m.get("label"), m["frequency_hz"], b, e, tol))
+    check(len(modes) >= 10, "Test03: 10 modes")
+    return own
+
+
+def no_rotary(req):
+    """BModes' model has no bending rotary inertia (Struct.f90:1222): the mass moments x 1e-6."""
+    r = json.loads(json.dumps(req))
+    for m in r["structure"]["members"]:
+        for s in m["stations"]:
+            s["flap_inertia"] *= 1e-6
+            s["edge_inertia"] *= 1e-6
+    return r
+
+
+def conventions(exe, own, tmp):
+    modes = solve(exe, no_rotary(own), tmp, "test03_norot")
+    for i, (m, b) in enumerate(zip(modes[:10], BMODES_TEST03)):
+        if m.get("label", "").endswith("torsion"):
+            continue  # its distributed torsional inertia went with the mass moments
+        e = 100 * (m["frequency_hz"] / b - 1)
+        check(abs(e) <= 0.05, "no rotary inertia, mode %2d (%s): %.6f Hz, BModes %.6f Hz: "
+              "%+.4f %% (within 0.05 %%)" % (i + 1, m.get("label"), m["frequency_hz"], b, e))
+    r = json.loads(json.dumps(own))
+    pm = r["structure"]["point_masses"][0]
+    pm["inertia"][2] *= 2  # ixx_tip: about tower fa = hub z
+    modes2 = solve(exe, no_rotary(r), tmp, "test03_ixx2")
+    ss1 = [m for m in modes2 if m.get("label") == "1st edge"]
+    fa1 = [m for m in modes2 if m.get("label") == "1st flap"]
+    check(ss1 and abs(ss1[0]["frequency_hz"] / BMODES_TEST03_IXX2[0] - 1) < 5e-4,
+          "ixx_tip x 2: our side-side (edge) mode %.6f Hz = BModes' 's-s' mode %.6f Hz"
+          % (ss1[0]["frequency_hz"] if ss1 else 0, BMODES_TEST03_IXX2[0]))
+    check(fa1 and abs(fa1[0]["frequency_hz"] / BMODES_TEST03_IXX2[1] - 1) < 5e-4,
+          "ixx_tip x 2: our fore-aft (flap) mode %.6f Hz stays at BModes' 'f-a' %.6f Hz"
+          % (fa1[0]["frequency_hz"] if fa1 else 0, BMODES_TEST03_IXX2[1]))
+
+
+def bad_files(exe, ref, tmp):
+    src = os.path.join(ref, "bmodes_certtest")
+    for f in ("blade_sec_props.dat", "tower_sec_props.dat"):
+        shutil.copy(os.path.join(src, f), tmp)
+    with open(os.path.join(src, "Test03_tower.bmi")) as f:
+        tower = f.read()
+    with open(os.path.join(src, "Test01_nonunif_blade.bmi")) as f:
+        blade = f.read()
+    cases = (("tower_as_blade.bmi", tower.replace("2         beam_type", "1         beam_type"),
+              "tower_as_blade.bmi:51: tow_support: a tower's support line, but beam_type (line "
+              "6) is 1 (blade)"),
+             ("blade_as_tower.bmi", blade.replace("1         beam_type", "2         beam_type"),
+              "blade_as_tower.bmi:51: tow_support: missing: beam_type (line 6) is 2 (tower)"),
+             ("wires.bmi", tower.replace("0         tow_support", "1         tow_support"),
+              "wires.bmi:51: tow_support: 1 (tension guy wires) is not supported yet"),
+             ("platform.bmi", tower.replace("0         tow_support", "2         tow_support"),
+              "platform.bmi:51: tow_support: 2 (offshore support: monopile or floating platform) "
+              "is not supported yet"))
+    for name, text, want in cases:
+        with open(os.path.join(tmp, name), "w") as f:
+            f.write(text)
+        rc, out, err = run(exe, ["import", "bmodes", name], cwd=tmp)
+        check(rc == 2 and out == "" and want in err, "%s: exit 2, '%s'" % (name, want))
+    rc, out, err = run(exe, ["import", "bmodes", "--rpm", "12", os.path.join(src, "Test03_tower.bmi")])
+    check(rc == 2 and "rpm: a tower does not spin" in err, "--rpm on a tower: refused")
+
+
+def main():
+    exe, ref = os.path.abspath(sys.argv[1]), sys.argv[2]
+    tmp = tempfile.mkdtemp(prefix="spinmodal-tower-")
+    try:
+        own = test03(exe, ref, tmp)
+        if own:
+            conventions(exe, own, tmp)
+        bad_files(exe, ref, tmp)
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+    if FAILURES:
+        print("%d failure(s)" % len(FAILURES))
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
