@@ -14,26 +14,26 @@
 
 /* A symmetric sparse matrix, both triangles stored, compressed by columns. */
 typedef struct csym {
-    int n;              /* order */
-    int *p;             /* n+1 column pointers into i, x */
-    int *i;             /* p[n] row indices, ascending within each column */
-    double *x;          /* p[n] values */
+    int n;     /* order */
+    int *p;    /* n+1 column pointers into i, x */
+    int *i;    /* p[n] row indices, ascending within each column */
+    double *x; /* p[n] values */
 } csym;
 
 /* P A P' = L D L' (L unit lower triangular, D diagonal) of a positive definite csym A. */
 typedef struct csym_ldl {
-    int n;              /* order */
-    int *perm;          /* n: perm[k] = row of A that is pivot k */
-    int *lp;            /* n+1 column pointers of the strictly lower part of L */
-    int *li;            /* lp[n] row indices (pivot order, ascending) */
-    double *lx;         /* lp[n] values */
-    double *d;          /* n pivots, all > 0 */
+    int n;      /* order */
+    int *perm;  /* n: perm[k] = row of A that is pivot k */
+    int *lp;    /* n+1 column pointers of the strictly lower part of L */
+    int *li;    /* lp[n] row indices (pivot order, ascending) */
+    double *lx; /* lp[n] values */
+    double *d;  /* n pivots, all > 0 */
 } csym_ldl;
 
 /* Where an assembly loop adds element entries: a dense matrix or a csym with the pattern. */
 typedef struct csym_sink {
-    dmat *dense;        /* used when not NULL */
-    csym *sparse;       /* used otherwise */
+    dmat *dense;  /* used when not NULL */
+    csym *sparse; /* used otherwise */
 } csym_sink;
 
 /* ------------------------------------------------------------- csym.c */

@@ -20,8 +20,9 @@ double smi_dot3(const double *a, const double *b)
 double smi_elem_bending_energy(double EI, double l, double v1, double s1, double v2, double s2)
 {
     double a = v1 - v2;
-    return EI / (l * l * l) * (12 * a * a + 12 * l * a * (s1 + s2) +
-                               l * l * (4 * s1 * s1 + 4 * s2 * s2 + 4 * s1 * s2));
+    return EI / (l * l * l) *
+           (12 * a * a + 12 * l * a * (s1 + s2) +
+            l * l * (4 * s1 * s1 + 4 * s2 * s2 + 4 * s1 * s2));
 }
 
 double smi_elem_bar_energy(double k, double l, double a1, double a2)
@@ -36,12 +37,8 @@ void fe_stiffness_local(double EA, double EI, double l, double k[36])
     double a = EA / l, b = 12.0 * EI / (l * l * l), c = 6.0 * EI / (l * l);
     double d = 4.0 * EI / l, e = 2.0 * EI / l;
     double v[36] = {
-        a, 0, 0, -a, 0, 0,
-        0, b, c, 0, -b, c,
-        0, c, d, 0, -c, e,
-        -a, 0, 0, a, 0, 0,
-        0, -b, -c, 0, b, -c,
-        0, c, e, 0, -c, d,
+        a,  0, 0, -a, 0, 0, 0, b,  c,  0, -b, c,  0, c, d, 0, -c, e,
+        -a, 0, 0, a,  0, 0, 0, -b, -c, 0, b,  -c, 0, c, e, 0, -c, d,
     };
     memcpy(k, v, sizeof v);
 }
@@ -66,10 +63,9 @@ void fe_shape(double xi, double l, double s[12])
 void fe_geometric_bending(double l, double g[16])
 {
     double v[16] = {
-        6.0 / 5.0, l / 10.0, -6.0 / 5.0, l / 10.0,
-        l / 10.0, 2.0 * l * l / 15.0, -l / 10.0, -l * l / 30.0,
-        -6.0 / 5.0, -l / 10.0, 6.0 / 5.0, -l / 10.0,
-        l / 10.0, -l * l / 30.0, -l / 10.0, 2.0 * l * l / 15.0,
+        6.0 / 5.0, l / 10.0,      -6.0 / 5.0, l / 10.0,           l / 10.0,  2.0 * l * l / 15.0,
+        -l / 10.0, -l * l / 30.0, -6.0 / 5.0, -l / 10.0,          6.0 / 5.0, -l / 10.0,
+        l / 10.0,  -l * l / 30.0, -l / 10.0,  2.0 * l * l / 15.0,
     };
     for (int i = 0; i < 16; i++)
         g[i] = v[i] / l;

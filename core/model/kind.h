@@ -33,12 +33,12 @@ typedef struct smi_dense {
 } smi_dense;
 
 typedef struct smi_kind {
-    const char *name;   /* "planar" | "spatial" */
-    int spatial;        /* 1: the model is reported as spatial (sm_model_info) */
-    int axes;           /* 1: members have principal axes and twist (sm_model_member_axes) */
-    int node_dof;       /* values per node in nodal outputs and shapes: 3 | 6 */
-    int pose_dof;       /* frame pose coordinates in the tree path: 3 | 6 */
-    int ubar_dim;       /* undeformed local coordinates per free node: 2 | 3 */
+    const char *name;    /* "planar" | "spatial" */
+    int spatial;         /* 1: the model is reported as spatial (sm_model_info) */
+    int axes;            /* 1: members have principal axes and twist (sm_model_member_axes) */
+    int node_dof;        /* values per node in nodal outputs and shapes: 3 | 6 */
+    int pose_dof;        /* frame pose coordinates in the tree path: 3 | 6 */
+    int ubar_dim;        /* undeformed local coordinates per free node: 2 | 3 */
     int stiffened_start; /* 1: the continuation from rest starts with a small increment and a
                             stiffened predictor (equilibrium.c, DESIGN.md 7.3) */
 
@@ -98,7 +98,7 @@ typedef struct smi_kind {
     double (*nodes)(const sm_model *m, void *k, double *nodes, int *at);
 
     /* ---- mode labels (labels.c, DESIGN.md 9.1) ---- */
-    int label_bending;  /* 1: the bending slot is labelled "bending" (no edge / flap split) */
+    int label_bending; /* 1: the bending slot is labelled "bending" (no edge / flap split) */
     /** Element e's axes t, p2, p3 (hub frame) at the steady state of case c. */
     void (*label_axes)(const sm_model *m, const sm_case *c, const sm_elem *e, double t[3],
                        double p2[3], double p3[3]);

@@ -25,7 +25,8 @@ int tree_choose(int solver, int n, int max_m, int modes)
         return 0;
     if (solver == SM_SOLVER_TREE)
         return 1;
-    return n >= TREE_AUTO_MIN_N && max_m <= TREE_MAX_FRAME_M && 8 * modes <= n && modes <= SM_TREE_MAX_MODES;
+    return n >= TREE_AUTO_MIN_N && max_m <= TREE_MAX_FRAME_M && 8 * modes <= n &&
+           modes <= SM_TREE_MAX_MODES;
 }
 
 int tree_use(const sm_model *m)
@@ -110,8 +111,8 @@ int tree_alloc(const sm_model *m, tree_ws *t)
     t->u = dm_vec((size_t)d * S);
     t->v = dm_vec((size_t)d * S);
     t->work = dm_vec(4 * (size_t)mx + 2 * (size_t)(mx + 2 * d) * (mx + 2 * d) + 64);
-    if (!t->Kl || !t->Ml || !t->Cl || !t->F || !t->X || !t->ipiv || !t->lk || !t->D || !t->z || !t->u ||
-        !t->v || !t->work)
+    if (!t->Kl || !t->Ml || !t->Cl || !t->F || !t->X || !t->ipiv || !t->lk || !t->D || !t->z ||
+        !t->u || !t->v || !t->work)
         goto fail;
     return SM_OK;
 fail:
@@ -123,7 +124,8 @@ fail:
 static void tree_forward6(const sm_model *m, const tree_ws *t, int s, const double *x, double *u)
 {
     const sm_sub *b = &m->subs[s], *p = &m->subs[b->parent];
-    const double *up = u + 6 * b->parent, *a = t->lk + 3 * s, *D = t->D + t->d_off[s], *xp = x + p->q0;
+    const double *up = u + 6 * b->parent, *a = t->lk + 3 * s, *D = t->D + t->d_off[s],
+                 *xp = x + p->q0;
     double *us = u + 6 * s;
     us[0] = up[0] + up[4] * a[2] - up[5] * a[1];
     us[1] = up[1] + up[5] * a[0] - up[3] * a[2];
@@ -211,7 +213,7 @@ void tree_adjoint(const sm_model *m, const tree_ws *t, double *v, double *y)
         vp[2] += lk[2] * vs[0] + lk[3] * vs[1] + vs[2];
         double f0 = lk[0] * vs[0] + lk[1] * vs[1], f1 = -lk[1] * vs[0] + lk[0] * vs[1];
         for (int j = 0; j < p->m; j++)
-            yp[j] += DM(&p->N, 3 * a, j) * f0 + DM(&p->N, 3 * a + 1, j) * f1 + DM(&p->N, 3 * a + 2, j) * vs[2];
+            yp[j] += DM(&p->N, 3 * a, j) * f0 + DM(&p->N, 3 * a + 1, j) * f1 +
+                     DM(&p->N, 3 * a + 2, j) * vs[2];
     }
 }
-

@@ -46,7 +46,8 @@ static int planar_check_spatial_fields(const sm_structure *st, sm_diag *d)
     for (int i = 0; i < st->n_members; i++) {
         const sm_member *b = &st->members[i];
         if (b->twist != 0.0)
-            return planar_fail(d, SM_ITEM_MEMBER, i, "twist_deg", "twist_deg needs spatial sections");
+            return planar_fail(d, SM_ITEM_MEMBER, i, "twist_deg",
+                               "twist_deg needs spatial sections");
         if (b->e3[0] != 0.0 || b->e3[1] != 0.0 || b->e3[2] != 0.0)
             return planar_fail(d, SM_ITEM_MEMBER, i, "flap_direction",
                                "flap_direction needs spatial sections");
@@ -170,14 +171,14 @@ static int planar_dense_alloc(const sm_model *m, int use, smi_dense *D)
     return SM_OK;
 }
 
-static void planar_dense_tangent(const sm_model *m, const double *q, void *k, double s, smi_dense *D,
-                                 double *work)
+static void planar_dense_tangent(const sm_model *m, const double *q, void *k, double s,
+                                 smi_dense *D, double *work)
 {
     lin_tangent(m, q, k, s, 0, &D->K, &D->M, &D->H, &D->W, work);
 }
 
-static void planar_dense_linearize(const sm_model *m, const double *q, void *k, double omega, int gyro,
-                                   smi_dense *D, double *work)
+static void planar_dense_linearize(const sm_model *m, const double *q, void *k, double omega,
+                                   int gyro, smi_dense *D, double *work)
 {
     frames_eval(m, q, k);
     lin_tangent(m, q, k, omega * omega, 1, &D->K, &D->M, &D->H, &D->W, work); /* K*, P frozen; M* */
@@ -185,8 +186,8 @@ static void planar_dense_linearize(const sm_model *m, const double *q, void *k, 
         lin_gyro(m, k, omega, &D->C, &D->W, &D->X);
 }
 
-static int planar_tree_assemble(const sm_model *m, const double *q, void *k, double s, int lin, int gyro,
-                                tree_ws *t)
+static int planar_tree_assemble(const sm_model *m, const double *q, void *k, double s, int lin,
+                                int gyro, tree_ws *t)
 {
     if (lin) { /* K*, P frozen; M*; C* */
         frames_eval(m, q, k);

@@ -15,10 +15,10 @@
 /* Mass points: lumped nodes, or 4 Gauss points per element + point masses. */
 int modes_planar_points(sm_model *m)
 {
-    static const double gx[4] = {-0.86113631159405258, -0.33998104358485626,
-                                 0.33998104358485626, 0.86113631159405258};
-    static const double gw[4] = {0.34785484513745386, 0.65214515486254614,
-                                 0.65214515486254614, 0.34785484513745386};
+    static const double gx[4] = {-0.86113631159405258, -0.33998104358485626, 0.33998104358485626,
+                                 0.86113631159405258};
+    static const double gw[4] = {0.34785484513745386, 0.65214515486254614, 0.65214515486254614,
+                                 0.34785484513745386};
     int consistent = m->opt.mass == SM_MASS_CONSISTENT, np = 0;
     for (int k = 0; k < m->n_nodes; k++)
         if (m->nodes[k].sub >= 0 && (consistent ? m->nodes[k].point_mass : m->nodes[k].mass) > 0)

@@ -37,7 +37,8 @@ static void tree_links(const sm_model *m, const sm_kin *k, tree_ws *t)
 }
 
 /* Jl = [G, A N] (2 x (3+m), column-major ld 2) of a point at local position w with rows N. */
-static void tree_point_jac(double c, double si, const double *w, const double *N, int ldn, int mm, double *Jl)
+static void tree_point_jac(double c, double si, const double *w, const double *N, int ldn, int mm,
+                           double *Jl)
 {
     Jl[0] = 1;
     Jl[1] = 0;
@@ -82,7 +83,8 @@ void tree_centrifugal(const sm_model *m, const sm_kin *k, tree_ws *t, double *g)
 
 /* a_s and g_s of frames_hessian for substructure s (subtree forces in k->fext, which this
  * updates for the parent): Hl_s = a_s on theta-theta, g_s on theta-q_s. */
-static double tree_hessian_sub(const sm_model *m, const sm_kin *k, const tree_ws *t, int s, double *gs)
+static double tree_hessian_sub(const sm_model *m, const sm_kin *k, const tree_ws *t, int s,
+                               double *gs)
 {
     const sm_sub *b = &m->subs[s];
     double th = k->theta[s], c = cos(th), si = sin(th), a = 0, Ft[2] = {0, 0}, *F = k->fext;
@@ -122,7 +124,8 @@ static double tree_hessian_sub(const sm_model *m, const sm_kin *k, const tree_ws
     return a;
 }
 
-int tree_assemble(const sm_model *m, const double *q, sm_kin *k, double s2, int frozen, int gyro, tree_ws *t)
+int tree_assemble(const sm_model *m, const double *q, sm_kin *k, double s2, int frozen, int gyro,
+                  tree_ws *t)
 {
     tree_links(m, k, t);
     memset(k->fext, 0, 2 * (size_t)m->n_nodes * sizeof(double));
@@ -132,7 +135,8 @@ int tree_assemble(const sm_model *m, const double *q, sm_kin *k, double s2, int 
         const sm_sub *b = &m->subs[s];
         int l = 3 + b->m;
         double c = cos(k->theta[s]), si = sin(k->theta[s]);
-        double *Ml = t->Ml + t->loc_off[s], *Cl = t->Cl + t->loc_off[s], *Kl = t->Kl + t->loc_off[s];
+        double *Ml = t->Ml + t->loc_off[s], *Cl = t->Cl + t->loc_off[s],
+               *Kl = t->Kl + t->loc_off[s];
         memset(Ml, 0, (size_t)l * l * sizeof(double));
         memset(Cl, 0, (size_t)l * l * sizeof(double));
         for (int i = t->mp_ptr[s]; i < t->mp_ptr[s + 1]; i++) {
@@ -141,7 +145,8 @@ int tree_assemble(const sm_model *m, const double *q, sm_kin *k, double s2, int 
             /* Ml += m Jl' Jl;  Cl += m Jl' S Jl, S Jl = [-Jl_y; Jl_x] */
             for (int j = 0; j < l; j++)
                 for (int r = 0; r < l; r++) {
-                    Ml[(size_t)j * l + r] += mp->mass * (Jl[2 * r] * Jl[2 * j] + Jl[2 * r + 1] * Jl[2 * j + 1]);
+                    Ml[(size_t)j * l + r] +=
+                        mp->mass * (Jl[2 * r] * Jl[2 * j] + Jl[2 * r + 1] * Jl[2 * j + 1]);
                     if (gyro)
                         Cl[(size_t)j * l + r] +=
                             mp->mass * (-Jl[2 * r] * Jl[2 * j + 1] + Jl[2 * r + 1] * Jl[2 * j]);

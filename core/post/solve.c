@@ -14,8 +14,8 @@
 #include <string.h>
 
 /* DESIGN.md 9.1 on a solved sweep: labels, tracking, critical speeds (shapes still present). */
-static int sweep_trust(const sm_model *m, sm_result *r, const double *omegas, int n, sm_progress_fn cb,
-                       void *user)
+static int sweep_trust(const sm_model *m, sm_result *r, const double *omegas, int n,
+                       sm_progress_fn cb, void *user)
 {
     int *ord = malloc((size_t)(n ? n : 1) * sizeof(int)), rc = SM_NOMEM;
     if (!ord || sweep_order(omegas, n, ord) < 0)

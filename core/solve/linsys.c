@@ -15,13 +15,13 @@
 
 struct smi_lin {
     const smi_kind *kind;
-    int use;           /* SMI_USE_NEWTON | SMI_USE_MODES */
-    int tree;          /* 1: tree form (t, light kinematics); 0: dense matrices */
-    void *kin;         /* the kind's kinematics workspace */
+    int use;   /* SMI_USE_NEWTON | SMI_USE_MODES */
+    int tree;  /* 1: tree form (t, light kinematics); 0: dense matrices */
+    void *kin; /* the kind's kinematics workspace */
     tree_ws t;
     smi_dense D;
-    int *ipiv;         /* LU pivots of the dense Newton tangent */
-    double *work;      /* 12 max m_s + n doubles */
+    int *ipiv;    /* LU pivots of the dense Newton tangent */
+    double *work; /* 12 max m_s + n doubles */
 };
 
 void smi_dense_free(smi_dense *D)
@@ -109,7 +109,8 @@ int smi_lin_solve(const sm_model *m, smi_lin *L, double *x)
     if (L->tree)
         return tree_solve(m, &L->t, x);
     return dm_lapack_status(
-        LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', n, 1, L->D.K.a, n, L->ipiv, x, n), SM_LAPACK_FAILED);
+        LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', n, 1, L->D.K.a, n, L->ipiv, x, n),
+        SM_LAPACK_FAILED);
 }
 
 int smi_lin_det_sign(const sm_model *m, const smi_lin *L)
@@ -155,7 +156,8 @@ int smi_lin_finite(const smi_lin *L)
     return L->tree || (dm_finite(&L->D.K) && dm_finite(&L->D.M) && dm_finite(&L->D.C));
 }
 
-int smi_lin_eigen(const sm_model *m, smi_lin *L, const sm_progress *pr, sm_eig_out *e, int *fallback)
+int smi_lin_eigen(const sm_model *m, smi_lin *L, const sm_progress *pr, sm_eig_out *e,
+                  int *fallback)
 {
     if (L->tree)
         return eig_solve_tree(m, &L->t, m->opt.coriolis, m->opt.modes, pr, e, fallback);
@@ -184,8 +186,8 @@ int smi_lin_lowest(const sm_model *m, smi_lin *L, double *lambda)
     if (!w || !ifail || L->tree)
         goto done;
     /* the lowest eigenvalue of the symmetric K* (its sign change is that of det K*) */
-    rc = dm_lapack_status(LAPACKE_dsyevx(LAPACK_COL_MAJOR, 'N', 'I', 'L', n, L->D.K.a, n, vl, vu, 1, 1,
-                                         0.0, &found, w, NULL, 1, ifail),
+    rc = dm_lapack_status(LAPACKE_dsyevx(LAPACK_COL_MAJOR, 'N', 'I', 'L', n, L->D.K.a, n, vl, vu, 1,
+                                         1, 0.0, &found, w, NULL, 1, ifail),
                           SM_LAPACK_FAILED);
     if (rc == SM_OK && found == 1)
         *lambda = w[0];

@@ -52,7 +52,8 @@ int smi_lin_finite(const smi_lin *L);
 /** The eigen-analysis of the last smi_lin_linearize into *e (eig_solve / eig_solve_tree):
  *  *fallback 1 when the tree path cannot give the modes and the dense one must (then e is empty
  *  and SM_OK returned); pr (may be NULL): the tree path's stop callback. */
-int smi_lin_eigen(const sm_model *m, smi_lin *L, const sm_progress *pr, sm_eig_out *e, int *fallback);
+int smi_lin_eigen(const sm_model *m, smi_lin *L, const sm_progress *pr, sm_eig_out *e,
+                  int *fallback);
 /** Negative eigenvalues of K* found by the tree path's factorisation (0 on the dense path). */
 int smi_lin_negative(const smi_lin *L);
 /** y (node_dof n_nodes) = nodal motion of modal vector x at the last linearisation. */

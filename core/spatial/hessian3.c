@@ -62,7 +62,8 @@ static void sp_rigid(const sm_model *m, sp_kin *k, int c)
             k->cR[3 * c + i] = k->bR[3 * c + i] + _Complex_I * h * v[i];
         for (int j = 0; j < 3; j++) { /* Im A = h skew(dtheta) A */
             const sp_cx *aj = A0 + 3 * j;
-            double w[3] = {v[4] * creal(aj[2]) - v[5] * creal(aj[1]), v[5] * creal(aj[0]) - v[3] * creal(aj[2]),
+            double w[3] = {v[4] * creal(aj[2]) - v[5] * creal(aj[1]),
+                           v[5] * creal(aj[0]) - v[3] * creal(aj[2]),
                            v[3] * creal(aj[1]) - v[4] * creal(aj[0])};
             for (int i = 0; i < 3; i++)
                 k->cA[9 * c + 3 * j + i] = aj[i] + _Complex_I * h * w[i];
@@ -99,7 +100,8 @@ static void sp_base(const sm_model *m, sp_kin *k)
     memcpy(k->bF, k->cF, 6 * (size_t)m->n_subs * sizeof(sp_cx));
     for (int pi = 0; pi < m->n_pt; pi++)
         if (m->pt[pi].sub >= 0)
-            sp_point_state(m, k, pi, k->cq, 1, k->lw + 3 * pi, k->lpsi + 3 * pi, k->lL + 9 * pi, k->lT + 9 * pi);
+            sp_point_state(m, k, pi, k->cq, 1, k->lw + 3 * pi, k->lpsi + 3 * pi, k->lL + 9 * pi,
+                           k->lT + 9 * pi);
     k->cached = 1;
     for (int c = m->n_subs - 1; c >= 0; c--)
         sp_rigid(m, k, c);

@@ -66,15 +66,15 @@ static int spatial_dense_alloc(const sm_model *m, int use, smi_dense *D)
     return SM_OK;
 }
 
-static void spatial_dense_tangent(const sm_model *m, const double *q, void *k, double s, smi_dense *D,
-                                  double *work)
+static void spatial_dense_tangent(const sm_model *m, const double *q, void *k, double s,
+                                  smi_dense *D, double *work)
 {
     lin3_tangent(m, q, k, s, 0, &D->K, &D->H, work);
 }
 
 /* K*, P frozen; M*; C* (DESIGN.md 7.3). */
-static void spatial_dense_linearize(const sm_model *m, const double *q, void *k, double omega, int gyro,
-                                    smi_dense *D, double *work)
+static void spatial_dense_linearize(const sm_model *m, const double *q, void *k, double omega,
+                                    int gyro, smi_dense *D, double *work)
 {
     sp_eval(m, q, k);
     lin3_tangent(m, q, k, omega * omega, 1, &D->K, &D->H, work);
@@ -83,8 +83,8 @@ static void spatial_dense_linearize(const sm_model *m, const double *q, void *k,
         lin3_gyro(m, k, omega, &D->C, &D->W);
 }
 
-static int spatial_tree_assemble(const sm_model *m, const double *q, void *k, double s, int lin, int gyro,
-                                 tree_ws *t)
+static int spatial_tree_assemble(const sm_model *m, const double *q, void *k, double s, int lin,
+                                 int gyro, tree_ws *t)
 {
     return tree3_assemble(m, q, k, s, lin, lin, lin && gyro, t);
 }
@@ -109,7 +109,8 @@ static void spatial_rotate(const double psi[3], double v[3])
     double th = sqrt(smi_dot3(psi, psi));
     if (!(th > 0))
         return;
-    double k[3] = {psi[0] / th, psi[1] / th, psi[2] / th}, kv = smi_dot3(k, v), cs = cos(th), sn = sin(th);
+    double k[3] = {psi[0] / th, psi[1] / th, psi[2] / th}, kv = smi_dot3(k, v), cs = cos(th),
+           sn = sin(th);
     double x[3] = {k[1] * v[2] - k[2] * v[1], k[2] * v[0] - k[0] * v[2], k[0] * v[1] - k[1] * v[0]};
     for (int i = 0; i < 3; i++)
         v[i] = v[i] * cs + x[i] * sn + k[i] * kv * (1 - cs);
