@@ -108,9 +108,9 @@ typedef struct bm_main {
     char sec_raw[256];  /* as written, for the loader */
     int sec_line;       /* line of sec_props_file in the .bmi */
     double mult[10]; /* sec_mass .. tc_offst multipliers, file order */
-    int tower;          /* beam_type 2 (DESIGN.md 8.5) */
-    int speed_line;     /* line of rot_rpm */
-    int beam_line;      /* line of beam_type */
+    int tower;       /* beam_type 2 (DESIGN.md 8.5) */
+    int speed_line;  /* line of rot_rpm */
+    int beam_line;   /* line of beam_type */
     unsigned tw_zeroed; /* tower: columns (1 << column) the file gives and BModes overwrites */
     int tw_zeroed_line; /* the first line with one of them */
 } bm_main;
@@ -313,7 +313,8 @@ static int bm_support(bm_in *b, const bm_main *m)
         while (imp_next(&b->r))
             if (imp_split(b->r.s, b->r.n, ",", t, 2) >= 2 && t[1].n >= 11 &&
                 !strncmp(t[1].s, "tow_support", 11))
-                return imp_fail(b->d, b->file, b->r.line, "tow_support", "a tower's support "
+                return imp_fail(b->d, b->file, b->r.line, "tow_support",
+                                "a tower's support "
                                 "line, but beam_type (line %d) is 1 (blade): this is a tower "
                                 "file; give beam_type 2 to import it as a tower",
                                 m->beam_line);
@@ -325,22 +326,26 @@ static int bm_support(bm_in *b, const bm_main *m)
     else
         b->r.line++;
     if (t[0].n == 0 || imp_number(&t[0], &x))
-        return imp_fail(b->d, b->file, b->r.line, "tow_support", "missing: beam_type (line %d) "
+        return imp_fail(b->d, b->file, b->r.line, "tow_support",
+                        "missing: beam_type (line %d) "
                         "is 2 (tower), and a tower's file goes on after el_loc with its support "
                         "lines (tow_support, BModes.f90:503), a number here; a blade's file has "
-                        "none: give beam_type 1 to import it as a blade", m->beam_line);
+                        "none: give beam_type 1 to import it as a blade",
+                        m->beam_line);
     if (x != floor(x) || x < 0.0 || x > 2.0)
         return imp_fail(b->d, b->file, b->r.line, "tow_support",
                         "must be an integer in [0, 2] (%.15g)", x);
     ts = (long)x;
     if (ts == 1)
-        return imp_fail(b->d, b->file, b->r.line, "tow_support", "1 (tension guy wires) is not "
+        return imp_fail(b->d, b->file, b->r.line, "tow_support",
+                        "1 (tension guy wires) is not "
                         "supported yet: the wires are springs on the tower (n_attachments, "
                         "n_wires, node_attach, wire_stfness, th_wire) and the solver has no "
                         "elastic supports yet (issue 25); tow_support 0 imports the tower "
                         "without them");
     if (ts == 2)
-        return imp_fail(b->d, b->file, b->r.line, "tow_support", "2 (offshore support: "
+        return imp_fail(b->d, b->file, b->r.line, "tow_support",
+                        "2 (offshore support: "
                         "monopile or floating platform) is not supported yet: the platform's "
                         "mass, hydrodynamic and mooring matrices and the distributed soil "
                         "springs need elastic supports and a free base, which the solver does "
@@ -477,49 +482,57 @@ static int bm_blade(const bm_main *m, const import_options *o, imp_blade *bl, js
 static int bm_tower(const bm_main *m, const import_options *o, imp_blade *bl, json_t *warn,
                     import_diag *d, const char *file)
 {
-    static const char *const names[] = {"sec_loc",  "str_tw",   "tw_iner",   "mass_den",
-                                        "flp_iner", "edge_iner", "flp_stff", "edge_stff",
-                                        "tor_stff", "axial_stff", "cg_offst", "sc_offst",
-                                        "tc_offst"};
+    static const char *const names[] = {
+        "sec_loc",   "str_tw",   "tw_iner",    "mass_den", "flp_iner", "edge_iner", "flp_stff",
+        "edge_stff", "tor_stff", "axial_stff", "cg_offst", "sc_offst", "tc_offst"};
     char cols[160];
     size_t len = 0;
     int bad = 0, c;
 
     if (!isnan(o->rpm))
-        return imp_fail(d, file, 0, "rpm", "a tower does not spin: the rotor speed option "
+        return imp_fail(d, file, 0, "rpm",
+                        "a tower does not spin: the rotor speed option "
                         "does not apply to a tower (beam_type 2)");
     bl->length = m->radius - m->hub_rad;
     bl->hub_radius = m->hub_rad;
     bl->rpm = 0.0;
     bl->modes = (int)m->modepr;
     if (o->max_modes > 0 && bl->modes > o->max_modes) {
-        bad |= imp_warn(warn, "/analysis/modes", "modepr %d is above the limit of %d modes: "
-                        "analysis.modes = %d", bl->modes, o->max_modes, o->max_modes);
+        bad |= imp_warn(warn, "/analysis/modes",
+                        "modepr %d is above the limit of %d modes: "
+                        "analysis.modes = %d",
+                        bl->modes, o->max_modes, o->max_modes);
         bl->modes = o->max_modes;
     }
     if (m->rpm != 0.0)
-        bad |= imp_warn(warn, "/analysis/omega", "%s:%d: rot_rpm x rpm_mult = %g rpm is not used: "
+        bad |= imp_warn(warn, "/analysis/omega",
+                        "%s:%d: rot_rpm x rpm_mult = %g rpm is not used: "
                         "a tower does not spin (BModes sets its speed to 0, BModes.f90:436)",
                         file, m->speed_line, m->rpm);
     if (m->precone != 0.0 || m->bl_thp != 0.0)
-        bad |= imp_warn(warn, "/tower", "precone %g and bl_thp %g degrees are not used: BModes "
-                        "sets them to zero for a tower", m->precone, m->bl_thp);
+        bad |= imp_warn(warn, "/tower",
+                        "precone %g and bl_thp %g degrees are not used: BModes "
+                        "sets them to zero for a tower",
+                        m->precone, m->bl_thp);
     if (m->tip[1] != m->tip[2] || m->tip[2] != 0.0)
-        bad |= imp_warn(warn, "/tower/top_mass/offset", "top_mass.offset = [cm_loc, 0, "
+        bad |= imp_warn(warn, "/tower/top_mass/offset",
+                        "top_mass.offset = [cm_loc, 0, "
                         "cm_axial] = [%g, 0, %g] m as the file's comments define them; BModes "
                         "v3.00 itself reads cm_axial into cm_loc (BModes.f90:448-449), so its "
                         "own numbers are for the offset [%g, 0, 0] (the option bmodes_mesh "
-                        "uses that, to reproduce them)", m->tip[1], m->tip[2], m->tip[2]);
+                        "uses that, to reproduce them)",
+                        m->tip[1], m->tip[2], m->tip[2]);
     for (c = 0; c < BM_COLUMNS && m->tw_zeroed; c++)
         if ((m->tw_zeroed & (1u << c)) && len < sizeof(cols))
-            len += (size_t)snprintf(cols + len, sizeof(cols) - len, "%s%s", len ? ", " : "",
-                                    names[c]);
+            len +=
+                (size_t)snprintf(cols + len, sizeof(cols) - len, "%s%s", len ? ", " : "", names[c]);
     if (m->tw_zeroed)
-        bad |= imp_warn(warn, "/tower/stations", "%s:%d: %s not used: BModes reads a tower's "
+        bad |= imp_warn(warn, "/tower/stations",
+                        "%s:%d: %s not used: BModes reads a tower's "
                         "sections as symmetric, with twists and offsets zero and the s-s "
                         "(edge) inertia and stiffness equal to the f-a (flap) ones "
-                        "(BModes.f90:667-677), and so does the import", m->sec_file,
-                        m->tw_zeroed_line, cols);
+                        "(BModes.f90:667-677), and so does the import",
+                        m->sec_file, m->tw_zeroed_line, cols);
     return bad ? SM_NOMEM : SM_OK;
 }
 
@@ -583,8 +596,8 @@ static int bm_tower_doc(json_t *doc, const bm_main *m)
  */
 static int bm_tower_own_offset(json_t *doc, const bm_main *m)
 {
-    json_t *top = json_object_get(json_object_get(json_object_get(doc, "request"), "tower"),
-                                  "top_mass");
+    json_t *top =
+        json_object_get(json_object_get(json_object_get(doc, "request"), "tower"), "top_mass");
     double off[3] = {m->tip[2], 0.0, 0.0};
 
     if (!top || (m->tip[1] == m->tip[2] && m->tip[2] == 0.0))
@@ -593,8 +606,8 @@ static int bm_tower_own_offset(json_t *doc, const bm_main *m)
         return -1;
     return imp_warn(json_object_get(doc, "input_warnings"), "/tower/top_mass/offset",
                     "BModes' own model: top_mass.offset = [%g, 0, 0] m, the offset BModes v3.00 "
-                    "computes with (it reads cm_axial = %g into cm_loc = %g)", m->tip[2],
-                    m->tip[2], m->tip[1]);
+                    "computes with (it reads cm_axial = %g into cm_loc = %g)",
+                    m->tip[2], m->tip[2], m->tip[1]);
 }
 
 /* "source": what the .bmi said that the request does not carry. */
@@ -616,11 +629,13 @@ static json_t *bm_source(const bm_main *m, const char *bmi, json_t *el_loc)
         mult = NULL;
         bad |= json_object_set_new(src, "nselt", json_integer(m->nselt));
         bad |= json_object_set(src, "el_loc", el_loc);
-        bad |= json_object_set_new(src, "note", json_string(
-            m->tower ? "BModes' element boundaries (nselt, el_loc) are not used: the tower is "
-                       "meshed with tower.elements equal elements"
-                     : "BModes' element boundaries (nselt, el_loc) are not used: the blade is "
-                       "meshed with blade.elements equal elements"));
+        bad |= json_object_set_new(
+            src, "note",
+            json_string(
+                m->tower ? "BModes' element boundaries (nselt, el_loc) are not used: the tower is "
+                           "meshed with tower.elements equal elements"
+                         : "BModes' element boundaries (nselt, el_loc) are not used: the blade is "
+                           "meshed with blade.elements equal elements"));
     }
     json_decref(mult);
     if (bad) {
@@ -760,8 +775,8 @@ static int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *fil
     root = json_object_get(json_object_get(ex, "joints"), rname);
     tip = json_object_get(json_object_get(ex, "joints"), tname);
     st = json_pack("{s:{}, s:O, s:[], s:s, s:O}", "joints", "sections",
-                   json_object_get(ex, "sections"), "members", "clamp", rname,
-                   "point_masses", json_object_get(ex, "point_masses"));
+                   json_object_get(ex, "sections"), "members", "clamp", rname, "point_masses",
+                   json_object_get(ex, "point_masses"));
     if (!st)
         goto done;
     joints = json_object_get(st, "joints");
@@ -811,10 +826,9 @@ static int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *fil
             }
             if (two[0] && two[1])
                 m = json_pack("{s:s, s:s, s:s, s:s, s:i, s:O, s:O, s:[O, O]}", "id", id, "from",
-                              from, "to", name, "section", secname, "elements", k,
-                              "flap_direction", json_object_get(mem, "flap_direction"),
-                              "twist_deg", json_object_get(mem, "twist_deg"), "stations",
-                              two[0], two[1]);
+                              from, "to", name, "section", secname, "elements", k, "flap_direction",
+                              json_object_get(mem, "flap_direction"), "twist_deg",
+                              json_object_get(mem, "twist_deg"), "stations", two[0], two[1]);
             json_decref(two[0]);
             json_decref(two[1]);
             json_decref(mid);
@@ -827,12 +841,13 @@ static int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *fil
         json_object_del(st, "point_masses");
     if (json_object_set(req, "structure", st) ||
         json_object_del(req, json_object_get(req, "tower") ? "tower" : "blade") ||
-        imp_warn(warn, "/structure", "BModes' own model (bmodes_mesh %d): its %zu elements as uniform members "
-                       "with the properties at their midpoints (BModes.f90:1110), %d FE elements "
-                       "each, which reproduces BModes' numbers; without the option the "
-                       "properties are interpolated along the span as the file gives them (the "
-                       "finer model: BModes itself refined to 96 elements gives 1.6-5.5 %% "
-                       "higher frequencies on its CertTest blades)",
+        imp_warn(warn, "/structure",
+                 "BModes' own model (bmodes_mesh %d): its %zu elements as uniform members "
+                 "with the properties at their midpoints (BModes.f90:1110), %d FE elements "
+                 "each, which reproduces BModes' numbers; without the option the "
+                 "properties are interpolated along the span as the file gives them (the "
+                 "finer model: BModes itself refined to 96 elements gives 1.6-5.5 %% "
+                 "higher frequencies on its CertTest blades)",
                  k, n - 1, k) ||
         json_object_set_new(json_object_get(doc, "source"), "note",
                             json_string("BModes' element boundaries (nselt, el_loc) are the "
@@ -896,8 +911,8 @@ int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void
     if ((st = imp_option(d, bmi->name, "rpm", o->rpm)) || (st = imp_encoding(d, bmi, &body)))
         goto done;
     bm_init(&b, &body, d);
-    if ((st = bm_general(&b, &m)) || (st = bm_props(&b, &m)) ||
-        (st = bm_mesh(&b, &m, el_loc)) || (st = bm_support(&b, &m)))
+    if ((st = bm_general(&b, &m)) || (st = bm_props(&b, &m)) || (st = bm_mesh(&b, &m, el_loc)) ||
+        (st = bm_support(&b, &m)))
         goto done;
     why[0] = '\0';
     st = load(ctx, m.sec_raw, &sf, why, sizeof(why));
@@ -924,9 +939,9 @@ int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void
     sec = json_pack("{s:f}", "ip_over_a", 0.0);
     if (!sec || imp_warn(warn, m.tower ? "/tower/section/ip_over_a" : "/blade/section/ip_over_a",
                          "%s.section.ip_over_a = 0: BModes has no tension-torsion "
-                               "(Wagner) stiffness, so the import leaves it out to reproduce "
-                               "BModes; delete ip_over_a to include it (it raises the first "
-                               "torsion frequency, ~1.4 %% on BModes' Test01)",
+                         "(Wagner) stiffness, so the import leaves it out to reproduce "
+                         "BModes; delete ip_over_a to include it (it raises the first "
+                         "torsion frequency, ~1.4 %% on BModes' Test01)",
                          m.tower ? "tower" : "blade")) {
         json_decref(sec);
         json_decref(src);

@@ -86,9 +86,8 @@ static const double tower_T[3][3] = {{0, 1, 0},  /* hub x: ss */
  */
 static void tower_tensor(const double diag[3], const double prod[3], double hd[3], double hp[3])
 {
-    double I[3][3] = {{diag[0], prod[0], prod[2]},
-                      {prod[0], diag[1], prod[1]},
-                      {prod[2], prod[1], diag[2]}};
+    double I[3][3] = {
+        {diag[0], prod[0], prod[2]}, {prod[0], diag[1], prod[1]}, {prod[2], prod[1], diag[2]}};
     double H[3][3];
     int i, j, a, b;
 
@@ -126,8 +125,10 @@ static int tower_top_mass(val_ctx *v, const json_t *tm, json_t *ct, double t[10]
     json_t *c;
 
     if (!json_is_object(tm)) {
-        field_error(v, "/tower/top_mass", "must be an object {mass [, offset, inertia, "
-                    "products]}, not %s", field_type_name(tm));
+        field_error(v, "/tower/top_mass",
+                    "must be an object {mass [, offset, inertia, "
+                    "products]}, not %s",
+                    field_type_name(tm));
         return 0;
     }
     if (!(c = json_object())) {
@@ -161,12 +162,15 @@ static void tower_reserved(val_ctx *v, const json_t *tw, json_t *ct)
 
     for (k = 0; k < sizeof(r) / sizeof(r[0]); k++)
         if (json_object_get(tw, r[k].key))
-            field_error_key(v, "/tower", r[k].key, "not supported yet: %s needs elastic "
+            field_error_key(v, "/tower", r[k].key,
+                            "not supported yet: %s needs elastic "
                             "supports, which the solver does not have yet (issue 25); leave "
-                            "'%s' out for a tower clamped at its base", r[k].what, r[k].key);
+                            "'%s' out for a tower clamped at its base",
+                            r[k].what, r[k].key);
     field_bool(v, tw, "gravity", "/tower", ct, 0);
     if (json_is_true(json_object_get(tw, "gravity")))
-        field_error(v, "/tower/gravity", "not supported yet: the weight of the tower and top "
+        field_error(v, "/tower/gravity",
+                    "not supported yet: the weight of the tower and top "
                     "mass as an axial load needs the solver's support (issue 25); give false "
                     "or leave it out (BModes and ElastoDyn's modes leave gravity out too)");
 }
@@ -184,7 +188,8 @@ static void tower_scalars(val_ctx *v, const json_t *tw, json_t *ct, double g[3])
     else if (!field_real(v, tw, "base_height", "/tower", ct, FIELD_NONNEG, " (m)", &g[1]))
         g[1] = 0;
     if (!(g[1] < g[0])) {
-        field_error(v, "/tower/base_height", "the rigid base (%g m) must be lower than the "
+        field_error(v, "/tower/base_height",
+                    "the rigid base (%g m) must be lower than the "
                     "tower's height (%g m): the flexible tower runs from base_height to height",
                     g[1], g[0]);
         g[1] = 0;
@@ -224,8 +229,7 @@ static json_t *tower_structure(const json_t *tw, const double g[3], const double
         if (json_array_append_new(json_object_get(st, "point_masses"),
                                   json_pack("{s:s, s:f, s:o, s:o, s:o}", "joint", "top", "mass",
                                             t[0], "offset", field_reals(off, 3), "inertia",
-                                            field_reals(hd, 3), "products",
-                                            field_reals(hp, 3)))) {
+                                            field_reals(hd, 3), "products", field_reals(hp, 3)))) {
             json_decref(st);
             return NULL;
         }
@@ -267,17 +271,19 @@ done:
 
 json_t *tower_validate(val_ctx *v, const json_t *root, json_t *canon)
 {
-    static const char *const keys[] = {"height",   "base_height", "elements", "section",
-                                       "stations", "top_mass",    "gravity",  "wires",
-                                       "foundation", "platform",  NULL};
+    static const char *const keys[] = {"height",     "base_height", "elements", "section",
+                                       "stations",   "top_mass",    "gravity",  "wires",
+                                       "foundation", "platform",    NULL};
     const json_t *tw = json_object_get(root, "tower"), *tm, *sec, *mem;
     json_t *ct, *st, *cst = NULL;
     double g[3], t[10];
     int top_ok = 0;
 
     if (!json_is_object(tw)) {
-        field_error(v, "/tower", "must be an object {height, [base_height, elements,] section "
-                    "and/or stations [, top_mass]}, not %s", field_type_name(tw));
+        field_error(v, "/tower",
+                    "must be an object {height, [base_height, elements,] section "
+                    "and/or stations [, top_mass]}, not %s",
+                    field_type_name(tw));
         return NULL;
     }
     if (!(ct = json_object())) {
@@ -291,7 +297,8 @@ json_t *tower_validate(val_ctx *v, const json_t *root, json_t *canon)
         top_ok = tower_top_mass(v, tm, ct, t);
     if (json_object_get(tw, "section") &&
         sec_classify_as(json_object_get(tw, "section"), 1) == SEC_PLANAR) {
-        field_error(v, "/tower/section", "a tower is spatial, and this section is %s: give it "
+        field_error(v, "/tower/section",
+                    "a tower is spatial, and this section is %s: give it "
                     "as EA, EI_flap (fore-aft), EI_edge (side-side), GJ and mass_per_length (or "
                     "E, G, A, I_flap, I_edge, J and mass_per_length)",
                     sec_form_name(SEC_PLANAR));
@@ -333,9 +340,11 @@ void tower_check_speeds(val_ctx *v, const json_t *canon)
     for (i = 0; i < n; i++)
         if (om[i] != 0) {
             char *p = err_ptr_key("/analysis", key);
-            field_error(v, p, "a tower does not spin: its speed must be 0 (speed %zu is %g "
+            field_error(v, p,
+                        "a tower does not spin: its speed must be 0 (speed %zu is %g "
                         "%s); the rotor's speed belongs to a rotor-on-tower model, which is "
-                        "not supported yet", i + 1, !strcmp(key, "rpm") ? rpm[i] : om[i],
+                        "not supported yet",
+                        i + 1, !strcmp(key, "rpm") ? rpm[i] : om[i],
                         !strcmp(key, "rpm") ? "rpm" : "rad/s");
             free(p);
             break;

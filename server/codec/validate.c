@@ -785,8 +785,8 @@ static void val_name(val_ctx *v, const json_t *root)
  */
 static json_t *val_document(val_ctx *v, const json_t *root, json_t **structure)
 {
-    static const char *const keys[] = {"structure", "blade", "tower", "frames", "analysis",
-                                       "name", NULL};
+    static const char *const keys[] = {"structure", "blade", "tower", "frames",
+                                       "analysis",  "name",  NULL};
     json_t *canon;
 
     if (!json_is_object(root)) {
