@@ -610,14 +610,12 @@ int sm_estimate(const sm_model *m, const sm_structure *st, const sm_options *opt
 /** One ElastoDyn polynomial (DESIGN §B "ElastoDyn polynomial fit"): phi(x) = sum over
  *  k = 2..6 of coef[k-2] x^k, x from the flexible root (0) to the tip (1). */
 typedef struct sm_ed_fit {
-    int mode;                 /* index of the fitted mode in its case; -1: no mode qualified */
-    int direction;            /* 0: direction a (blade flap, tower fore-aft), 1: direction b */
-    double coef[5];           /* C2..C6, C6 = 1 - (C2 + ... + C5): phi(0) = phi'(0) = 0, phi(1) = 1 */
-    double tip;               /* the signed tip displacement the shape was divided by (units of
-                                 the input) */
-    double share;             /* the direction's share of the mode's bending strain energy
-                                 (NaN when no energy was given) */
-    int warning;              /* 1 when share < SM_ED_CLEAN */
+    int mode;       /* index of the fitted mode in its case; -1: no mode qualified */
+    int direction;  /* 0: direction a (blade flap, tower fore-aft), 1: direction b */
+    double coef[5]; /* C2..C6, C6 = 1 - (C2 + ... + C5): phi(0) = phi'(0) = 0, phi(1) = 1 */
+    double tip;     /* the signed tip displacement the shape was divided by (input units) */
+    double share;   /* the direction's share of the bending strain energy (NaN: none given) */
+    int warning;    /* 1 when share < SM_ED_CLEAN */
     double rms, max_residual; /* residuals phi(x_j) - y_j/tip over the nodes (root included) */
     double tip_slope_fe;      /* d(y/tip)/dx at the tip from the FE rotations, NaN when not given */
     double tip_slope_fit;     /* phi'(1) = sum k C_k */
@@ -642,16 +640,16 @@ double sm_elastodyn_eval(const double coef[5], double x, double *slope);
  *  and b (blade: flap and edge in the principal axes; tower: fore-aft and side-side).
  *  All arrays borrowed. */
 typedef struct sm_ed_shapes {
-    int n_modes;              /* modes of the case, ascending frequency */
-    int n_nodes;              /* nodes along the member, root first, >= 4 */
-    const double *x;          /* n_nodes: distance from the flexible root / flexible length */
-    const double *re;         /* n_modes * 2 * n_nodes: displacement of mode k in direction d
-                                 at node j is re[(2k + d) n_nodes + j] */
-    const double *im;         /* the same imaginary parts (Coriolis), or NULL */
-    const double *slope_re;   /* n_modes * 2: d(displacement)/dx at the tip, [2k + d], or NULL */
-    const double *slope_im;   /* the same imaginary parts, or NULL */
-    const double *energy;     /* n_modes * SM_ENERGY_PARTS (sm_case.energy) */
-    int part[2];              /* the energy slot (SM_MODE_EDGE or SM_MODE_FLAP) of a and b */
+    int n_modes;            /* modes of the case, ascending frequency */
+    int n_nodes;            /* nodes along the member, root first, >= 4 */
+    const double *x;        /* n_nodes: distance from the flexible root / flexible length */
+    const double *re;       /* n_modes * 2 * n_nodes: mode k, direction d, node j at
+                               re[(2k + d) n_nodes + j] (displacement) */
+    const double *im;       /* the same imaginary parts (Coriolis), or NULL */
+    const double *slope_re; /* n_modes * 2: d(displacement)/dx at the tip, [2k + d], or NULL */
+    const double *slope_im; /* the same imaginary parts, or NULL */
+    const double *energy;   /* n_modes * SM_ENERGY_PARTS (sm_case.energy) */
+    int part[2];            /* the energy slot (SM_MODE_EDGE or SM_MODE_FLAP) of a and b */
 } sm_ed_shapes;
 
 /**

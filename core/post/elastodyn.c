@@ -28,8 +28,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define ED_TERMS 4     /* unknowns C2..C5 */
-#define ED_MAX_WANT 8  /* modes per direction a caller may ask for */
+#define ED_TERMS 4    /* unknowns C2..C5 */
+#define ED_MAX_WANT 8 /* modes per direction a caller may ask for */
 
 double sm_elastodyn_eval(const double coef[5], double x, double *slope)
 {
@@ -39,7 +39,7 @@ double sm_elastodyn_eval(const double coef[5], double x, double *slope)
     for (k = 2; k <= 6; k++) {
         d += k * coef[k - 2] * p; /* phi' = sum k C_k x^(k-1) */
         p *= x;
-        phi += coef[k - 2] * p;   /* phi = sum C_k x^k */
+        phi += coef[k - 2] * p; /* phi = sum C_k x^k */
     }
     if (slope)
         *slope = d;
@@ -104,7 +104,7 @@ int sm_elastodyn_fit(int n, const double *x, const double *y, double tip_slope, 
         x6 = pow(x[j], 6);
         for (k = 0; k < ED_TERMS; k++) /* A[j][k] = x^(k+2) - x^6, column-major */
             A[(size_t)k * n + j] = pow(x[j], k + 2) - x6;
-        b[j] = y[j] / fit->tip - x6;   /* b = y/y_tip - x^6 */
+        b[j] = y[j] / fit->tip - x6; /* b = y/y_tip - x^6 */
     }
     /* c = argmin || A c - b || (QR); the solution is b[0..3] */
     info = LAPACKE_dgels(LAPACK_COL_MAJOR, 'N', n, ED_TERMS, 1, A, n, b, n);
@@ -115,7 +115,7 @@ int sm_elastodyn_fit(int n, const double *x, const double *y, double tip_slope, 
     fit->coef[4] = 1.0;
     for (k = 0; k < ED_TERMS; k++) {
         fit->coef[k] = b[k];
-        fit->coef[4] -= b[k];          /* C6 = 1 - (C2 + ... + C5) */
+        fit->coef[4] -= b[k]; /* C6 = 1 - (C2 + ... + C5) */
     }
     ed_fit_quality(n, x, y, tip_slope, fit);
 done:
@@ -306,11 +306,11 @@ int sm_elastodyn_blade(const sm_model *m, const sm_case *c, int member,
         ed_project(c->shape_re + k * stride, n, nodes, tw, ax, L, rows, re + (size_t)2 * k * n,
                    sr + 2 * k);
         if (im)
-            ed_project(c->shape_im + k * stride, n, nodes, tw, ax, L, rows,
-                       im + (size_t)2 * k * n, si + 2 * k);
+            ed_project(c->shape_im + k * stride, n, nodes, tw, ax, L, rows, im + (size_t)2 * k * n,
+                       si + 2 * k);
     }
-    s = (sm_ed_shapes){c->n_modes, n, x, re, im, sr, im ? si : NULL, c->energy,
-                       {SM_MODE_FLAP, SM_MODE_EDGE}};
+    s = (sm_ed_shapes){
+        c->n_modes, n, x, re, im, sr, im ? si : NULL, c->energy, {SM_MODE_FLAP, SM_MODE_EDGE}};
     rc = sm_elastodyn_fit_modes(&s, want, fits);
 done:
     free(nodes);

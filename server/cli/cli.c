@@ -485,8 +485,8 @@ static int cli_patch_deck(const json_t *doc, long ci, const char *deck_path, cha
     codec_elastodyn_blade_values(fits, v);
     for (i = 0; i < CODEC_ED_BLADE_VALUES; i++)
         vp[i] = v[i];
-    st = codec_elastodyn_patch(out, n, deck, dlen, codec_ed_blade_names, vp,
-                               CODEC_ED_BLADE_VALUES, why, whycap);
+    st = codec_elastodyn_patch(out, n, deck, dlen, codec_ed_blade_names, vp, CODEC_ED_BLADE_VALUES,
+                               why, whycap);
     free(deck);
     return st;
 }

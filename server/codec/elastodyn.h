@@ -40,8 +40,7 @@ int codec_elastodyn_case(const json_t *result, size_t ci, sm_ed_fit fits[SM_ED_B
  * *out receives a malloc'd NUL-terminated string (free), *len its length (may be NULL).
  * Returns SM_OK, SM_NOMEM or SM_INVALID_INPUT with err (as codec_elastodyn_case).
  */
-int codec_result_elastodyn(char **out, size_t *len, const json_t *result, char *err,
-                           size_t errcap);
+int codec_result_elastodyn(char **out, size_t *len, const json_t *result, char *err, size_t errcap);
 
 /** Room for one written coefficient (codec_elastodyn_format). */
 #define CODEC_ED_TEXT 48
@@ -70,8 +69,8 @@ extern const char *const codec_ed_blade_names[CODEC_ED_BLADE_VALUES];
  * the line or the name (a name missing or given twice, an empty value or one with blanks).
  */
 int codec_elastodyn_patch(char **out, size_t *len, const char *text, size_t text_len,
-                          const char *const *names, const char *const *values, int n,
-                          char *err, size_t errcap);
+                          const char *const *names, const char *const *values, int n, char *err,
+                          size_t errcap);
 
 #ifdef __cplusplus
 }

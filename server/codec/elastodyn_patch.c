@@ -66,8 +66,8 @@ static int edp_line(const char *text, const char *p)
 }
 
 /* Find each name's value token; *where[i] is its token (s NULL when not seen). */
-static int edp_locate(const char *text, size_t len, const char *const *names, int n,
-                      edp_tok *where, char *err, size_t errcap)
+static int edp_locate(const char *text, size_t len, const char *const *names, int n, edp_tok *where,
+                      char *err, size_t errcap)
 {
     const char *p = text, *end = text + len, *eol;
     edp_tok value, name;
@@ -123,8 +123,8 @@ static int edp_write(FILE *f, const char *text, size_t len, const edp_tok *where
 }
 
 int codec_elastodyn_patch(char **out, size_t *len, const char *text, size_t text_len,
-                          const char *const *names, const char *const *values, int n,
-                          char *err, size_t errcap)
+                          const char *const *names, const char *const *values, int n, char *err,
+                          size_t errcap)
 {
     edp_tok *where = NULL;
     char *buf = NULL, dummy[8];

@@ -39,7 +39,7 @@ typedef struct edt_input {
     const json_t *layout; /* the blade member's layout */
     int n;                /* its nodes */
     double ax[9], length;
-    double *x, *twist;    /* n each */
+    double *x, *twist; /* n each */
 } edt_input;
 
 static void edt_input_clear(edt_input *in)
@@ -62,7 +62,8 @@ static const json_t *edt_member(const json_t *result)
     const json_t *mems = json_object_get(json_object_get(result, "model"), "members"), *lay;
     size_t i;
 
-    json_array_foreach(mems, i, lay) {
+    json_array_foreach(mems, i, lay)
+    {
         const char *id = json_string_value(json_object_get(lay, "id"));
         if (id && !strcmp(id, "blade"))
             return lay;
@@ -78,12 +79,14 @@ static int edt_layout(const json_t *result, edt_input *in, char *err, size_t err
 
     memset(in, 0, sizeof *in);
     if (!json_is_true(json_object_get(json_object_get(result, "model"), "spatial")))
-        return edt_err(err, errcap, "ElastoDyn coefficients need a spatial result with mode "
-                                    "shapes (\"mode_shapes\": true)");
+        return edt_err(err, errcap,
+                       "ElastoDyn coefficients need a spatial result with mode "
+                       "shapes (\"mode_shapes\": true)");
     lay = edt_member(result);
     if (!lay)
-        return edt_err(err, errcap, "ElastoDyn coefficients need a blade: the blade form or a "
-                                    "structure of one member, with mode shapes");
+        return edt_err(err, errcap,
+                       "ElastoDyn coefficients need a blade: the blade form or a "
+                       "structure of one member, with mode shapes");
     in->layout = lay;
     in->n = (int)json_array_size(json_object_get(lay, "nodes"));
     if (in->n < 4 || (int)json_array_size(json_object_get(lay, "s")) != in->n)
@@ -94,8 +97,9 @@ static int edt_layout(const json_t *result, edt_input *in, char *err, size_t err
         return SM_NOMEM;
     for (j = 0; j < in->n; j++) {
         in->x[j] = json_number_value(json_array_get(json_object_get(lay, "s"), (size_t)j));
-        in->twist[j] = CODEC_RAD_PER_DEG * json_number_value(json_array_get(
-                                               json_object_get(lay, "twist_deg"), (size_t)j));
+        in->twist[j] =
+            CODEC_RAD_PER_DEG *
+            json_number_value(json_array_get(json_object_get(lay, "twist_deg"), (size_t)j));
     }
     in->x[in->n - 1] = 1.0;
     for (j = 0; j < 9; j++)
@@ -130,8 +134,8 @@ static void edt_project(const edt_input *in, const json_t *part, double *rows, d
     int j, c;
 
     for (j = 0; j < in->n; j++) {
-        const json_t *row = json_array_get(
-            part, (size_t)json_integer_value(json_array_get(nodes, (size_t)j)));
+        const json_t *row =
+            json_array_get(part, (size_t)json_integer_value(json_array_get(nodes, (size_t)j)));
         for (c = 0; c < 6; c++)
             rows[6 * j + c] = json_number_value(json_array_get(row, (size_t)c));
     }
@@ -165,7 +169,8 @@ static int edt_shapes(const edt_input *in, const json_t *modes, edt_bufs *b, sm_
     if (!b->rows || !b->re || !b->im || !b->sr || !b->si || !b->energy)
         return SM_NOMEM;
     *has_im = 0;
-    json_array_foreach(modes, k, mode) {
+    json_array_foreach(modes, k, mode)
+    {
         shape = json_object_get(mode, "shape");
         if (!json_is_array(json_object_get(shape, "re")) ||
             !edt_energy(mode, b->energy + k * SM_ENERGY_PARTS))
@@ -177,8 +182,15 @@ static int edt_shapes(const edt_input *in, const json_t *modes, edt_bufs *b, sm_
             *has_im = 1;
         }
     }
-    *s = (sm_ed_shapes){(int)nm, in->n, in->x, b->re, *has_im ? b->im : NULL, b->sr,
-                        *has_im ? b->si : NULL, b->energy, {SM_MODE_FLAP, SM_MODE_EDGE}};
+    *s = (sm_ed_shapes){(int)nm,
+                        in->n,
+                        in->x,
+                        b->re,
+                        *has_im ? b->im : NULL,
+                        b->sr,
+                        *has_im ? b->si : NULL,
+                        b->energy,
+                        {SM_MODE_FLAP, SM_MODE_EDGE}};
     return SM_OK;
 }
 
@@ -196,8 +208,9 @@ static int edt_case_fits(const edt_input *in, const json_t *cs, sm_ed_fit *fits,
         return edt_err(err, errcap, "the case has no modes");
     rc = edt_shapes(in, modes, &b, &s, &has_im);
     if (rc == SM_INVALID_INPUT)
-        edt_err(err, errcap, "a mode has no shape or energy split (\"mode_shapes\": true; a "
-                             "spatial result)");
+        edt_err(err, errcap,
+                "a mode has no shape or energy split (\"mode_shapes\": true; a "
+                "spatial result)");
     else if (rc == SM_OK) {
         rc = sm_elastodyn_fit_modes(&s, want, fits);
         if (rc == SM_INVALID_INPUT)
@@ -242,7 +255,7 @@ void codec_elastodyn_format(const double coef[5], char text[5][CODEC_ED_TEXT])
         n[k] = llround(coef[k] * scale); /* C_k in units of 10^-d */
         sum += n[k];
     }
-    n[4] = unit - sum;                   /* C6 = 1 - (C2 + ... + C5), exact in decimal */
+    n[4] = unit - sum; /* C6 = 1 - (C2 + ... + C5), exact in decimal */
     for (k = 0; k < 5; k++) {
         a = n[k] < 0 ? -n[k] : n[k];
         if (d)
@@ -279,17 +292,18 @@ static void edt_write_fit(FILE *f, const json_t *modes, int i, const sm_ed_fit *
     int k;
 
     if (fit->mode < 0) {
-        fprintf(f, "! %s: no %s-dominated mode among the %zu computed: ask for more modes "
-                   "(\"modes\")\n",
+        fprintf(f,
+                "! %s: no %s-dominated mode among the %zu computed: ask for more modes "
+                "(\"modes\")\n",
                 edt_blade[i].name, edt_blade[i].dir, json_array_size(modes));
         return;
     }
     fprintf(f, "! %s: mode %d (%.6g Hz, %s): %s share of the bending strain energy ",
             edt_blade[i].name, fit->mode + 1,
             json_number_value(json_object_get(md, "frequency_hz")),
-            json_string_value(json_object_get(md, "label")) ? json_string_value(
-                                                                 json_object_get(md, "label"))
-                                                           : "unlabelled",
+            json_string_value(json_object_get(md, "label"))
+                ? json_string_value(json_object_get(md, "label"))
+                : "unlabelled",
             edt_blade[i].dir);
     edt_num(f, "%.2f %%", 100 * fit->share);
     fprintf(f, "; rms residual %.3e, largest %.3e (of tip); tip slope FE ", fit->rms,
@@ -317,14 +331,15 @@ static void edt_header(FILE *f, const json_t *result, const edt_input *in)
     const json_t *solver = json_object_get(result, "solver");
     const char *id = json_string_value(json_object_get(in->layout, "id"));
 
-    fprintf(f, "! spinmodal %s ElastoDyn blade mode-shape coefficients (DESIGN.md 9.3)\n"
-               "! request %s\n"
-               "! member %s (%.6g m): x = s from its root joint (the flexible root), shapes in "
-               "the principal axes (flap p3, edge p2, with the structural twist), divided by "
-               "the tip value; least squares on x^k - x^6 (k = 2..5), C6 = 1 - (C2 + ... + "
-               "C5)\n"
-               "! flap 1, flap 2: the two lowest modes with more flapwise than edgewise "
-               "kinetic energy; edge 1: the lowest with more edgewise\n",
+    fprintf(f,
+            "! spinmodal %s ElastoDyn blade mode-shape coefficients (DESIGN.md 9.3)\n"
+            "! request %s\n"
+            "! member %s (%.6g m): x = s from its root joint (the flexible root), shapes in "
+            "the principal axes (flap p3, edge p2, with the structural twist), divided by "
+            "the tip value; least squares on x^k - x^6 (k = 2..5), C6 = 1 - (C2 + ... + "
+            "C5)\n"
+            "! flap 1, flap 2: the two lowest modes with more flapwise than edgewise "
+            "kinetic energy; edge 1: the lowest with more edgewise\n",
             json_string_value(json_object_get(solver, "version")),
             json_string_value(json_object_get(solver, "request_sha256")), id ? id : "0",
             in->length);
@@ -340,8 +355,7 @@ static double edt_rpm(const json_t *cs)
                : json_number_value(json_object_get(cs, "omega")) * 60 / CODEC_TWO_PI;
 }
 
-int codec_result_elastodyn(char **out, size_t *len, const json_t *result, char *err,
-                           size_t errcap)
+int codec_result_elastodyn(char **out, size_t *len, const json_t *result, char *err, size_t errcap)
 {
     const json_t *cases = json_object_get(result, "cases"), *cs;
     sm_ed_fit fits[SM_ED_BLADE_FITS];
@@ -362,7 +376,8 @@ int codec_result_elastodyn(char **out, size_t *len, const json_t *result, char *
     if (rc)
         goto done;
     edt_header(f, result, &in);
-    json_array_foreach(cases, ci, cs) {
+    json_array_foreach(cases, ci, cs)
+    {
         fprintf(f, "!\n! case %zu of %zu: %.6g rpm (%.6g rad/s), %s\n", ci + 1,
                 json_array_size(cases), edt_rpm(cs),
                 json_number_value(json_object_get(cs, "omega")),

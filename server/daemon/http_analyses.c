@@ -216,8 +216,8 @@ static enum MHD_Result http_spanwise(struct MHD_Connection *c, http_req *r, char
     json_decref(doc);
     free(text);
     if (st == SM_INVALID_INPUT && bmodes == 3)
-        return http_problem(c, r, MHD_HTTP_CONFLICT, "no-elastodyn-shapes",
-                            "No ElastoDyn Shapes", why, NULL, 0);
+        return http_problem(c, r, MHD_HTTP_CONFLICT, "no-elastodyn-shapes", "No ElastoDyn Shapes",
+                            why, NULL, 0);
     if (st == SM_INVALID_INPUT)
         return http_problem(c, r, MHD_HTTP_CONFLICT, "no-spanwise-shapes",
                             "No Span-wise Shapes", why, NULL, 0);

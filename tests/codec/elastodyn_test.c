@@ -116,8 +116,8 @@ static void check_fits(const json_t *result, sm_ed_fit *fits)
 {
     static const char *const labels[SM_ED_BLADE_FITS] = {"1st flap", "2nd flap", "1st edge"};
     static const double bound[SM_ED_BLADE_FITS] = {0.02, 0.04, 0.01};
-    const json_t *modes = json_object_get(json_array_get(json_object_get(result, "cases"), 0),
-                                          "modes");
+    const json_t *modes =
+        json_object_get(json_array_get(json_object_get(result, "cases"), 0), "modes");
     double sum, d0, worst, dphi;
     char why[256];
     int i, k, j;
@@ -130,8 +130,7 @@ static void check_fits(const json_t *result, sm_ed_fit *fits)
         const char *lab = json_string_value(
             json_object_get(json_array_get(modes, (size_t)fits[i].mode), "label"));
         if (fits[i].mode < 0 || !lab || strcmp(lab, labels[i]))
-            fail("fit %d: mode %d is \"%s\", want %s", i, fits[i].mode, lab ? lab : "",
-                 labels[i]);
+            fail("fit %d: mode %d is \"%s\", want %s", i, fits[i].mode, lab ? lab : "", labels[i]);
         if (fits[i].warning || !(fits[i].share >= 0.9))
             fail("fit %d: share %.4f", i, fits[i].share);
         if (!(fits[i].max_residual < 0.01))
@@ -213,8 +212,8 @@ static void check_patch(const char *deck, size_t len, const sm_ed_fit *fits)
     codec_elastodyn_blade_values(fits, v);
     for (i = 0; i < CODEC_ED_BLADE_VALUES; i++)
         vp[i] = v[i];
-    if (codec_elastodyn_patch(&out, &n, deck, len, codec_ed_blade_names, vp,
-                              CODEC_ED_BLADE_VALUES, why, sizeof why) != SM_OK) {
+    if (codec_elastodyn_patch(&out, &n, deck, len, codec_ed_blade_names, vp, CODEC_ED_BLADE_VALUES,
+                              why, sizeof why) != SM_OK) {
         fail("patch: %s", why);
         return;
     }
@@ -246,8 +245,8 @@ static void check_patch(const char *deck, size_t len, const sm_ed_fit *fits)
         if (crlf_in != crlf_out || crlf_in < 80)
             fail("patch: CRLF %zu -> %zu", crlf_in, crlf_out);
     }
-    printf("patch: %zu -> %zu bytes, %zu value tokens replaced, everything else identical\n",
-           len, n, changed);
+    printf("patch: %zu -> %zu bytes, %zu value tokens replaced, everything else identical\n", len,
+           n, changed);
     free(out);
 }
 
@@ -317,8 +316,8 @@ static void check_patch_errors(const char *deck, size_t len)
     p = strstr(bad, "BldEdgSh(6)");
     if (p)
         p[3] = 'X'; /* BldXdgSh(6) */
-    if (codec_elastodyn_patch(&out, NULL, bad, len, codec_ed_blade_names, v,
-                              CODEC_ED_BLADE_VALUES, why, sizeof why) != SM_INVALID_INPUT ||
+    if (codec_elastodyn_patch(&out, NULL, bad, len, codec_ed_blade_names, v, CODEC_ED_BLADE_VALUES,
+                              why, sizeof why) != SM_INVALID_INPUT ||
         !strstr(why, "BldEdgSh(6)"))
         fail("missing name: \"%s\"", why);
     free(out);
@@ -327,8 +326,8 @@ static void check_patch_errors(const char *deck, size_t len)
     if (p)
         memcpy(p, "BldFl1Sh(2)", 11);
     out = NULL;
-    if (codec_elastodyn_patch(&out, NULL, bad, len, codec_ed_blade_names, v,
-                              CODEC_ED_BLADE_VALUES, why, sizeof why) != SM_INVALID_INPUT ||
+    if (codec_elastodyn_patch(&out, NULL, bad, len, codec_ed_blade_names, v, CODEC_ED_BLADE_VALUES,
+                              why, sizeof why) != SM_INVALID_INPUT ||
         !strstr(why, "second time"))
         fail("name twice: \"%s\"", why);
     printf("refusals: %s\n", why);

@@ -148,8 +148,8 @@ static void uniform_blade(double omega)
     for (i = 0; i < SM_ED_BLADE_FITS; i++) {
         TU_CHECK(fits[i].mode == modes[i], "omega %g fit %d: mode %d, want %d", omega, i,
                  fits[i].mode, modes[i]);
-        TU_CHECK(fits[i].max_residual < 0.01, "omega %g fit %d within 1 %% of tip: %.2e", omega,
-                 i, fits[i].max_residual);
+        TU_CHECK(fits[i].max_residual < 0.01, "omega %g fit %d within 1 %% of tip: %.2e", omega, i,
+                 fits[i].max_residual);
         /* at rest the twisted blade's principal directions are uncoupled; spinning, the
          * pitched (30 degree) blade couples flap and edge (flap 1 keeps ~95 %) */
         TU_CHECK(!fits[i].warning && fits[i].share > (omega == 0 ? 0.999 : 0.94),
@@ -157,7 +157,8 @@ static void uniform_blade(double omega)
         TU_CHECK(fabs(fits[i].tip_slope_error) < 0.02, "omega %g fit %d tip slope error %.2e",
                  omega, i, fits[i].tip_slope_error);
         TU_NEAR(fits[i].coef[0] + fits[i].coef[1] + fits[i].coef[2] + fits[i].coef[3] +
-                    fits[i].coef[4], 1, 1e-14, "omega %g fit %d: sum of C", omega, i);
+                    fits[i].coef[4],
+                1, 1e-14, "omega %g fit %d: sum of C", omega, i);
     }
     if (omega == 0) {
         /* non-rotating: the Euler-Bernoulli modes (flap 1, flap 2, edge 1 = first shape) */
