@@ -56,19 +56,23 @@ static int edt_err(char *err, size_t errcap, const char *msg)
     return SM_INVALID_INPUT;
 }
 
-/* The blade member's layout: id "blade", else the only member. */
+/* The blade member's layout: id "blade", else the only member unless it is a tower's (a
+ * tower form's member takes TwFAM1Sh..., not the blade's names). */
 static const json_t *edt_member(const json_t *result)
 {
     const json_t *mems = json_object_get(json_object_get(result, "model"), "members"), *lay;
+    const char *id;
     size_t i;
 
     json_array_foreach(mems, i, lay)
     {
-        const char *id = json_string_value(json_object_get(lay, "id"));
+        id = json_string_value(json_object_get(lay, "id"));
         if (id && !strcmp(id, "blade"))
             return lay;
     }
-    return json_array_size(mems) == 1 ? json_array_get(mems, 0) : NULL;
+    lay = json_array_get(mems, 0);
+    id = json_string_value(json_object_get(lay, "id"));
+    return json_array_size(mems) == 1 && !(id && !strcmp(id, "tower")) ? lay : NULL;
 }
 
 /* The member's nodes, span fractions, twists (rad), axes and length into *in. */
