@@ -90,9 +90,11 @@ typedef struct smi_kind {
                          tree_ws *t);
 
     /* ---- outputs ---- */
-    /** y (node_dof n_nodes) = the nodal motion of modal vector x at the kinematics in k (t:
-     *  the tree workspace of the last assembly, or NULL for the dense Jacobians). */
-    void (*nodal)(const sm_model *m, void *k, tree_ws *t, const double *x, double *y);
+    /** yr, yi (node_dof n_nodes each) = the nodal motion of the modal vector xr + i xi at the
+     *  kinematics in k (t: the tree workspace of the last assembly, or NULL for the dense
+     *  Jacobians); both parts in one pass where the kind can. */
+    void (*nodal)(const sm_model *m, void *k, tree_ws *t, const double *xr, const double *xi,
+                  double *yr, double *yi);
     /** nodes (node_dof n_nodes) = the steady-state positions and rotations at the kinematics
      *  in k; returns the largest rotation of a node relative to its frame, its node in *at. */
     double (*nodes)(const sm_model *m, void *k, double *nodes, int *at);

@@ -196,22 +196,27 @@ static int planar_tree_assemble(const sm_model *m, const double *q, void *k, dou
     return tree_assemble(m, q, k, s, 0, 0, t);
 }
 
-/* (dx, dy, dphi) = J_k x per node, hub frame. */
-static void planar_nodal(const sm_model *m, void *kin, tree_ws *t, const double *x, double *y)
+/* (dx, dy, dphi) = J_k x per node, hub frame, for both parts of x in one pass over J_k. */
+static void planar_nodal(const sm_model *m, void *kin, tree_ws *t, const double *xr,
+                         const double *xi, double *yr, double *yi)
 {
     const sm_kin *k = kin;
     int n = m->n;
 
     if (t) {
-        tree_nodal(m, k, t, x, y);
+        tree_nodal(m, k, t, xr, yr);
+        tree_nodal(m, k, t, xi, yi);
         return;
     }
     for (int c = 0; c < 3 * m->n_nodes; c++) {
         const double *jc = &DM(&k->Jn, 0, c);
-        double a = 0;
-        for (int i = 0; i < n; i++)
-            a += jc[i] * x[i];
-        y[c] = a;
+        double a = 0, b = 0;
+        for (int i = 0; i < n; i++) {
+            a += jc[i] * xr[i];
+            b += jc[i] * xi[i];
+        }
+        yr[c] = a;
+        yi[c] = b;
     }
 }
 

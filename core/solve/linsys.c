@@ -170,9 +170,10 @@ int smi_lin_negative(const smi_lin *L)
     return L->tree ? L->t.neg : 0;
 }
 
-void smi_lin_nodal(const sm_model *m, smi_lin *L, const double *x, double *y)
+void smi_lin_nodal(const sm_model *m, smi_lin *L, const double *xr, const double *xi, double *yr,
+                   double *yi)
 {
-    L->kind->nodal(m, L->kin, L->tree ? &L->t : NULL, x, y);
+    L->kind->nodal(m, L->kin, L->tree ? &L->t : NULL, xr, xi, yr, yi);
 }
 
 int smi_lin_lowest(const sm_model *m, smi_lin *L, double *lambda)

@@ -56,8 +56,10 @@ int smi_lin_eigen(const sm_model *m, smi_lin *L, const sm_progress *pr, sm_eig_o
                   int *fallback);
 /** Negative eigenvalues of K* found by the tree path's factorisation (0 on the dense path). */
 int smi_lin_negative(const smi_lin *L);
-/** y (node_dof n_nodes) = nodal motion of modal vector x at the last linearisation. */
-void smi_lin_nodal(const sm_model *m, smi_lin *L, const double *x, double *y);
+/** yr, yi (node_dof n_nodes each) = nodal motion of the modal vector xr + i xi at the last
+ *  linearisation. */
+void smi_lin_nodal(const sm_model *m, smi_lin *L, const double *xr, const double *xi, double *yr,
+                   double *yi);
 /** *lambda = the lowest eigenvalue of the dense K* of the last smi_lin_linearize (destroys it).
  *  SM_OK, SM_NOMEM or SM_LAPACK_FAILED. */
 int smi_lin_lowest(const sm_model *m, smi_lin *L, double *lambda);

@@ -66,8 +66,7 @@ static void sweep_shapes(const sm_model *m, smi_lin *L, const sm_eig_out *e, dou
     for (int j = 0; j < e->n_modes; j++) {
         const double *xr = e->xre + (size_t)j * n, *xi = e->xim + (size_t)j * n;
         double *yr = sr + (size_t)j * dof * nn, *yi = si + (size_t)j * dof * nn;
-        smi_lin_nodal(m, L, xr, yr);
-        smi_lin_nodal(m, L, xi, yi);
+        smi_lin_nodal(m, L, xr, xi, yr, yi);
         double best = -1;
         double complex piv = 1;
         for (int c = 0; c < dof * nn; c++)

@@ -89,12 +89,16 @@ static int spatial_tree_assemble(const sm_model *m, const double *q, void *k, do
     return tree3_assemble(m, q, k, s, lin, lin, lin && gyro, t);
 }
 
-static void spatial_nodal(const sm_model *m, void *k, tree_ws *t, const double *x, double *y)
+static void spatial_nodal(const sm_model *m, void *k, tree_ws *t, const double *xr,
+                          const double *xi, double *yr, double *yi)
 {
-    if (t)
-        tree3_nodal(m, k, t, x, y);
-    else
-        lin3_nodal(m, k, x, y);
+    if (t) {
+        tree3_nodal(m, k, t, xr, yr);
+        tree3_nodal(m, k, t, xi, yi);
+    } else {
+        lin3_nodal(m, k, xr, yr);
+        lin3_nodal(m, k, xi, yi);
+    }
 }
 
 /* |psi|: the rotation relative to the own frame. */

@@ -307,7 +307,6 @@ static int bm_support(bm_in *b, const bm_main *m)
     imp_tok t[2];
     double x;
     long ts;
-    int st;
 
     if (!m->tower) { /* a tower's file given as a blade: its support lines follow el_loc */
         while (imp_next(&b->r))
