@@ -76,9 +76,18 @@ def scenario(exe, ref, tmp):
         r = d.post("/v1/import/bmodes", {"main": main.replace("1         beam_type", "2         beam_type"),
                                          "sec_props": sec, "name": "tower.bmi"})
         p = r.json() or {}
-        check(r.status == 422 and p.get("detail") == "tower.bmi:6: beam_type: towers are not "
-              "supported yet (beam_type 2); only blades (1)" and p["errors"][0]["pointer"] == "/main",
-              "tower: 422 naming tower.bmi:6 (%s)" % p.get("detail"))
+        check(r.status == 422 and str(p.get("detail", "")).startswith(
+              "tower.bmi:51: tow_support: missing: beam_type (line 6) is 2 (tower)")
+              and p["errors"][0]["pointer"] == "/main",
+              "a blade's file marked as a tower: 422 naming tower.bmi:51 and line 6 (%s)"
+              % p.get("detail"))
+        # a real tower (BModes CertTest Test03, tow_support 0) imports as the tower form
+        r = d.post("/v1/import/bmodes", {"main": read(os.path.join(bm, "Test03_tower.bmi")),
+                                         "sec_props": read(os.path.join(bm, "tower_sec_props.dat"))})
+        tower = ((r.json() or {}).get("request") or {}).get("tower") or {}
+        check(r.status == 200 and tower.get("height", 0) > 0 and tower.get("stations"),
+              "Test03 tower: 200 with the tower form (got %s, keys %s)"
+              % (r.status, sorted(tower)[:6]))
         r = d.post("/v1/import/bmodes", {"main": main})
         check(r.status == 400 and (r.json() or {}).get("errors", [{}])[0].get("pointer") == "/sec_props",
               "bmodes without sec_props: 400 /sec_props (got %s)" % r.status)
