@@ -22,6 +22,7 @@
 #include "spinmodal.h"
 #include "csym.h"
 #include "dense.h"
+#include "diag.h"
 
 /* FE node. */
 typedef struct sm_node {

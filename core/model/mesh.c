@@ -27,19 +27,6 @@ const smi_kind *smi_kind_of(const sm_structure *st)
     return st->spatial ? &smi_kind_spatial : &smi_kind_planar;
 }
 
-static int mesh_fail(sm_diag *d, sm_item item, int index, const char *field,
-                     const char *msg)
-{
-    if (d) {
-        d->status = SM_INVALID_INPUT;
-        d->item = item;
-        d->item_index = index;
-        snprintf(d->field, sizeof d->field, "%s", field ? field : "");
-        snprintf(d->message, sizeof d->message, "%s", msg);
-    }
-    return SM_INVALID_INPUT;
-}
-
 /*
  * The smallest member or element length the numerics carry (issue 23 item 7: a 1e-15 m member
  * at 0.5 m from the hub solved at 2.9e18 rad/s; a 1e-300 m one was told its flap_direction was
@@ -88,7 +75,7 @@ static int mesh_length(sm_diag *d, int i, double l, int elements, double size)
                  MESH_MIN_RELATIVE, size);
     else
         snprintf(why, sizeof why, "%g m", MESH_MIN_ABSOLUTE);
-    int rc = mesh_fail(d, SM_ITEM_MEMBER, i, l < lmin ? "" : "elements", "");
+    int rc = smi_input_fail(d, SM_ITEM_MEMBER, i, l < lmin ? "" : "elements", "");
     if (d && l < lmin)
         snprintf(d->message, sizeof d->message,
                  "the member is %.3g m long: shorter than the smallest length the numerics carry "
@@ -104,18 +91,20 @@ static int mesh_length(sm_diag *d, int i, double l, int elements, double size)
 static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
 {
     if (!st)
-        return mesh_fail(d, SM_ITEM_NONE, -1, "", "no structure");
+        return smi_input_fail(d, SM_ITEM_NONE, -1, "", "no structure");
     if (st->n_joints < 1 || st->n_joints > MESH_MAX_ITEMS || !st->joint_xy)
-        return mesh_fail(d, SM_ITEM_NONE, -1, "", "the structure has no joints");
+        return smi_input_fail(d, SM_ITEM_NONE, -1, "", "the structure has no joints");
     if (st->n_members < 1 || st->n_members > MESH_MAX_ITEMS || !st->members)
-        return mesh_fail(d, SM_ITEM_NONE, -1, "", "the structure has no members");
+        return smi_input_fail(d, SM_ITEM_NONE, -1, "", "the structure has no members");
     if (st->n_sections < 1 || !st->sections)
-        return mesh_fail(d, SM_ITEM_NONE, -1, "", "the structure has no sections");
+        return smi_input_fail(d, SM_ITEM_NONE, -1, "", "the structure has no sections");
     if (st->clamp < 0 || st->clamp >= st->n_joints)
-        return mesh_fail(d, SM_ITEM_CLAMP, -1, "", "the clamp is not a joint of the structure");
+        return smi_input_fail(d, SM_ITEM_CLAMP, -1, "",
+                              "the clamp is not a joint of the structure");
     for (int j = 0; j < st->n_joints; j++)
         if (!isfinite(st->joint_xy[2 * j]) || !isfinite(st->joint_xy[2 * j + 1]))
-            return mesh_fail(d, SM_ITEM_JOINT, j, "", "joint coordinates must be finite numbers");
+            return smi_input_fail(d, SM_ITEM_JOINT, j, "",
+                                  "joint coordinates must be finite numbers");
     int rc = smi_kind_of(st)->check(st, o, d);
     if (rc < 0)
         return rc;
@@ -124,22 +113,24 @@ static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
     for (int i = 0; i < st->n_members; i++) {
         const sm_member *b = &st->members[i];
         if (b->from < 0 || b->from >= st->n_joints)
-            return mesh_fail(d, SM_ITEM_MEMBER, i, "from", "unknown joint");
+            return smi_input_fail(d, SM_ITEM_MEMBER, i, "from", "unknown joint");
         if (b->to < 0 || b->to >= st->n_joints)
-            return mesh_fail(d, SM_ITEM_MEMBER, i, "to", "unknown joint");
+            return smi_input_fail(d, SM_ITEM_MEMBER, i, "to", "unknown joint");
         if (b->section < 0 || b->section >= st->n_sections)
-            return mesh_fail(d, SM_ITEM_MEMBER, i, "section", "unknown section");
+            return smi_input_fail(d, SM_ITEM_MEMBER, i, "section", "unknown section");
         if (b->elements < 1 || b->elements > MESH_MAX_ITEMS)
-            return mesh_fail(d, SM_ITEM_MEMBER, i, "elements", "elements must be a positive integer");
+            return smi_input_fail(d, SM_ITEM_MEMBER, i, "elements",
+                                  "elements must be a positive integer");
         total += b->elements;
         if (total > MESH_MAX_ITEMS)
-            return mesh_fail(d, SM_ITEM_MEMBER, i, "elements", "too many elements");
+            return smi_input_fail(d, SM_ITEM_MEMBER, i, "elements", "too many elements");
         double dx = st->joint_xy[2 * b->to] - st->joint_xy[2 * b->from];
         double dy = st->joint_xy[2 * b->to + 1] - st->joint_xy[2 * b->from + 1];
         double dz = MESH_Z(st, b->to) - MESH_Z(st, b->from);
         double l = hypot(hypot(dx, dy), dz);
         if (b->from == b->to || !(l > 0.0))
-            return mesh_fail(d, SM_ITEM_MEMBER, i, "", "zero-length member: its joints coincide");
+            return smi_input_fail(d, SM_ITEM_MEMBER, i, "",
+                                  "zero-length member: its joints coincide");
         rc = mesh_length(d, i, l, b->elements, size);
         if (rc < 0)
             return rc;
@@ -147,19 +138,22 @@ static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
     for (int i = 0; i < st->n_point_masses; i++) {
         const sm_point_mass *p = &st->point_masses[i];
         if (p->joint < 0 || p->joint >= st->n_joints)
-            return mesh_fail(d, SM_ITEM_POINT_MASS, i, "joint", "unknown joint");
+            return smi_input_fail(d, SM_ITEM_POINT_MASS, i, "joint", "unknown joint");
         if (!isfinite(p->mass) || p->mass < 0.0)
-            return mesh_fail(d, SM_ITEM_POINT_MASS, i, "mass", "mass must be a non-negative number (kg)");
+            return smi_input_fail(d, SM_ITEM_POINT_MASS, i, "mass",
+                                  "mass must be a non-negative number (kg)");
     }
     if (o->modes < 1)
-        return mesh_fail(d, SM_ITEM_OPTIONS, -1, "modes", "modes must be a positive integer");
+        return smi_input_fail(d, SM_ITEM_OPTIONS, -1, "modes", "modes must be a positive integer");
     if ((o->frames == SM_FRAMES_PER_MEMBER || o->frames == SM_FRAMES_ELEMENTS_PER_FRAME) &&
         o->frames_param < 1)
-        return mesh_fail(d, SM_ITEM_OPTIONS, -1, "frames", "the frame count must be a positive integer");
+        return smi_input_fail(d, SM_ITEM_OPTIONS, -1, "frames",
+                              "the frame count must be a positive integer");
     if (o->frames < SM_FRAMES_SINGLE || o->frames > SM_FRAMES_PER_ELEMENT)
-        return mesh_fail(d, SM_ITEM_OPTIONS, -1, "frames", "unknown frame scheme");
+        return smi_input_fail(d, SM_ITEM_OPTIONS, -1, "frames", "unknown frame scheme");
     if (o->modes_per_frame < 0)
-        return mesh_fail(d, SM_ITEM_OPTIONS, -1, "modes_per_frame", "modes_per_frame must be positive or all");
+        return smi_input_fail(d, SM_ITEM_OPTIONS, -1, "modes_per_frame",
+                              "modes_per_frame must be positive or all");
     return SM_OK;
 }
 
@@ -206,8 +200,9 @@ static int mesh_walk(const sm_structure *st, int *order, int *near, sm_diag *d)
                 continue;
             int other = b->from == j ? b->to : b->from;
             if (seen[other]) {
-                rc = mesh_fail(d, SM_ITEM_MEMBER, i, "",
-                               "this member closes a cycle: members must form a tree rooted at the clamp");
+                rc = smi_input_fail(
+                    d, SM_ITEM_MEMBER, i, "",
+                    "this member closes a cycle: members must form a tree rooted at the clamp");
                 goto done;
             }
             used[i] = 1;
@@ -219,18 +214,18 @@ static int mesh_walk(const sm_structure *st, int *order, int *near, sm_diag *d)
         }
     }
     if (count == 0) {
-        rc = mesh_fail(d, SM_ITEM_CLAMP, -1, "", "the clamp joint is not on any member");
+        rc = smi_input_fail(d, SM_ITEM_CLAMP, -1, "", "the clamp joint is not on any member");
         goto done;
     }
     for (int i = 0; i < nm; i++)
         if (!used[i]) {
-            rc = mesh_fail(d, SM_ITEM_MEMBER, i, "",
-                           "this member is not connected to the clamp joint");
+            rc = smi_input_fail(d, SM_ITEM_MEMBER, i, "",
+                                "this member is not connected to the clamp joint");
             goto done;
         }
     for (int j = 0; j < nj; j++)
         if (!seen[j]) {
-            rc = mesh_fail(d, SM_ITEM_JOINT, j, "", "this joint is not on any member");
+            rc = smi_input_fail(d, SM_ITEM_JOINT, j, "", "this joint is not on any member");
             goto done;
         }
     rc = SM_OK;

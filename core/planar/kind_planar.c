@@ -18,18 +18,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int planar_fail(sm_diag *d, sm_item item, int index, const char *field, const char *msg)
-{
-    if (d) {
-        d->status = SM_INVALID_INPUT;
-        d->item = item;
-        d->item_index = index;
-        snprintf(d->field, sizeof d->field, "%s", field ? field : "");
-        snprintf(d->message, sizeof d->message, "%s", msg);
-    }
-    return SM_INVALID_INPUT;
-}
-
 static int planar_positive(double v)
 {
     return isfinite(v) && v > 0.0;
@@ -40,40 +28,42 @@ static int planar_check_spatial_fields(const sm_structure *st, sm_diag *d)
 {
     for (int j = 0; st->joint_z && j < st->n_joints; j++)
         if (st->joint_z[j] != 0.0)
-            return planar_fail(d, SM_ITEM_JOINT, j, "z",
-                               "a joint out of the x-y plane needs spatial sections (EA, EI_flap, "
-                               "EI_edge, GJ, mass_per_length)");
+            return smi_input_fail(
+                d, SM_ITEM_JOINT, j, "z",
+                "a joint out of the x-y plane needs spatial sections (EA, EI_flap, "
+                "EI_edge, GJ, mass_per_length)");
     for (int i = 0; i < st->n_members; i++) {
         const sm_member *b = &st->members[i];
         if (b->twist != 0.0)
-            return planar_fail(d, SM_ITEM_MEMBER, i, "twist_deg",
-                               "twist_deg needs spatial sections");
+            return smi_input_fail(d, SM_ITEM_MEMBER, i, "twist_deg",
+                                  "twist_deg needs spatial sections");
         if (b->e3[0] != 0.0 || b->e3[1] != 0.0 || b->e3[2] != 0.0)
-            return planar_fail(d, SM_ITEM_MEMBER, i, "flap_direction",
-                               "flap_direction needs spatial sections");
+            return smi_input_fail(d, SM_ITEM_MEMBER, i, "flap_direction",
+                                  "flap_direction needs spatial sections");
     }
     for (int i = 0; i < st->n_point_masses; i++) {
         const sm_point_mass *pm = &st->point_masses[i];
         const double *I = pm->inertia;
         if (I[0] != 0.0 || I[1] != 0.0 || I[2] != 0.0)
-            return planar_fail(d, SM_ITEM_POINT_MASS, i, "inertia",
-                               "a rotary inertia needs spatial sections");
+            return smi_input_fail(d, SM_ITEM_POINT_MASS, i, "inertia",
+                                  "a rotary inertia needs spatial sections");
         if (pm->products[0] != 0.0 || pm->products[1] != 0.0 || pm->products[2] != 0.0)
-            return planar_fail(d, SM_ITEM_POINT_MASS, i, "products",
-                               "products of inertia need spatial sections");
+            return smi_input_fail(d, SM_ITEM_POINT_MASS, i, "products",
+                                  "products of inertia need spatial sections");
         if (pm->offset[0] != 0.0 || pm->offset[1] != 0.0 || pm->offset[2] != 0.0)
-            return planar_fail(d, SM_ITEM_POINT_MASS, i, "offset",
-                               "a point-mass offset needs spatial sections");
+            return smi_input_fail(d, SM_ITEM_POINT_MASS, i, "offset",
+                                  "a point-mass offset needs spatial sections");
     }
     for (int i = 0; i < st->n_members; i++)
         if (st->members[i].n_stations || st->members[i].station_mask)
-            return planar_fail(d, SM_ITEM_MEMBER, i, "stations", "stations need spatial sections");
+            return smi_input_fail(d, SM_ITEM_MEMBER, i, "stations",
+                                  "stations need spatial sections");
     for (int s = 0; s < st->n_sections; s++) {
         const sm_section *c = &st->sections[s];
         if (c->cg[0] != 0.0 || c->cg[1] != 0.0 || c->sc[0] != 0.0 || c->sc[1] != 0.0 ||
             c->tc[0] != 0.0 || c->tc[1] != 0.0)
-            return planar_fail(d, SM_ITEM_SECTION, s, "cg_offset",
-                               "section offsets need spatial sections");
+            return smi_input_fail(d, SM_ITEM_SECTION, s, "cg_offset",
+                                  "section offsets need spatial sections");
     }
     return SM_OK;
 }
@@ -88,14 +78,14 @@ static int planar_check(const sm_structure *st, const sm_options *o, sm_diag *d)
     for (int s = 0; s < st->n_sections; s++) {
         const sm_section *c = &st->sections[s];
         if (!planar_positive(c->E))
-            return planar_fail(d, SM_ITEM_SECTION, s, "E", "E must be a positive number (Pa)");
+            return smi_input_fail(d, SM_ITEM_SECTION, s, "E", "E must be a positive number (Pa)");
         if (!planar_positive(c->A))
-            return planar_fail(d, SM_ITEM_SECTION, s, "A", "A must be a positive number (m^2)");
+            return smi_input_fail(d, SM_ITEM_SECTION, s, "A", "A must be a positive number (m^2)");
         if (!planar_positive(c->I))
-            return planar_fail(d, SM_ITEM_SECTION, s, "I", "I must be a positive number (m^4)");
+            return smi_input_fail(d, SM_ITEM_SECTION, s, "I", "I must be a positive number (m^4)");
         if (!planar_positive(c->mu))
-            return planar_fail(d, SM_ITEM_SECTION, s, "mass_per_length",
-                               "mass_per_length must be a positive number (kg/m)");
+            return smi_input_fail(d, SM_ITEM_SECTION, s, "mass_per_length",
+                                  "mass_per_length must be a positive number (kg/m)");
     }
     return SM_OK;
 }

@@ -18,18 +18,6 @@
  * unusable. */
 #define MESH3_PARALLEL 1e-6
 
-static int mesh3_fail(sm_diag *d, sm_item item, int index, const char *field, const char *msg)
-{
-    if (d) {
-        d->status = SM_INVALID_INPUT;
-        d->item = item;
-        d->item_index = index;
-        snprintf(d->field, sizeof d->field, "%s", field);
-        snprintf(d->message, sizeof d->message, "%s", msg);
-    }
-    return SM_INVALID_INPUT;
-}
-
 static int mesh3_positive(double v)
 {
     return isfinite(v) && v > 0.0;
@@ -55,25 +43,27 @@ static int mesh3_section(const sm_section *c, int s, sm_diag *d)
     for (int i = 0; i < 5; i++)
         if (!mesh3_positive(pv[i])) {
             snprintf(msg, sizeof msg, "%s must be a positive number (%s)", pos[i], units[i]);
-            return mesh3_fail(d, SM_ITEM_SECTION, s, pos[i], msg);
+            return smi_input_fail(d, SM_ITEM_SECTION, s, pos[i], msg);
         }
     if (!mesh3_nonneg(c->i_flap))
-        return mesh3_fail(d, SM_ITEM_SECTION, s, "flap_inertia",
-                          "flap_inertia must be a non-negative number (kg m)");
+        return smi_input_fail(d, SM_ITEM_SECTION, s, "flap_inertia",
+                              "flap_inertia must be a non-negative number (kg m)");
     if (!mesh3_nonneg(c->i_edge))
-        return mesh3_fail(d, SM_ITEM_SECTION, s, "edge_inertia",
-                          "edge_inertia must be a non-negative number (kg m)");
+        return smi_input_fail(d, SM_ITEM_SECTION, s, "edge_inertia",
+                              "edge_inertia must be a non-negative number (kg m)");
     if (!mesh3_nonneg(c->ip_over_a))
-        return mesh3_fail(d, SM_ITEM_SECTION, s, "ip_over_a",
-                          "the polar radius of gyration squared I_p/A must be a non-negative number (m^2)");
+        return smi_input_fail(
+            d, SM_ITEM_SECTION, s, "ip_over_a",
+            "the polar radius of gyration squared I_p/A must be a non-negative number (m^2)");
     if (!mesh3_finite2(c->cg))
-        return mesh3_fail(d, SM_ITEM_SECTION, s, "cg_offset", "cg_offset must be two finite numbers (m)");
+        return smi_input_fail(d, SM_ITEM_SECTION, s, "cg_offset",
+                              "cg_offset must be two finite numbers (m)");
     if (!mesh3_finite2(c->sc))
-        return mesh3_fail(d, SM_ITEM_SECTION, s, "shear_center_offset",
-                          "shear_center_offset must be two finite numbers (m)");
+        return smi_input_fail(d, SM_ITEM_SECTION, s, "shear_center_offset",
+                              "shear_center_offset must be two finite numbers (m)");
     if (!mesh3_finite2(c->tc))
-        return mesh3_fail(d, SM_ITEM_SECTION, s, "tension_center_offset",
-                          "tension_center_offset must be two finite numbers (m)");
+        return smi_input_fail(d, SM_ITEM_SECTION, s, "tension_center_offset",
+                              "tension_center_offset must be two finite numbers (m)");
     return SM_OK;
 }
 
@@ -116,27 +106,28 @@ static int mesh3_stations(const sm_member *b, int i, sm_diag *d)
 {
     char msg[200];
     if (b->n_stations == 0)
-        return b->station_mask ? mesh3_fail(d, SM_ITEM_MEMBER, i, "stations", "station_mask without stations")
+        return b->station_mask ? smi_input_fail(d, SM_ITEM_MEMBER, i, "stations",
+                                                "station_mask without stations")
                                : SM_OK;
     if (b->n_stations < 2 || !b->stations)
-        return mesh3_fail(d, SM_ITEM_MEMBER, i, "stations",
-                          "stations need at least two entries, at s = 0 and s = 1");
+        return smi_input_fail(d, SM_ITEM_MEMBER, i, "stations",
+                              "stations need at least two entries, at s = 0 and s = 1");
     if (b->station_mask >= (SM_ST_TC << 1))
-        return mesh3_fail(d, SM_ITEM_MEMBER, i, "stations", "unknown bits in station_mask");
+        return smi_input_fail(d, SM_ITEM_MEMBER, i, "stations", "unknown bits in station_mask");
     for (int j = 0; j < b->n_stations; j++) {
         const sm_station *t = &b->stations[j];
         double prev = j ? b->stations[j - 1].s : -1.0;
         if (!isfinite(t->s) || t->s < 0.0 || t->s > 1.0) {
             snprintf(msg, sizeof msg, "station %d: s = %g is outside 0..1 (span fraction)", j, t->s);
-            return mesh3_fail(d, SM_ITEM_MEMBER, i, "stations", msg);
+            return smi_input_fail(d, SM_ITEM_MEMBER, i, "stations", msg);
         }
         if ((j == 0 && t->s != 0.0) || (j == b->n_stations - 1 && t->s != 1.0)) {
             snprintf(msg, sizeof msg, "station %d: the first station must be at s = 0 and the last at s = 1", j);
-            return mesh3_fail(d, SM_ITEM_MEMBER, i, "stations", msg);
+            return smi_input_fail(d, SM_ITEM_MEMBER, i, "stations", msg);
         }
         if (!(t->s > prev)) {
             snprintf(msg, sizeof msg, "station %d: s = %g does not increase (previous %g)", j, t->s, prev);
-            return mesh3_fail(d, SM_ITEM_MEMBER, i, "stations", msg);
+            return smi_input_fail(d, SM_ITEM_MEMBER, i, "stations", msg);
         }
         for (int q = 0; q < MESH3_NSTQ; q++) {
             const mesh3_stq *f = &mesh3_stqs[q];
@@ -148,7 +139,7 @@ static int mesh3_stations(const sm_member *b, int i, sm_diag *d)
                 if (!ok) {
                     snprintf(msg, sizeof msg, "station %d: %s must be a %s number (%s)", j, f->name,
                              f->kind > 0 ? "positive" : f->kind == 0 ? "non-negative" : "finite", f->unit);
-                    return mesh3_fail(d, SM_ITEM_MEMBER, i, "stations", msg);
+                    return smi_input_fail(d, SM_ITEM_MEMBER, i, "stations", msg);
                 }
             }
         }
@@ -186,7 +177,8 @@ int mesh3_check(const sm_structure *st, const sm_options *o, sm_diag *d)
 {
     for (int j = 0; st->joint_z && j < st->n_joints; j++)
         if (!isfinite(st->joint_z[j]))
-            return mesh3_fail(d, SM_ITEM_JOINT, j, "z", "joint coordinates must be finite numbers");
+            return smi_input_fail(d, SM_ITEM_JOINT, j, "z",
+                                  "joint coordinates must be finite numbers");
     for (int s = 0; s < st->n_sections; s++) {
         int rc = mesh3_section(&st->sections[s], s, d);
         if (rc < 0)
@@ -195,10 +187,11 @@ int mesh3_check(const sm_structure *st, const sm_options *o, sm_diag *d)
     for (int i = 0; i < st->n_members; i++) {
         const sm_member *b = &st->members[i];
         if (!isfinite(b->twist))
-            return mesh3_fail(d, SM_ITEM_MEMBER, i, "twist_deg", "twist_deg must be a finite number (deg)");
+            return smi_input_fail(d, SM_ITEM_MEMBER, i, "twist_deg",
+                                  "twist_deg must be a finite number (deg)");
         if (!isfinite(b->e3[0]) || !isfinite(b->e3[1]) || !isfinite(b->e3[2]))
-            return mesh3_fail(d, SM_ITEM_MEMBER, i, "flap_direction",
-                              "flap_direction must be three finite numbers");
+            return smi_input_fail(d, SM_ITEM_MEMBER, i, "flap_direction",
+                                  "flap_direction must be three finite numbers");
         int rc = mesh3_stations(b, i, d);
         if (rc < 0)
             return rc;
@@ -207,15 +200,16 @@ int mesh3_check(const sm_structure *st, const sm_options *o, sm_diag *d)
         const sm_point_mass *pm = &st->point_masses[i];
         for (int c = 0; c < 3; c++)
             if (!mesh3_nonneg(pm->inertia[c]))
-                return mesh3_fail(d, SM_ITEM_POINT_MASS, i, "inertia",
-                                  "inertia must be three non-negative numbers (kg m^2)");
+                return smi_input_fail(d, SM_ITEM_POINT_MASS, i, "inertia",
+                                      "inertia must be three non-negative numbers (kg m^2)");
         for (int c = 0; c < 3; c++)
             if (!isfinite(pm->products[c]))
-                return mesh3_fail(d, SM_ITEM_POINT_MASS, i, "products",
-                                  "products must be three finite numbers (kg m^2)");
+                return smi_input_fail(d, SM_ITEM_POINT_MASS, i, "products",
+                                      "products must be three finite numbers (kg m^2)");
         for (int c = 0; c < 3; c++)
             if (!isfinite(pm->offset[c]))
-                return mesh3_fail(d, SM_ITEM_POINT_MASS, i, "offset", "offset must be three finite numbers (m)");
+                return smi_input_fail(d, SM_ITEM_POINT_MASS, i, "offset",
+                                      "offset must be three finite numbers (m)");
         /* positive semi-definite: the diagonal is >= 0; the 2x2 minors and the determinant too
          * (round-off allowed relative to the diagonal) */
         const double *I = pm->inertia, *P = pm->products;
@@ -223,14 +217,16 @@ int mesh3_check(const sm_structure *st, const sm_options *o, sm_diag *d)
         double m01 = I[0] * I[1] - P[0] * P[0], m12 = I[1] * I[2] - P[1] * P[1], m20 = I[2] * I[0] - P[2] * P[2];
         double det = I[0] * m12 - P[0] * (P[0] * I[2] - P[1] * P[2]) + P[2] * (P[0] * P[1] - I[1] * P[2]);
         if (m01 < -tol || m12 < -tol || m20 < -tol || det < -tol * (I[0] + I[1] + I[2]))
-            return mesh3_fail(d, SM_ITEM_POINT_MASS, i, "products",
-                              "inertia and products do not form a physical inertia tensor (it must be "
-                              "positive semi-definite)");
+            return smi_input_fail(
+                d, SM_ITEM_POINT_MASS, i, "products",
+                "inertia and products do not form a physical inertia tensor (it must be "
+                "positive semi-definite)");
     }
     if (o->basis == SM_BASIS_PAPER)
-        return mesh3_fail(d, SM_ITEM_OPTIONS, -1, "substructure_modes",
-                          "the paper basis is planar-only (it exists to reproduce Table 2): use "
-                          "\"augmented\" for a spatial structure");
+        return smi_input_fail(
+            d, SM_ITEM_OPTIONS, -1, "substructure_modes",
+            "the paper basis is planar-only (it exists to reproduce Table 2): use "
+            "\"augmented\" for a spatial structure");
     return SM_OK;
 }
 
@@ -263,17 +259,18 @@ static int mesh3_axes(const sm_structure *st, int i, double ax[9], sm_diag *d)
         f[1] = 0.5 * (P[2 * b->to + 1] + P[2 * b->from + 1]);
         f[2] = 0;
         if (!(hypot(f[0], f[1]) > 1e-12 * l))
-            return mesh3_fail(d, SM_ITEM_MEMBER, i, "flap_direction",
-                              "the member lies on the spin axis, where the flapwise direction has no "
-                              "default: give flap_direction [x, y, z], a direction not along the member");
+            return smi_input_fail(
+                d, SM_ITEM_MEMBER, i, "flap_direction",
+                "the member lies on the spin axis, where the flapwise direction has no "
+                "default: give flap_direction [x, y, z], a direction not along the member");
     }
     double fn = mesh3_norm(f), fe = f[0] * e1[0] + f[1] * e1[1] + f[2] * e1[2];
     for (int c = 0; c < 3; c++)
         e3[c] = f[c] - fe * e1[c];
     double n3 = mesh3_norm(e3);
     if (!(n3 > MESH3_PARALLEL * fn))
-        return mesh3_fail(d, SM_ITEM_MEMBER, i, "flap_direction",
-                          "flap_direction is along the member: give a direction normal to it");
+        return smi_input_fail(d, SM_ITEM_MEMBER, i, "flap_direction",
+                              "flap_direction is along the member: give a direction normal to it");
     for (int c = 0; c < 3; c++)
         e3[c] /= n3;
     e2[0] = e3[1] * e1[2] - e3[2] * e1[1]; /* e2 = e3 x e1 */
