@@ -181,6 +181,8 @@ static int cli_import_load(void *ctx, const char *name, import_file *out, char *
         return SM_NOMEM;
     memcpy(path, fs->main_path, dir);
     strcpy(path + dir, name);
+    free(fs->sec); /* a main file may name several (ElastoDyn: tower, then blade) */
+    fs->sec = NULL;
     err = cli_import_read(path, 0, &fs->sec, &len);
     free(path);
     if (err == ENOMEM)

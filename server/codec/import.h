@@ -106,7 +106,16 @@ typedef int (*import_loader)(void *ctx, const char *name, import_file *out, char
 int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void *ctx,
                   const import_options *o, import_diag *d);
 
-/** OpenFAST ElastoDyn blade file; o->tip_radius is required (the file has no length). */
+/**
+ * OpenFAST ElastoDyn: a blade file (o->tip_radius required: the file has no length), or the
+ * main ElastoDyn file, which gives the tower form: the tower file it names (TwrFile) and the
+ * blade file (BldFile(1), for the rotor's mass in the tower-top mass) are read through
+ * load(ctx, ...), relative to the main file (DESIGN.md 8.5).
+ */
+int import_elastodyn_files(json_t **out, const import_file *f, import_loader load, void *ctx,
+                           const import_options *o, import_diag *d);
+
+/** import_elastodyn_files without a loader: a blade file (a main file is refused). */
 int import_elastodyn(json_t **out, const import_file *f, const import_options *o,
                      import_diag *d);
 

@@ -19,13 +19,11 @@
 #include <stdio.h>
 #include <string.h>
 
-/* import_parse_fn for ElastoDyn: one file, no loader. */
+/* import_parse_fn for ElastoDyn: a blade file, or a main file and the files it names. */
 static int imf_elastodyn(json_t **out, const import_file *f, import_loader load, void *ctx,
                          const import_options *o, import_diag *d)
 {
-    (void)load;
-    (void)ctx;
-    return import_elastodyn(out, f, o, d);
+    return import_elastodyn_files(out, f, load, ctx, o, d);
 }
 
 /* import_parse_fn for CSV: one file, no loader. */
@@ -40,8 +38,8 @@ static int imf_csv(json_t **out, const import_file *f, import_loader load, void 
 const import_format import_formats[] = {
     {"bmodes", "BModes", "main.bmi", "FILE.bmi [--rpm SPEEDS] [--bmodes-mesh K] [--allow-outside]",
      IMPORT_SEC_FILE | IMPORT_OWN_MESH, import_bmodes},
-    {"elastodyn", "ElastoDyn", "blade.dat", "FILE --tip-radius R [--hub-radius H] [--rpm SPEEDS]",
-     0, imf_elastodyn},
+    {"elastodyn", "ElastoDyn", "blade.dat",
+     "BLADE.dat --tip-radius R [--hub-radius H] [--rpm SPEEDS] | MAIN.dat", 0, imf_elastodyn},
     {"csv", "CSV", "stations.csv", "FILE [--tip-radius R] [--hub-radius H] [--rpm SPEEDS]", 0,
      imf_csv},
     {NULL, NULL, NULL, NULL, 0, NULL},
