@@ -260,4 +260,17 @@ int imp_document_assumed(json_t **out, import_diag *d, const char *file, const i
  */
 int imp_encoding(import_diag *d, const import_file *f, import_file *body);
 
+/* ---- import_bmodes_mesh.c: BModes' own model (import option bmodes_mesh) ---- */
+/**
+ * Replace the blade or tower form of the import document doc by BModes' own model: the
+ * stations sampled at the midpoints of el_loc's elements (BModes' mesh), k FE elements each,
+ * written as a structure; file names the .bmi in refusals.  SM_OK, SM_NOMEM, SM_INVALID_INPUT
+ * (d) when the result is not a valid request; a warning may be added to warn.
+ */
+int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *file, import_diag *d,
+                json_t *warn);
+/** The warnings' pointers of doc follow the structure that replaced its form (tower: 1 for
+ *  /tower, 0 for /blade).  0, -1 (memory). */
+int bm_mesh_warnings(json_t *doc, int tower);
+
 #endif /* SPINMODAL_IMPORT_INTERNAL_H */
