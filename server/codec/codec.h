@@ -207,7 +207,7 @@ const char *codec_request_stored_text(const codec_request *r);
 
 /**
  * SHA-256 of len bytes of data as lowercase hex into hex[65] (NUL-terminated).
- * Returns SM_OK or SM_NOMEM (OpenSSL failure).
+ * Returns SM_OK (sha256.c: FIPS 180-4, no library).
  */
 int codec_sha256_hex(const void *data, size_t len, char hex[65]);
 

@@ -20,8 +20,6 @@
 #include <limits.h>
 #include <string.h>
 
-#include <openssl/evp.h>
-
 /* Flags for dumping canonical text. */
 #define CODEC_DUMP_CANON (JSON_SORT_KEYS | JSON_COMPACT | JSON_REAL_PRECISION(17))
 
@@ -302,23 +300,6 @@ static int req_build_options(codec_request *r)
         return SM_NOMEM;
     spd_fill(an, r->speeds, r->rpm); /* speeds.c: rpm or omega, numbers, lists, ranges */
     r->n_speeds = (int)n;
-    return SM_OK;
-}
-
-int codec_sha256_hex(const void *data, size_t len, char hex[65])
-{
-    static const char digits[] = "0123456789abcdef";
-    unsigned char md[EVP_MAX_MD_SIZE];
-    unsigned int n = 0, i;
-
-    hex[0] = '\0';
-    if (!EVP_Digest(data, len, md, &n, EVP_sha256(), NULL) || n != 32)
-        return SM_NOMEM;
-    for (i = 0; i < n; i++) {
-        hex[2 * i] = digits[md[i] >> 4];
-        hex[2 * i + 1] = digits[md[i] & 15];
-    }
-    hex[64] = '\0';
     return SM_OK;
 }
 

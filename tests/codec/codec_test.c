@@ -709,9 +709,27 @@ static void unit_sha(test_case *tc)
 {
     char hex[65];
 
+    static const char two[] = "abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq";
+    char *million = malloc(1000000);
+
     codec_sha256_hex("abc", 3, hex);
     if (strcmp(hex, "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"))
         fail(tc, "SHA-256(\"abc\") = %s", hex);
+    /* FIPS 180-2 appendix B.2 (two blocks) and B.3 (a million 'a'), and the empty string
+     * (NIST's example values): sha256.c's padding at 0, 56 and 64k bytes. */
+    codec_sha256_hex(two, strlen(two), hex);
+    if (strcmp(hex, "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1"))
+        fail(tc, "SHA-256(B.2) = %s", hex);
+    codec_sha256_hex("", 0, hex);
+    if (strcmp(hex, "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855"))
+        fail(tc, "SHA-256(\"\") = %s", hex);
+    if (million) {
+        memset(million, 'a', 1000000);
+        codec_sha256_hex(million, 1000000, hex);
+        if (strcmp(hex, "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0"))
+            fail(tc, "SHA-256(B.3) = %s", hex);
+    }
+    free(million);
 }
 
 static void unit_errors(test_case *tc)
