@@ -691,6 +691,39 @@ enum { SM_ED_FLAP1, SM_ED_FLAP2, SM_ED_EDGE1, SM_ED_BLADE_FITS };
 int sm_elastodyn_blade(const sm_model *m, const sm_case *c, int member,
                        sm_ed_fit fits[SM_ED_BLADE_FITS]);
 
+/* ------------------------------------------------ MAC between two results (DESIGN.md 9.2) */
+
+/**
+ * One set of mode shapes sampled at points along the members of a structure, as read from a
+ * result (its member nodes) or another program's table (BModes' span stations).  Points of
+ * segment k (a member) are [seg_start[k], seg_start[k + 1]) in ascending span fraction s.
+ */
+typedef struct sm_mac_shapes {
+    int n_modes;          /* modes in re / im */
+    int n_points;         /* sample points per mode */
+    int n_comp;           /* values per point, all compared (e.g. translations) */
+    int n_segments;       /* members; 0 or 1 with seg_start NULL: one segment of all points */
+    const int *seg_start; /* n_segments + 1 offsets into the points, or NULL */
+    const double *s;      /* n_points span fractions, or NULL (then matching by index only) */
+    const double *re;     /* n_modes * n_points * n_comp */
+    const double *im;     /* same, or NULL for real shapes */
+} sm_mac_shapes;
+
+/** How sm_mac matched the points of the two sets. */
+enum { SM_MAC_BY_INDEX = 0, SM_MAC_INTERPOLATED_A = 1, SM_MAC_INTERPOLATED_B = 2 };
+
+/**
+ * mac[i * b->n_modes + j] = |a_i^H b_j|^2 / (a_i^H a_i  b_j^H b_j) between mode i of a and
+ * mode j of b.  Points match by index when the two sets have the same segments and points
+ * (and the same s where both give s, to 1e-9); otherwise, per segment, the set with more
+ * points is interpolated linearly in s at the other's points (*how says which), which needs
+ * s on both sides, the same number of segments and the sampled points inside the other's
+ * span.  A zero shape gives MAC 0.  Returns SM_OK, or SM_INVALID_INPUT with the reason in
+ * why (different components, segments or node counts without s, no modes, bad s).
+ */
+int sm_mac(const sm_mac_shapes *a, const sm_mac_shapes *b, double *mac, int *how, char *why,
+           size_t why_size);
+
 #ifdef __cplusplus
 }
 #endif

@@ -22,6 +22,7 @@
 #include "cli_import.h"
 #include "codec.h"
 #include "elastodyn.h"
+#include "mac.h"
 #include "spinmodal.h"
 
 /* OpenBLAS: the program chooses its BLAS threads (weak: a reference BLAS links too). */
@@ -55,6 +56,7 @@ static const char cli_usage_text[] =
     "                        [--rpm SPEEDS] [--bmodes-mesh K] [--allow-outside] [--pretty] [--full]\n"
     "       spinmodal export spanwise|bmodes RESULT|-\n"
     "       spinmodal export elastodyn RESULT|- [--case K] [--patch DECK]\n"
+    "       spinmodal compare A B [--case K] [--case-b K] [--format json|csv] [--pretty]\n"
     "       spinmodal --help | --version\n";
 
 static void cli_help(void)
@@ -76,7 +78,11 @@ static void cli_help(void)
            "  export elastodyn RESULT|- [--case K] [--patch DECK]  ElastoDyn blade\n"
            "                   mode-shape coefficients (BldFl1Sh, BldFl2Sh, BldEdgSh) with\n"
            "                   the fit report; --patch: DECK with them replaced (case K,\n"
-           "                   default 1), every other byte as it was\n\n"
+           "                   default 1), every other byte as it was\n"
+           "  compare A B      MAC table between the modes of case K (default 1; B's:\n"
+           "                   --case-b) of two results, or of a result and a BModes\n"
+           "                   .out (its flap and lag columns); same nodes: by index,\n"
+           "                   other meshes: by span fraction along each member\n\n"
            "options:\n"
            "  --csv            print the frequency table as CSV instead of JSON\n"
            "  --table          print an aligned table: speed (rad/s, rpm), mode,\n"
@@ -572,6 +578,101 @@ static int cli_export_main(int argc, char **argv)
     return e ? CLI_FAILED : CLI_OK;
 }
 
+/* One side of compare: a result document, or a BModes .out (no '{' first); CLI_OK or not. */
+static int cli_mac_side(const char *path, long case_no, int comp, codec_mac_set *x)
+{
+    char *text = NULL, why[400] = "";
+    size_t len = 0, i = 0;
+    json_t *doc = NULL;
+    int e = cli_read(path, (size_t)1 << 31, &text, &len), st;
+
+    if (e) {
+        fprintf(stderr, "spinmodal: %s: %s\n", path, strerror(e));
+        return CLI_FAILED;
+    }
+    while (i < len && (text[i] == ' ' || text[i] == '\n' || text[i] == '\r' || text[i] == '\t'))
+        i++;
+    if (i < len && text[i] == '{') {
+        json_error_t jerr;
+        doc = json_loadb(text, len, 0, &jerr);
+        st = doc ? codec_mac_from_result(x, doc, case_no, comp, why, sizeof why) : SM_INVALID_INPUT;
+        if (!doc)
+            snprintf(why, sizeof why, "line %d: not a result document: %s", jerr.line, jerr.text);
+    } else
+        st = codec_mac_from_bmodes_out(x, text, len, why, sizeof why);
+    free(text);
+    json_decref(doc);
+    if (st)
+        fprintf(stderr, "spinmodal: %s: %s\n", path, st == SM_NOMEM ? "out of memory" : why);
+    return st == SM_OK ? CLI_OK : st == SM_NOMEM ? CLI_FAILED : CLI_INVALID;
+}
+
+/* 1 when the file at path starts with something other than '{' (a BModes .out). */
+static int cli_is_table(const char *path)
+{
+    FILE *f = strcmp(path, "-") ? fopen(path, "rb") : NULL;
+    int c = ' ';
+    while (f && (c == ' ' || c == '\n' || c == '\r' || c == '\t'))
+        c = fgetc(f);
+    if (f)
+        fclose(f);
+    return f && c != '{';
+}
+
+/* spinmodal compare A B [--case K] [--case-b K] [--format json|csv] [--pretty]: codec_mac_doc. */
+static int cli_compare(int argc, char **argv)
+{
+    const char *path[2] = {NULL, NULL};
+    long ck[2] = {1, 0};
+    int csv = 0, pretty = 0, i, np = 0, rc = CLI_FAILED, comp;
+    codec_mac_set x[2];
+    char why[400] = "";
+    json_t *doc = NULL;
+
+    for (i = 2; i < argc; i++) {
+        if ((!strcmp(argv[i], "--case") || !strcmp(argv[i], "--case-b")) && i + 1 < argc) {
+            char *end;
+            long *k = &ck[argv[i][6] == '-'];
+            *k = strtol(argv[++i], &end, 10);
+            if (*end || *k < 1)
+                return cli_usage("--case and --case-b take a case number from 1");
+        } else if (!strcmp(argv[i], "--format") && i + 1 < argc) {
+            csv = !strcmp(argv[++i], "csv");
+            if (!csv && strcmp(argv[i], "json"))
+                return cli_usage("compare formats: json or csv");
+        } else if (!strcmp(argv[i], "--pretty"))
+            pretty = 1;
+        else if (np < 2 && (argv[i][0] != '-' || !strcmp(argv[i], "-")))
+            path[np++] = argv[i];
+        else
+            return cli_usage("compare takes A B [--case K] [--case-b K] [--format json|csv]");
+    }
+    if (np != 2)
+        return cli_usage("compare takes two files: results (JSON) or BModes .out tables");
+    if (!ck[1])
+        ck[1] = ck[0];
+    comp = cli_is_table(path[0]) || cli_is_table(path[1]) ? CODEC_MAC_FLAP_LAG : CODEC_MAC_HUB;
+    memset(x, 0, sizeof x);
+    if ((rc = cli_mac_side(path[0], ck[0], comp, &x[0])) ||
+        (rc = cli_mac_side(path[1], ck[1], comp, &x[1])))
+        goto done;
+    i = codec_mac_doc(&doc, &x[0], &x[1], comp, why, sizeof why);
+    if (i) {
+        fprintf(stderr, "spinmodal: compare: %s\n", i == SM_NOMEM ? "out of memory" : why);
+        rc = i == SM_NOMEM ? CLI_FAILED : CLI_INVALID;
+    } else if (csv) {
+        char *out = NULL;
+        size_t n = 0;
+        rc = codec_mac_csv(&out, &n, doc) ? CLI_FAILED : cli_put(out, n);
+    } else
+        rc = cli_print_json(stdout, doc, pretty);
+done:
+    json_decref(doc);
+    codec_mac_set_free(&x[0]);
+    codec_mac_set_free(&x[1]);
+    return rc;
+}
+
 int main(int argc, char **argv)
 {
     cli_args a = {NULL, NULL, 0, 0, 0, 0};
@@ -583,6 +684,8 @@ int main(int argc, char **argv)
         return cli_import_main(argc, argv);
     if (!strcmp(argv[1], "export"))
         return cli_export_main(argc, argv);
+    if (!strcmp(argv[1], "compare"))
+        return cli_compare(argc, argv);
     for (i = 1; i < argc; i++) {
         const char *s = argv[i];
         if (!opts_done && (!strcmp(s, "-h") || !strcmp(s, "--help") || !strcmp(s, "help"))) {

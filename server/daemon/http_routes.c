@@ -28,6 +28,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "http_mac.h"
 #include "import.h"
 
 /* ------------------------------------------------------ operational routes */
@@ -190,12 +191,14 @@ static const http_route_def http_routes[] = {
     {"/v1/validate", R_VALIDATE, M_POST, 0, NULL, NULL, http_post_begin, http_post_end},
     {"/v1/analyses/{id}", R_ANALYSIS, HTTP_READ | M_DELETE, HTTP_ROUTE_READ_TOKEN,
      http_get_analysis, http_delete, NULL, NULL},
-    {"/v1/analyses/{id}/result", R_RESULT, HTTP_READ, HTTP_ROUTE_READ_TOKEN, http_get_result,
+    {"/v1/analyses/{id}/result", R_RESULT, HTTP_READ, HTTP_ROUTE_READ_TOKEN, http_get_result, NULL,
+     NULL, NULL},
+    {"/v1/analyses/{id}/request", R_REQUEST, HTTP_READ, HTTP_ROUTE_READ_TOKEN, http_get_request,
      NULL, NULL, NULL},
-    {"/v1/analyses/{id}/request", R_REQUEST, HTTP_READ, HTTP_ROUTE_READ_TOKEN,
-     http_get_request, NULL, NULL, NULL},
-    {"/v1/import/{format}", R_IMPORT, M_POST, 0, NULL, NULL, http_import_begin,
-     http_import_end},
+    /* reads stored results as /result does: its route id (http_mac.c) */
+    {"/v1/analyses/{id}/mac", R_RESULT, HTTP_READ, HTTP_ROUTE_READ_TOKEN, http_get_mac, NULL, NULL,
+     NULL},
+    {"/v1/import/{format}", R_IMPORT, M_POST, 0, NULL, NULL, http_import_begin, http_import_end},
     {"/livez", R_LIVEZ, HTTP_READ, 0, http_livez, NULL, NULL, NULL},
     {"/readyz", R_READYZ, HTTP_READ, 0, http_readyz, NULL, NULL, NULL},
     {"/metrics", R_METRICS, HTTP_READ, HTTP_ROUTE_READ_TOKEN, http_metrics, NULL, NULL, NULL},
