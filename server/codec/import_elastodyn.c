@@ -559,6 +559,65 @@ static int ed_tower_doc(json_t *doc, const ed_main *m, json_t *top)
     return 0;
 }
 
+/* Stand-ins for what ElastoDyn's tower lacks (DESIGN.md 8.5): EA = 1e7 EI/L^2, GJ = 1e5 EI
+ * (ElastoDyn's tower is rigid in extension and torsion; the top mass's c.m. offset and
+ * product of inertia couple them to bending, so the blade's 1e4 and 10 would move the bending
+ * frequencies by 3e-3; these move them by <= 2e-7 when changed 10x either way, with
+ * cond(K) ~ 1e9), and rotary inertias mu (1e-5 L)^2 (ElastoDyn's tower has none; without
+ * them the default mu EI/EA would tie the frequencies to the EA stand-in).  Only what the file
+ * does not give; each with a warning replacing the blade's. */
+#define ED_TW_EA 1e7
+#define ED_TW_GJ 1e5
+#define ED_TW_RG 1e-5
+
+static int ed_tower_standins(json_t *doc, const imp_table *t, double length)
+{
+    json_t *tw = json_object_get(json_object_get(doc, "request"), "tower");
+    json_t *sec = json_object_get(tw, "section"), *ws = json_object_get(doc, "input_warnings"), *st;
+    double ei = imp_table_max(t, IK_EI_FLAP), ea, gj, rg = ED_TW_RG * length;
+    size_t i;
+    int bad = 0;
+
+    if (imp_table_max(t, IK_EI_EDGE) > ei)
+        ei = imp_table_max(t, IK_EI_EDGE);
+    ea = imp_round(ED_TW_EA * ei / (length * length));
+    gj = imp_round(ED_TW_GJ * ei);
+    for (i = json_array_size(ws); i-- > 0;) { /* the blade's stand-in warnings go */
+        const char *p = json_string_value(json_object_get(json_array_get(ws, i), "pointer"));
+        if (p && (!strcmp(p, "/tower/section/EA") || !strcmp(p, "/tower/section/GJ")))
+            bad |= json_array_remove(ws, i);
+    }
+    if (json_object_get(sec, "EA")) {
+        bad |= json_object_set_new(sec, "EA", json_real(ea));
+        bad |= imp_warn(ws, "/tower/section/EA",
+                        "EA is not in the ElastoDyn tower file (rigid "
+                        "in extension): tower.section.EA = %.6g N assumed (1e7 x the largest EI / "
+                        "height^2)",
+                        ea);
+    }
+    if (json_object_get(sec, "GJ")) {
+        bad |= json_object_set_new(sec, "GJ", json_real(gj));
+        bad |= imp_warn(ws, "/tower/section/GJ",
+                        "GJ is not in the ElastoDyn tower file (rigid "
+                        "in torsion): tower.section.GJ = %.6g N m^2 assumed (1e5 x the largest "
+                        "EI)",
+                        gj);
+    }
+    if (!(t->mask & (1u << IK_I_FLAP)) && !(t->mask & (1u << IK_I_EDGE))) {
+        json_array_foreach(json_object_get(tw, "stations"), i, st)
+        {
+            double mu = json_number_value(json_object_get(st, "mass_per_length"));
+            bad |= json_object_set_new(st, "flap_inertia", json_real(imp_round(mu * rg * rg)));
+            bad |= json_object_set_new(st, "edge_inertia", json_real(imp_round(mu * rg * rg)));
+        }
+        bad |= imp_warn(ws, "/tower/stations",
+                        "ElastoDyn's tower has no rotary inertia: "
+                        "flap_inertia = edge_inertia = mass_per_length x (1e-5 x height)^2 "
+                        "(negligible, and independent of the EA stand-in)");
+    }
+    return bad || imp_legacy_warnings(doc) ? -1 : 0;
+}
+
 /* The main file: the tower form (the file's head comment). */
 static int ed_main_import(json_t **out, const import_file *f, import_loader load, void *ctx,
                           const import_options *o, import_diag *d)
@@ -615,7 +674,8 @@ static int ed_main_import(json_t **out, const import_file *f, import_loader load
     st = imp_document_assumed(out, d, tf.name, &bl, &t, "ElastoDyn tower", ed_tw_ei_names, warn,
                               src);
     warn = src = NULL;
-    if (!st && ((top = ed_top_json(&tm)) == NULL || ed_tower_doc(*out, &m, top))) {
+    if (!st && ((top = ed_top_json(&tm)) == NULL || ed_tower_doc(*out, &m, top) ||
+                ed_tower_standins(*out, &t, bl.length))) {
         json_decref(*out);
         *out = NULL;
         st = SM_NOMEM;
