@@ -38,8 +38,8 @@ static json_t *bm_lerp(const json_t *a, const json_t *b, double f, int *big)
         json_t *o = json_array();
         size_t i;
         for (i = 0; o && i < json_array_size(a); i++)
-            if (json_array_append_new(o, bm_lerp(json_array_get(a, i), json_array_get(b, i), f,
-                                                 big))) {
+            if (json_array_append_new(
+                    o, bm_lerp(json_array_get(a, i), json_array_get(b, i), f, big))) {
                 json_decref(o);
                 return NULL;
             }
@@ -80,8 +80,8 @@ static json_t *bm_sample(const json_t *sts, double x, int *big)
     b = json_array_get(sts, j + 1);
     f = (x - bm_st(a, "s")) / (bm_st(b, "s") - bm_st(a, "s"));
     json_object_foreach((json_t *)a, key, v)
-        if (strcmp(key, "s") && json_object_set_new(o, key, bm_lerp(v, json_object_get(b, key), f,
-                                                                     big)))
+        if (strcmp(key, "s") &&
+            json_object_set_new(o, key, bm_lerp(v, json_object_get(b, key), f, big)))
             goto fail;
     mu = bm_st(o, "mass_per_length");
     ra = bm_st(a, "flap_inertia") / bm_st(a, "mass_per_length");
@@ -93,8 +93,8 @@ static json_t *bm_sample(const json_t *sts, double x, int *big)
     rb = bm_st(b, "edge_inertia") / bm_st(b, "mass_per_length") + BM_CG(b) * BM_CG(b);
     cg = BM_CG(o);
 #undef BM_CG
-    if (json_object_set_new(o, "edge_inertia", bm_real(mu * (ra + f * (rb - ra)) - mu * cg * cg,
-                                                       big)))
+    if (json_object_set_new(o, "edge_inertia",
+                            bm_real(mu * (ra + f * (rb - ra)) - mu * cg * cg, big)))
         goto fail;
     return o;
 fail:
@@ -157,8 +157,10 @@ int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *file, impo
                              x * (json_number_value(json_array_get(tip, c)) -
                                   json_number_value(json_array_get(root, c))));
             if (!imp_finite(p[c])) {
-                rc = imp_fail(d, file, 0, "bmodes_mesh", "the joint at el_loc %.15g is beyond "
-                              "the largest number a request carries (%s)", x, IMP_MAX_ABS_TEXT);
+                rc = imp_fail(d, file, 0, "bmodes_mesh",
+                              "the joint at el_loc %.15g is beyond "
+                              "the largest number a request carries (%s)",
+                              x, IMP_MAX_ABS_TEXT);
                 goto done;
             }
         }
@@ -177,9 +179,11 @@ int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *file, impo
             char from[32], id[32];
             if (big) {
                 json_decref(mid);
-                rc = imp_fail(d, file, 0, "bmodes_mesh", "element e%zu (el_loc %.15g to %.15g): "
+                rc = imp_fail(d, file, 0, "bmodes_mesh",
+                              "element e%zu (el_loc %.15g to %.15g): "
                               "a property sampled at its midpoint is beyond the largest number a "
-                              "request carries (%s)", i, x0, x, IMP_MAX_ABS_TEXT);
+                              "request carries (%s)",
+                              i, x0, x, IMP_MAX_ABS_TEXT);
                 goto done;
             }
             if (i == 1)
