@@ -73,8 +73,7 @@ static int mac_count(const json_t *cs, int *with_im)
     size_t i;
     int n = 0;
     *with_im = 0;
-    json_array_foreach(json_object_get(cs, "modes"), i, m)
-    {
+    json_array_foreach(json_object_get(cs, "modes"), i, m) {
         const json_t *sh = json_object_get(m, "shape");
         if (json_array_size(json_object_get(sh, "re"))) {
             n++;
@@ -84,14 +83,14 @@ static int mac_count(const json_t *cs, int *with_im)
     return n;
 }
 
-/* Fills the shapes of x (already allocated) from case cs, members `mems` (NULL: by node). */
-static void mac_fill(codec_mac_set *x, const json_t *cs, const json_t *mems, int comp)
+/* Fills the shapes of x (already allocated) from case cs, members `mems` (NULL: by node; chain:
+ * the node a member shares with the one before is taken once). */
+static void mac_fill(codec_mac_set *x, const json_t *cs, const json_t *mems, int chain, int comp)
 {
     const json_t *m, *lay;
     size_t i, k, j;
     int mi = 0, nc = x->sh.n_comp;
-    json_array_foreach(json_object_get(cs, "modes"), i, m)
-    {
+    json_array_foreach(json_object_get(cs, "modes"), i, m) {
         const json_t *sh = json_object_get(m, "shape"), *re = json_object_get(sh, "re");
         const json_t *im = json_object_get(sh, "im");
         double *o = x->re + (size_t)mi * x->sh.n_points * nc, ax[9] = {0};
@@ -108,12 +107,11 @@ static void mac_fill(codec_mac_set *x, const json_t *cs, const json_t *mems, int
                     mac_point(im, k, ax, comp, nc, oi + k * nc);
             }
         size_t p = 0;
-        json_array_foreach(mems, k, lay)
-        {
+        json_array_foreach(mems, k, lay) {
             const json_t *nodes = json_object_get(lay, "nodes");
             for (j = 0; j < 9; j++)
                 ax[j] = json_number_value(json_array_get(json_object_get(lay, "axes"), j));
-            for (j = 0; j < json_array_size(nodes); j++, p++) {
+            for (j = chain && k > 0; j < json_array_size(nodes); j++, p++) {
                 size_t node = (size_t)json_integer_value(json_array_get(nodes, j));
                 mac_point(re, node, ax, comp, nc, o + p * nc);
                 if (oi && im)
@@ -124,22 +122,72 @@ static void mac_fill(codec_mac_set *x, const json_t *cs, const json_t *mems, int
     }
 }
 
-/* The members of a result's model with their nodes (NULL for a result without them). */
-static const json_t *mac_members(const json_t *result, int *np)
+/* Node j of a member layout. */
+static json_int_t mac_node(const json_t *lay, size_t j)
 {
-    const json_t *mems = json_object_get(json_object_get(result, "model"), "members"), *lay;
+    return json_integer_value(json_array_get(json_object_get(lay, "nodes"), j));
+}
+
+/* Number of nodes of a member layout. */
+static size_t mac_n(const json_t *lay)
+{
+    return json_array_size(json_object_get(lay, "nodes"));
+}
+
+/*
+ * The members of a result's model with their nodes (NULL for a result without them), *np
+ * their points and *chain 1 when they form one chain in order (each starts at the node where
+ * the one before ends: a blade or tower cut into members, e.g. BModes' own mesh), read then as
+ * one segment whose span fraction runs along the whole length.
+ */
+static const json_t *mac_members(const json_t *result, int *np, int *chain)
+{
+    const json_t *mems = json_object_get(json_object_get(result, "model"), "members"), *lay, *prev;
     size_t k;
     *np = 0;
-    json_array_foreach(mems, k, lay) *np += (int)json_array_size(json_object_get(lay, "nodes"));
+    *chain = json_array_size(mems) > 1;
+    json_array_foreach(mems, k, lay) {
+        prev = k > 0 ? json_array_get(mems, k - 1) : NULL;
+        if (mac_n(lay) < 2 || (prev && mac_node(lay, 0) != mac_node(prev, mac_n(prev) - 1)))
+            *chain = 0;
+        *np += (int)mac_n(lay);
+    }
+    if (*chain)
+        *np -= (int)json_array_size(mems) - 1;
     return *np > 0 ? mems : NULL;
+}
+
+/* The span fractions and segments of x from the member layouts (chain: one segment, s along
+ * the summed lengths). */
+static void mac_layout(codec_mac_set *x, const json_t *mems, int chain)
+{
+    const json_t *lay;
+    double total = 0, at = 0;
+    size_t k, j, p = 0;
+    json_array_foreach(mems, k, lay)
+        total += json_number_value(json_object_get(lay, "length"));
+    json_array_foreach(mems, k, lay) {
+        const json_t *s = json_object_get(lay, "s");
+        double len = json_number_value(json_object_get(lay, "length"));
+        if (!chain)
+            x->seg[k] = (int)p;
+        for (j = chain && k > 0; j < mac_n(lay); j++) {
+            double sj = json_number_value(json_array_get(s, j));
+            x->s[p++] = chain && total > 0 ? (at + sj * len) / total : sj;
+        }
+        if (!chain)
+            x->seg[k + 1] = (int)p;
+        at += len;
+    }
+    if (chain)
+        x->seg[0] = 0, x->seg[1] = (int)p;
 }
 
 int codec_mac_from_result(codec_mac_set *x, const json_t *result, long case_no, int comp, char *err,
                           size_t errcap)
 {
-    const json_t *cases = json_object_get(result, "cases"), *cs, *mems, *lay;
-    int np, n_modes, with_im, nc, st;
-    size_t k, j, p = 0;
+    const json_t *cases = json_object_get(result, "cases"), *cs, *mems;
+    int np, n_modes, with_im, nc, st, chain;
 
     memset(x, 0, sizeof(*x));
     if (!json_is_array(cases)) {
@@ -162,7 +210,7 @@ int codec_mac_from_result(codec_mac_set *x, const json_t *result, long case_no, 
                      : "?");
         return SM_INVALID_INPUT;
     }
-    mems = mac_members(result, &np);
+    mems = mac_members(result, &np, &chain);
     if (!mems && comp == CODEC_MAC_FLAP_LAG) {
         snprintf(err, errcap,
                  "flap and lag shapes need a spatial result with mode shapes "
@@ -175,20 +223,14 @@ int codec_mac_from_result(codec_mac_set *x, const json_t *result, long case_no, 
     if (!mems) /* planar: every node, by index */
         np = (int)json_array_size(json_object_get(
             json_object_get(json_array_get(json_object_get(cs, "modes"), 0), "shape"), "re"));
-    st = mac_alloc(x, n_modes, np, nc, mems ? (int)json_array_size(mems) : 1, with_im);
+    st = mac_alloc(x, n_modes, np, nc, mems && !chain ? (int)json_array_size(mems) : 1, with_im);
     if (st)
         goto fail;
     if (!mems)
         x->sh.s = NULL, x->seg[1] = np;
-    json_array_foreach(mems, k, lay)
-    {
-        const json_t *s = json_object_get(lay, "s");
-        x->seg[k] = (int)p;
-        for (j = 0; j < json_array_size(json_object_get(lay, "nodes")); j++)
-            x->s[p++] = json_number_value(json_array_get(s, j));
-        x->seg[k + 1] = (int)p;
-    }
-    mac_fill(x, cs, mems, comp);
+    else
+        mac_layout(x, mems, chain);
+    mac_fill(x, cs, mems, chain, comp);
     x->case_no = case_no;
     x->omega = json_number_value(json_object_get(cs, "omega"));
     x->kind = "result";
@@ -296,13 +338,13 @@ int codec_mac_csv(char **out, size_t *len, const json_t *doc)
     for (j = 0; j < json_array_size(json_array_get(rows, 0)); j++)
         fprintf(f, ",b%zu", j + 1);
     fputc('\n', f);
-    json_array_foreach(rows, i, r)
-    {
+    json_array_foreach(rows, i, r) {
         const char *lab = json_string_value(json_array_get(json_object_get(a, "labels"), i));
         fprintf(f, "%zu,%.17g,%s", i + 1,
                 json_number_value(json_array_get(json_object_get(a, "frequency_hz"), i)),
                 lab ? lab : "");
-        json_array_foreach(r, j, v) fprintf(f, ",%.17g", json_number_value(v));
+        json_array_foreach(r, j, v)
+            fprintf(f, ",%.17g", json_number_value(v));
         fputc('\n', f);
     }
     return codec_memstream_done(f, &buf, &n, out, len);

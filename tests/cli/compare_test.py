@@ -12,6 +12,8 @@ at 48 elements (20 modes) and at 30 elements (8 modes), then:
     interpolated), diagonal >= 0.99 for modes 1-8 and each row's best its own mode;
   - against BModes' own shapes, TestFiles/Test01_nonunif_blade.out (BModes v3.00, published
     with its CertTest): flap and lag columns, diagonal >= 0.99 for modes 1-5 (printed);
+  - the import on BModes' own mesh (--bmodes-mesh: 12 members in a chain) against the same
+    .out: read as one span, matched by index at BModes' 13 stations, diagonal >= 0.998 (1-4);
   - --format csv: the JSON's numbers, one row per mode of A;
   - refusals, exit 2 with the reason on stderr: planar against spatial, a request instead of a
     result, a case without shapes, a case that does not exist, a file that is neither;
@@ -99,6 +101,19 @@ def t_tables(exe, tmp, bm):
         check(min(diag[:5]) >= 0.99, "vs BModes .out: diagonal >= 0.99 for modes 1-5 (min %.5f)"
               % min(diag[:5]))
         check(d["components"].startswith("flap, lag"), "vs BModes .out: flap and lag compared")
+    rc, text, err = run(exe, ["import", "bmodes", "--bmodes-mesh", "1",
+                              os.path.join(bm, "Test01_nonunif_blade.bmi")])
+    _, rown = solve(exe, tmp, "t01_own", json.loads(text))
+    rc, d, err = compare(exe, [rown, out])
+    if check(rc == 0, "BModes' own mesh vs its .out: exit 0 (%d %s)" % (rc, err[:200])):
+        diag = [d["mac"][i][i] for i in range(4)]
+        print("     own mesh (12 members, one chain) vs BModes .out, diagonal 1-4: " +
+              " ".join("%.5f" % v for v in diag))
+        check(d["matching"] == "by_index" and d["a"]["points"] == 13,
+              "own mesh: its 12 members read as one span of 13 nodes, BModes' stations (%s, %d)"
+              % (d["matching"], d["a"]["points"]))
+        check(min(diag) >= 0.998, "own mesh: diagonal >= 0.998 for modes 1-4 (min %.5f)"
+              % min(diag))
     rc, csv, err = run(exe, ["compare", r48, r30, "--format", "csv"])
     rows = csv.strip().splitlines()
     _, d, _ = compare(exe, [r48, r30])
