@@ -553,8 +553,16 @@ async function exportsAndCompare(page, result) {
   ok(refS.label === `ref ${r20.modes[0].label}`, 'compare: the reference line is named by its label', refS.label);
   ok(ref1 === want && cur1 < want, 'compare: ref mode 1 at 20 rad/s is the first design\'s, the heavier beam\'s is lower',
     `${ref1} vs ${want}; now ${cur1}`);
+  // the MAC table against the reference (GET /v1/analyses/{id}/mac, DESIGN.md 9.2): mass per length
+  // doubled everywhere keeps every shape, so the diagonal is 1
+  ok(await waitFor(page, () => !document.getElementById('mac-table').hidden, null, 'the MAC table'),
+    'compare: the MAC table against the reference is shown', await page.textContent('#mac-note'));
+  const macRows = await page.$$eval('#mac-table tbody tr', (trs) => trs.map((tr) => [...tr.cells].slice(1).map((td) => Number(td.textContent))));
+  ok(macRows.length === now.cases[0].modes.length && macRows.every((r, i) => r[i] >= 0.999),
+    'compare: one MAC row per mode, the diagonal 1 (same shapes)', JSON.stringify(macRows));
   await shot(page, '12-compare-designs.png');
   await page.click('#clear-ref');
+  ok(await page.evaluate(() => document.getElementById('mac-table').hidden), 'Stop comparing hides the MAC table');
   ok(!(await page.evaluate(() => window.__spinmodal.campbell())).series.some((s) => /^ref /.test(s.label)),
     'Stop comparing removes the overlay');
   ok(!(await page.evaluate(() => window.__spinmodal.campbell())).series.some((s) => s.kind === 'ref'),

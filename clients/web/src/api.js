@@ -116,6 +116,17 @@ export async function getResult(id) {
 }
 
 /**
+ * GET /v1/analyses/{id}/mac?with=ID2: the MAC table between the modes of the first case of
+ * both results (DESIGN.md 9.2): {ok: true, doc} or {ok: false, message} (409 not-comparable:
+ * different structures or no mode shapes; 404 on a daemon without the route).
+ */
+export async function getMac(id, withId) {
+  const ans = await call('GET', `v1/analyses/${encodeURIComponent(id)}/mac?with=${encodeURIComponent(withId)}`);
+  if (ans.ok && ans.body) return {ok: true, doc: ans.body};
+  return {ok: false, status: ans.status, message: problemErrors(ans)[0].message};
+}
+
+/**
  * GET /v1/analyses/{id}/result?format=F as a file: {ok: true, blob, type} with
  * the daemon's bytes unchanged (its Content-Type), or {ok: false, status,
  * message} (409 no-spanwise-shapes: a planar result or one without shapes).

@@ -6,6 +6,7 @@
 
 import {sig, SPEED_UNITS, FREQ_UNITS} from './request.js';
 import {campbellChart, parseOrders, COLORS, divergenceSpeeds} from './campbell.js';
+import {getMac} from './api.js';
 import {$, plural} from './dom.js';
 import {S} from './state.js';
 import {units} from './units.js';
@@ -74,6 +75,62 @@ export function updateChart() {
   $('critical-hint').hidden = !!critical || d.rows.length < 2 || !orders.length;
   criticalTable(critical);
   divergenceTable(S.result.result);
+  macTable(ref ? S.result.id : null, ref ? S.ref.id : null);
+}
+
+let macShown = ''; // "id|ref" of the table shown (or asked for)
+
+/**
+ * The MAC table between the modes of the result shown (rows) and the reference (columns), from
+ * the daemon (GET /v1/analyses/{id}/mac?with=REF, DESIGN.md 9.2), asked once per pair; the
+ * reason instead when they cannot be compared (another structure, no mode shapes).
+ */
+async function macTable(id, refId) {
+  const key = id && refId ? `${id}|${refId}` : '';
+  if (key === macShown) return;
+  macShown = key;
+  $('mac-table').hidden = true;
+  $('mac-note').hidden = true;
+  if (!key) return;
+  let ans;
+  try {
+    ans = await getMac(id, refId);
+  } catch (e) {
+    ans = {ok: false, message: String(e.message || e)};
+  }
+  if (macShown !== key) return; // another pair was asked for meanwhile
+  if (!ans.ok) {
+    $('mac-note').textContent = `No MAC table against the reference: ${ans.message}`;
+    $('mac-note').hidden = false;
+    return;
+  }
+  const d = ans.doc;
+  const head = $('mac-head');
+  head.textContent = '';
+  const th0 = document.createElement('th');
+  th0.scope = 'col';
+  th0.textContent = 'mode (Hz)';
+  head.appendChild(th0);
+  (d.b.frequency_hz || []).forEach((f, j) => {
+    const th = document.createElement('th');
+    th.scope = 'col';
+    th.textContent = `${j + 1} (${sig(f, 4)})`;
+    head.appendChild(th);
+  });
+  const tb = $('mac-table').tBodies[0];
+  tb.textContent = '';
+  d.mac.forEach((row, i) => {
+    const tr = tb.insertRow();
+    const lab = (d.a.labels || [])[i];
+    tr.insertCell().textContent = `${i + 1} ${lab || ''} (${sig(d.a.frequency_hz[i], 4)})`;
+    row.forEach((v, j) => {
+      const td = tr.insertCell();
+      td.textContent = v.toFixed(3);
+      if (d.best[i] && d.best[i].b === j + 1) td.style.fontWeight = 'bold';
+    });
+  });
+  $('mac-caption').textContent = `MAC against the reference (first speed of each; ${d.matching.replace('_', ' ')}; bold: the best match of each mode)`;
+  $('mac-table').hidden = false;
 }
 
 /**
