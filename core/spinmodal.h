@@ -663,6 +663,23 @@ typedef struct sm_ed_shapes {
  */
 int sm_elastodyn_fit_modes(const sm_ed_shapes *s, const int want[2], sm_ed_fit *fits);
 
+/** Relative frequency gap below which two modes are a degenerate pair (DESIGN §B). */
+#define SM_ED_DEGENERATE 1e-4
+
+/**
+ * Rotate degenerate pairs to pure directions before sm_elastodyn_fit_modes classifies them
+ * (DESIGN §B: a symmetric tower's fore-aft and side-side modes share a frequency, and the
+ * eigensolver returns any two orthogonal mixtures).  For each pair of consecutive modes k,
+ * k + 1 with |freq[k+1] - freq[k]| < SM_ED_DEGENERATE freq[k+1]: the two combinations whose
+ * tip displacement in direction b, resp. a, is zero replace them (mode k pure a, k + 1 pure
+ * b), each scaled to a largest |displacement| of 1; their energy entries are made from the
+ * new shapes' nodal displacements (kinetic and strain alike: the a and b parts in proportion
+ * to the sums of squares, axial and torsion the smaller of the pair's).  s's arrays re, im,
+ * slope_re, slope_im and energy are modified in place (the caller's buffers, cast from s).
+ * Returns the number of pairs rotated.
+ */
+int sm_elastodyn_degenerate(sm_ed_shapes *s, const double *freq);
+
 /**
  * Project one mode shape on a member's principal axes (DESIGN.md 9.3): rows[6 j .. 6 j + 6)
  * the displacement and small rotation (hub frame) of the member's node j (n nodes, root

@@ -200,6 +200,102 @@ int sm_elastodyn_fit_modes(const sm_ed_shapes *s, const int want[2], sm_ed_fit *
     return rc;
 }
 
+/* Combination y = ca x mode k + cb x mode k1 of one array of the shapes (stride per mode
+ * `per`, offset o within a mode) into out[len]. */
+static void ed_combine(const double *v, size_t per, int k, int k1, double ca, double cb, size_t len,
+                       double *out)
+{
+    size_t j;
+
+    for (j = 0; j < len; j++)
+        out[j] = ca * v[(size_t)k * per + j] + cb * v[(size_t)k1 * per + j];
+}
+
+/* Mode k's shape (both directions), slopes and energy from its displacements, scaled. */
+static void ed_degenerate_store(sm_ed_shapes *s, int k, const double *y, const double *yi,
+                                const double *sl, const double *sli, double ax_to)
+{
+    size_t n2 = 2 * (size_t)s->n_nodes, j;
+    double big = 0, sa = 0, sb = 0, *e = (double *)s->energy + (size_t)k * SM_ENERGY_PARTS;
+    int h;
+
+    for (j = 0; j < n2; j++)
+        big = fmax(big, fabs(y[j]));
+    big = big > 0 ? big : 1;
+    for (j = 0; j < n2; j++) {
+        ((double *)s->re)[(size_t)k * n2 + j] = y[j] / big;
+        if (s->im)
+            ((double *)s->im)[(size_t)k * n2 + j] = yi[j] / big;
+        if (j < (size_t)s->n_nodes)
+            sa += y[j] * y[j];
+        else
+            sb += y[j] * y[j];
+    }
+    for (h = 0; h < 2; h++) {
+        if (s->slope_re)
+            ((double *)s->slope_re)[2 * k + h] = sl[h] / big;
+        if (s->slope_im)
+            ((double *)s->slope_im)[2 * k + h] = sli[h] / big;
+    }
+    for (h = 0; h < SM_ENERGY_PARTS; h += SM_ENERGY_PARTS / 2) { /* kinetic, then strain */
+        double rest = 1 - ax_to;
+        e[h + SM_MODE_AXIAL] = e[h + SM_MODE_TORSION] = ax_to / 2;
+        e[h + s->part[0]] = sa + sb > 0 ? rest * sa / (sa + sb) : 0;
+        e[h + s->part[1]] = sa + sb > 0 ? rest * sb / (sa + sb) : 0;
+    }
+}
+
+/* Rotate the pair k, k + 1 (the declaration of sm_elastodyn_degenerate); 1 when done. */
+static int ed_degenerate_pair(sm_ed_shapes *s, int k, double *buf)
+{
+    size_t n = (size_t)s->n_nodes, n2 = 2 * n, tip = n - 1;
+    const double *re = s->re;
+    double a0 = re[(size_t)k * n2 + tip], b0 = re[(size_t)k * n2 + n + tip];
+    double a1 = re[(size_t)(k + 1) * n2 + tip], b1 = re[(size_t)(k + 1) * n2 + n + tip];
+    double det = a0 * b1 - a1 * b0, c[2][2] = {{b1, -b0}, {a1, -a0}};
+    double sl[2][2] = {{0, 0}, {0, 0}}, sli[2][2] = {{0, 0}, {0, 0}};
+    const double *e0 = s->energy + (size_t)k * SM_ENERGY_PARTS, *e1 = e0 + SM_ENERGY_PARTS;
+    double ax_to =
+        fmin(e0[SM_MODE_AXIAL] + e0[SM_MODE_TORSION], e1[SM_MODE_AXIAL] + e1[SM_MODE_TORSION]);
+    double *y = buf, *yi = buf + 2 * n2;
+    int r;
+
+    if (!(fabs(det) > 1e-12 * (fabs(a0 * b1) + fabs(a1 * b0))))
+        return 0;             /* both already along one direction: nothing to separate */
+    for (r = 0; r < 2; r++) { /* r = 0: b-tip zero (pure a); r = 1: a-tip zero (pure b) */
+        ed_combine(s->re, n2, k, k + 1, c[r][0], c[r][1], n2, y + r * n2);
+        if (s->im)
+            ed_combine(s->im, n2, k, k + 1, c[r][0], c[r][1], n2, yi + r * n2);
+        if (s->slope_re)
+            ed_combine(s->slope_re, 2, k, k + 1, c[r][0], c[r][1], 2, sl[r]);
+        if (s->slope_im)
+            ed_combine(s->slope_im, 2, k, k + 1, c[r][0], c[r][1], 2, sli[r]);
+    }
+    for (r = 0; r < 2; r++)
+        ed_degenerate_store(s, k + r, y + r * n2, yi + r * n2, sl[r], sli[r], ax_to);
+    return 1;
+}
+
+int sm_elastodyn_degenerate(sm_ed_shapes *s, const double *freq)
+{
+    double *buf;
+    int k, got = 0;
+
+    if (!s || !freq || !s->re || !s->energy || s->n_nodes < 1 || s->n_modes < 2)
+        return 0;
+    buf = calloc((size_t)8 * (size_t)s->n_nodes, sizeof *buf);
+    if (!buf)
+        return 0;
+    for (k = 0; k + 1 < s->n_modes; k++)
+        if (freq[k + 1] > 0 && fabs(freq[k + 1] - freq[k]) < SM_ED_DEGENERATE * freq[k + 1] &&
+            ed_degenerate_pair(s, k, buf)) {
+            got++;
+            k++;
+        }
+    free(buf);
+    return got;
+}
+
 /* The principal edge (p2) and flap (p3) directions at a node: the member's e2, e3 turned by
  * the twist t about e1 (p2 = cos t e2 + sin t e3, p3 = -sin t e2 + cos t e3). */
 static void ed_principal(const double ax[9], double t, double p2[3], double p3[3])

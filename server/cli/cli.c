@@ -463,22 +463,24 @@ static int cli_load_result(const char *path, json_t **doc)
     return CLI_OK;
 }
 
-/* The deck at deck_path with case ci's blade coefficients of doc (elastodyn_patch.c). */
+/* The deck at deck_path with case ci's blade (or tower) coefficients of doc
+ * (elastodyn_patch.c). */
 static int cli_patch_deck(const json_t *doc, long ci, const char *deck_path, char *why,
                           size_t whycap, char **out, size_t *n)
 {
-    sm_ed_fit fits[SM_ED_BLADE_FITS];
-    char v[CODEC_ED_BLADE_VALUES][CODEC_ED_TEXT];
-    const char *vp[CODEC_ED_BLADE_VALUES];
+    sm_ed_fit fits[CODEC_ED_TOWER_FITS];
+    char v[CODEC_ED_TOWER_VALUES][CODEC_ED_TEXT];
+    const char *vp[CODEC_ED_TOWER_VALUES];
+    const char *const *names = NULL;
     char *deck = NULL;
     size_t dlen = 0;
-    int st, e, i;
+    int st, e, i, nfit = 0;
 
-    st = codec_elastodyn_case(doc, (size_t)ci - 1, fits, why, whycap);
-    for (i = 0; st == SM_OK && i < SM_ED_BLADE_FITS; i++)
+    st = codec_elastodyn_fits(doc, (size_t)ci - 1, fits, &nfit, &names, why, whycap);
+    for (i = 0; st == SM_OK && i < nfit; i++)
         if (fits[i].mode < 0) {
             snprintf(why, whycap, "case %ld: no mode for %.8s: ask for more modes", ci,
-                     codec_ed_blade_names[5 * i]);
+                     names[5 * i]);
             st = SM_INVALID_INPUT;
         }
     if (st)
@@ -488,11 +490,10 @@ static int cli_patch_deck(const json_t *doc, long ci, const char *deck_path, cha
         snprintf(why, whycap, "%s: %s", deck_path, strerror(e));
         return SM_INVALID_INPUT;
     }
-    codec_elastodyn_blade_values(fits, v);
-    for (i = 0; i < CODEC_ED_BLADE_VALUES; i++)
+    codec_elastodyn_values(fits, nfit, v);
+    for (i = 0; i < 5 * nfit; i++)
         vp[i] = v[i];
-    st = codec_elastodyn_patch(out, n, deck, dlen, codec_ed_blade_names, vp, CODEC_ED_BLADE_VALUES,
-                               why, whycap);
+    st = codec_elastodyn_patch(out, n, deck, dlen, names, vp, 5 * nfit, why, whycap);
     free(deck);
     return st;
 }

@@ -22,6 +22,20 @@ extern "C" {
 /** Values in a blade deck: BldFl1Sh(2..6), BldFl2Sh(2..6), BldEdgSh(2..6). */
 #define CODEC_ED_BLADE_VALUES 15
 
+/** A tower's fits (FA 1, FA 2, SS 1, SS 2) and deck values TwFAM1Sh(2..6) ... TwSSM2Sh(2..6). */
+#define CODEC_ED_TOWER_FITS 4
+#define CODEC_ED_TOWER_VALUES 20
+
+/**
+ * The fits of case ci (0-based) of a result document (borrowed), blade or tower: a blade
+ * (member "blade", else the only member) gives 3 (flap 1, flap 2, edge 1), a tower form's
+ * member ("tower") 4 (FA 1, FA 2, SS 1, SS 2: the root's rigid motion taken out, a degenerate
+ * FA/SS pair turned to pure directions, DESIGN.md 9.3); *nfit their number, *names (may be
+ * NULL) codec_ed_blade_names or codec_ed_tower_names.  Returns as codec_elastodyn_case.
+ */
+int codec_elastodyn_fits(const json_t *result, size_t ci, sm_ed_fit fits[CODEC_ED_TOWER_FITS],
+                         int *nfit, const char *const **names, char *err, size_t errcap);
+
 /**
  * The blade fits (flap 1, flap 2, edge 1: SM_ED_FLAP1...) of case ci (0-based) of a result
  * document (borrowed): its member "blade" (the blade form), else its only member, the `from`
@@ -59,6 +73,12 @@ void codec_elastodyn_blade_values(const sm_ed_fit fits[SM_ED_BLADE_FITS],
 
 /** The deck's names of those values: "BldFl1Sh(2)" ... "BldEdgSh(6)". */
 extern const char *const codec_ed_blade_names[CODEC_ED_BLADE_VALUES];
+
+/** The deck values of nfit fits (5 each, codec_elastodyn_format), in the fits' order. */
+void codec_elastodyn_values(const sm_ed_fit *fits, int nfit, char values[][CODEC_ED_TEXT]);
+
+/** The tower deck's names: "TwFAM1Sh(2)" ... "TwSSM2Sh(6)". */
+extern const char *const codec_ed_tower_names[CODEC_ED_TOWER_VALUES];
 
 /**
  * A copy of the ElastoDyn deck text[len] with the value of each parameter names[i] (the

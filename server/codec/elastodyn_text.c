@@ -7,7 +7,11 @@
  * and each mode its shape and energy split (labels).  This file gathers the blade member's
  * node rows of every mode, lets the core project them on the principal axes
  * (sm_elastodyn_project) and select and fit (sm_elastodyn_fit_modes, want {2, 1}: the
- * numerics are the core's, DESIGN §B), then writes the ElastoDyn lines.  It reads nothing but
+ * numerics are the core's, DESIGN §B), then writes the ElastoDyn lines.  A tower form's
+ * member ("tower") gives TwFAM1Sh, TwFAM2Sh, TwSSM1Sh, TwSSM2Sh the same way (flap = fore-aft,
+ * edge = side-side, DESIGN.md 8.5; want {2, 2}), after the root's rigid motion is taken out
+ * and a degenerate fore-aft/side-side pair is turned to pure directions (the core's
+ * sm_elastodyn_degenerate).  It reads nothing but
  * the document, so the daemon (from the stored result) and the CLI give the same bytes, and
  * elastodyn_patch.c writes the same values into a deck.  Helpers are edt_*.
  */
@@ -25,19 +29,37 @@ const char *const codec_ed_blade_names[CODEC_ED_BLADE_VALUES] = {
     "BldEdgSh(2)", "BldEdgSh(3)", "BldEdgSh(4)", "BldEdgSh(5)", "BldEdgSh(6)",
 };
 
-/* The deck name, the NREL description and the direction word of each blade fit. */
-static const struct {
+const char *const codec_ed_tower_names[CODEC_ED_TOWER_VALUES] = {
+    "TwFAM1Sh(2)", "TwFAM1Sh(3)", "TwFAM1Sh(4)", "TwFAM1Sh(5)", "TwFAM1Sh(6)",
+    "TwFAM2Sh(2)", "TwFAM2Sh(3)", "TwFAM2Sh(4)", "TwFAM2Sh(5)", "TwFAM2Sh(6)",
+    "TwSSM1Sh(2)", "TwSSM1Sh(3)", "TwSSM1Sh(4)", "TwSSM1Sh(5)", "TwSSM1Sh(6)",
+    "TwSSM2Sh(2)", "TwSSM2Sh(3)", "TwSSM2Sh(4)", "TwSSM2Sh(5)", "TwSSM2Sh(6)",
+};
+
+/* The deck name, the NREL description and the direction word of each fit. */
+typedef struct edt_name {
     const char *name, *what, *dir;
-} edt_blade[SM_ED_BLADE_FITS] = {
+} edt_name;
+
+static const edt_name edt_blade[SM_ED_BLADE_FITS] = {
     {"BldFl1Sh", "Flap mode 1", "flap"},
     {"BldFl2Sh", "Flap mode 2", "flap"},
     {"BldEdgSh", "Edge mode 1", "edge"},
 };
 
+/* The tower's, in the tower file's order (fore-aft = the form's flap, DESIGN.md 8.5). */
+static const edt_name edt_tower[CODEC_ED_TOWER_FITS] = {
+    {"TwFAM1Sh", "Mode 1", "fore-aft"},
+    {"TwFAM2Sh", "Mode 2", "fore-aft"},
+    {"TwSSM1Sh", "Mode 1", "side-side"},
+    {"TwSSM2Sh", "Mode 2", "side-side"},
+};
+
 /* What codec_elastodyn_case reads out of a document (borrowed pointers, owned arrays). */
 typedef struct edt_input {
-    const json_t *layout; /* the blade member's layout */
+    const json_t *layout; /* the blade (or tower) member's layout */
     int n;                /* its nodes */
+    int tower;            /* 1: the tower form's member (fore-aft, side-side; want {2, 2}) */
     double ax[9], length;
     double *x, *twist; /* n each */
 } edt_input;
@@ -56,23 +78,23 @@ static int edt_err(char *err, size_t errcap, const char *msg)
     return SM_INVALID_INPUT;
 }
 
-/* The blade member's layout: id "blade", else the only member unless it is a tower's (a
- * tower form's member takes TwFAM1Sh..., not the blade's names). */
-static const json_t *edt_member(const json_t *result)
+/* The blade member's layout: id "blade", else the only member (*tower = 1 when its id is
+ * "tower": the tower form's member, which takes TwFAM1Sh..., not the blade's names). */
+static const json_t *edt_member(const json_t *result, int *tower)
 {
     const json_t *mems = json_object_get(json_object_get(result, "model"), "members"), *lay;
     const char *id;
     size_t i;
 
-    json_array_foreach(mems, i, lay)
-    {
+    json_array_foreach(mems, i, lay) {
         id = json_string_value(json_object_get(lay, "id"));
         if (id && !strcmp(id, "blade"))
             return lay;
     }
     lay = json_array_get(mems, 0);
     id = json_string_value(json_object_get(lay, "id"));
-    return json_array_size(mems) == 1 && !(id && !strcmp(id, "tower")) ? lay : NULL;
+    *tower = id && !strcmp(id, "tower");
+    return json_array_size(mems) == 1 ? lay : NULL;
 }
 
 /* The member's nodes, span fractions, twists (rad), axes and length into *in. */
@@ -86,24 +108,25 @@ static int edt_layout(const json_t *result, edt_input *in, char *err, size_t err
         return edt_err(err, errcap,
                        "ElastoDyn coefficients need a spatial result with mode "
                        "shapes (\"mode_shapes\": true)");
-    lay = edt_member(result);
+    lay = edt_member(result, &in->tower);
     if (!lay)
         return edt_err(err, errcap,
-                       "ElastoDyn coefficients need a blade: the blade form or a "
-                       "structure of one member, with mode shapes");
+                       "ElastoDyn coefficients need a blade or a tower: the blade or tower "
+                       "form or a structure of one member, with mode shapes");
     in->layout = lay;
     in->n = (int)json_array_size(json_object_get(lay, "nodes"));
     if (in->n < 4 || (int)json_array_size(json_object_get(lay, "s")) != in->n)
-        return edt_err(err, errcap, "the blade has fewer than 4 nodes: no polynomial fit");
+        return edt_err(err, errcap, "the member has fewer than 4 nodes: no polynomial fit");
     in->x = malloc((size_t)in->n * sizeof *in->x);
     in->twist = malloc((size_t)in->n * sizeof *in->twist);
     if (!in->x || !in->twist)
         return SM_NOMEM;
     for (j = 0; j < in->n; j++) {
         in->x[j] = json_number_value(json_array_get(json_object_get(lay, "s"), (size_t)j));
-        in->twist[j] =
-            CODEC_RAD_PER_DEG *
-            json_number_value(json_array_get(json_object_get(lay, "twist_deg"), (size_t)j));
+        in->twist[j] = /* a tower's shapes are fore-aft and side-side, whatever its twist */
+            in->tower ? 0.0
+                      : CODEC_RAD_PER_DEG * json_number_value(json_array_get(
+                                                json_object_get(lay, "twist_deg"), (size_t)j));
     }
     in->x[in->n - 1] = 1.0;
     for (j = 0; j < 9; j++)
@@ -130,6 +153,25 @@ static int edt_energy(const json_t *mode, double *e)
     return 1;
 }
 
+/* A tower's shape less the root's rigid motion (DESIGN §B: y - y0 - y0' x, per direction;
+ * y0' = -L e2.r for fore-aft, L e3.r for side-side, the projection's slopes at the root, the
+ * tower untwisted).  Zero on a clamped base; it matters on elastic supports. */
+static void edt_root_rigid(const edt_input *in, const double *rows, double *out, double slope[2])
+{
+    const double *r = rows + 3;
+    double s0[2], y0;
+    int d, j;
+
+    s0[0] = -in->length * (in->ax[3] * r[0] + in->ax[4] * r[1] + in->ax[5] * r[2]);
+    s0[1] = in->length * (in->ax[6] * r[0] + in->ax[7] * r[1] + in->ax[8] * r[2]);
+    for (d = 0; d < 2; d++) {
+        y0 = out[d * in->n];
+        for (j = 0; j < in->n; j++)
+            out[d * in->n + j] -= y0 + s0[d] * in->x[j];
+        slope[d] -= s0[d];
+    }
+}
+
 /* One shape part ([[dx..rz] per model node]) on the member's nodes, projected (core). */
 static void edt_project(const edt_input *in, const json_t *part, double *rows, double *out,
                         double slope[2])
@@ -144,16 +186,19 @@ static void edt_project(const edt_input *in, const json_t *part, double *rows, d
             rows[6 * j + c] = json_number_value(json_array_get(row, (size_t)c));
     }
     sm_elastodyn_project(in->n, in->ax, in->twist, in->length, rows, out, slope);
+    if (in->tower)
+        edt_root_rigid(in, rows, out, slope);
 }
 
 /* Buffers of one case's sm_ed_shapes (owned). */
 typedef struct edt_bufs {
-    double *rows, *re, *im, *sr, *si, *energy;
+    double *rows, *re, *im, *sr, *si, *energy, *freq;
 } edt_bufs;
 
 static void edt_bufs_free(edt_bufs *b)
 {
     free(b->rows), free(b->re), free(b->im), free(b->sr), free(b->si), free(b->energy);
+    free(b->freq);
 }
 
 /* Fill the shapes of case cs's modes into b and s; SM_INVALID_INPUT when a mode lacks its
@@ -170,15 +215,16 @@ static int edt_shapes(const edt_input *in, const json_t *modes, edt_bufs *b, sm_
     b->sr = malloc(nm * 2 * sizeof(double));
     b->si = calloc(nm * 2, sizeof(double));
     b->energy = malloc(nm * SM_ENERGY_PARTS * sizeof(double));
-    if (!b->rows || !b->re || !b->im || !b->sr || !b->si || !b->energy)
+    b->freq = malloc((nm ? nm : 1) * sizeof(double));
+    if (!b->rows || !b->re || !b->im || !b->sr || !b->si || !b->energy || !b->freq)
         return SM_NOMEM;
     *has_im = 0;
-    json_array_foreach(modes, k, mode)
-    {
+    json_array_foreach(modes, k, mode) {
         shape = json_object_get(mode, "shape");
         if (!json_is_array(json_object_get(shape, "re")) ||
             !edt_energy(mode, b->energy + k * SM_ENERGY_PARTS))
             return SM_INVALID_INPUT;
+        b->freq[k] = json_number_value(json_object_get(mode, "frequency_hz"));
         edt_project(in, json_object_get(shape, "re"), b->rows, b->re + 2 * k * n, b->sr + 2 * k);
         if (json_is_array(json_object_get(shape, "im"))) {
             edt_project(in, json_object_get(shape, "im"), b->rows, b->im + 2 * k * n,
@@ -195,6 +241,8 @@ static int edt_shapes(const edt_input *in, const json_t *modes, edt_bufs *b, sm_
                         *has_im ? b->si : NULL,
                         b->energy,
                         {SM_MODE_FLAP, SM_MODE_EDGE}};
+    if (in->tower) /* a symmetric tower's fore-aft/side-side pair (core, DESIGN §B) */
+        sm_elastodyn_degenerate(s, b->freq);
     return SM_OK;
 }
 
@@ -202,9 +250,9 @@ static int edt_shapes(const edt_input *in, const json_t *modes, edt_bufs *b, sm_
 static int edt_case_fits(const edt_input *in, const json_t *cs, sm_ed_fit *fits, char *err,
                          size_t errcap)
 {
-    static const int want[2] = {2, 1};
+    static const int want[2][2] = {{2, 1}, {2, 2}};
     const json_t *modes = json_object_get(cs, "modes");
-    edt_bufs b = {NULL, NULL, NULL, NULL, NULL, NULL};
+    edt_bufs b = {NULL, NULL, NULL, NULL, NULL, NULL, NULL};
     sm_ed_shapes s;
     int rc, has_im;
 
@@ -216,7 +264,7 @@ static int edt_case_fits(const edt_input *in, const json_t *cs, sm_ed_fit *fits,
                 "a mode has no shape or energy split (\"mode_shapes\": true; a "
                 "spatial result)");
     else if (rc == SM_OK) {
-        rc = sm_elastodyn_fit_modes(&s, want, fits);
+        rc = sm_elastodyn_fit_modes(&s, want[in->tower], fits);
         if (rc == SM_INVALID_INPUT)
             edt_err(err, errcap, "a fitted mode has a zero tip displacement");
     }
@@ -224,8 +272,8 @@ static int edt_case_fits(const edt_input *in, const json_t *cs, sm_ed_fit *fits,
     return rc;
 }
 
-int codec_elastodyn_case(const json_t *result, size_t ci, sm_ed_fit fits[SM_ED_BLADE_FITS],
-                         char *err, size_t errcap)
+int codec_elastodyn_fits(const json_t *result, size_t ci, sm_ed_fit fits[CODEC_ED_TOWER_FITS],
+                         int *nfit, const char *const **names, char *err, size_t errcap)
 {
     const json_t *cs = json_array_get(json_object_get(result, "cases"), ci);
     edt_input in;
@@ -233,12 +281,34 @@ int codec_elastodyn_case(const json_t *result, size_t ci, sm_ed_fit fits[SM_ED_B
 
     if (err && errcap)
         err[0] = '\0';
+    *nfit = 0;
     if (!cs)
         return edt_err(err, errcap, "no such case in the result");
     rc = edt_layout(result, &in, err, errcap);
     if (rc == SM_OK)
         rc = edt_case_fits(&in, cs, fits, err, errcap);
+    if (rc == SM_OK) {
+        *nfit = in.tower ? CODEC_ED_TOWER_FITS : SM_ED_BLADE_FITS;
+        if (names)
+            *names = in.tower ? codec_ed_tower_names : codec_ed_blade_names;
+    }
     edt_input_clear(&in);
+    return rc;
+}
+
+int codec_elastodyn_case(const json_t *result, size_t ci, sm_ed_fit fits[SM_ED_BLADE_FITS],
+                         char *err, size_t errcap)
+{
+    sm_ed_fit all[CODEC_ED_TOWER_FITS];
+    int rc, n;
+
+    rc = codec_elastodyn_fits(result, ci, all, &n, NULL, err, errcap);
+    if (rc == SM_OK && n != SM_ED_BLADE_FITS)
+        return edt_err(err, errcap,
+                       "the result is a tower's: its coefficients are "
+                       "TwFAM1Sh... (codec_elastodyn_fits)");
+    if (rc == SM_OK)
+        memcpy(fits, all, SM_ED_BLADE_FITS * sizeof fits[0]);
     return rc;
 }
 
@@ -273,9 +343,14 @@ void codec_elastodyn_format(const double coef[5], char text[5][CODEC_ED_TEXT])
 void codec_elastodyn_blade_values(const sm_ed_fit fits[SM_ED_BLADE_FITS],
                                   char values[CODEC_ED_BLADE_VALUES][CODEC_ED_TEXT])
 {
+    codec_elastodyn_values(fits, SM_ED_BLADE_FITS, values);
+}
+
+void codec_elastodyn_values(const sm_ed_fit *fits, int nfit, char values[][CODEC_ED_TEXT])
+{
     int f;
 
-    for (f = 0; f < SM_ED_BLADE_FITS; f++)
+    for (f = 0; f < nfit; f++)
         codec_elastodyn_format(fits[f].coef, values + 5 * f);
 }
 
@@ -289,7 +364,8 @@ static void edt_num(FILE *f, const char *fmt, double v)
 }
 
 /* The report line(s) and the five coefficient lines of fit i of a case's modes. */
-static void edt_write_fit(FILE *f, const json_t *modes, int i, const sm_ed_fit *fit)
+static void edt_write_fit(FILE *f, const json_t *modes, const edt_name *nm, int tower,
+                          const sm_ed_fit *fit)
 {
     const json_t *md = json_array_get(modes, (size_t)(fit->mode < 0 ? 0 : fit->mode));
     char text[5][CODEC_ED_TEXT];
@@ -299,16 +375,15 @@ static void edt_write_fit(FILE *f, const json_t *modes, int i, const sm_ed_fit *
         fprintf(f,
                 "! %s: no %s-dominated mode among the %zu computed: ask for more modes "
                 "(\"modes\")\n",
-                edt_blade[i].name, edt_blade[i].dir, json_array_size(modes));
+                nm->name, nm->dir, json_array_size(modes));
         return;
     }
-    fprintf(f, "! %s: mode %d (%.6g Hz, %s): %s share of the bending strain energy ",
-            edt_blade[i].name, fit->mode + 1,
-            json_number_value(json_object_get(md, "frequency_hz")),
+    fprintf(f, "! %s: mode %d (%.6g Hz, %s): %s share of the bending strain energy ", nm->name,
+            fit->mode + 1, json_number_value(json_object_get(md, "frequency_hz")),
             json_string_value(json_object_get(md, "label"))
                 ? json_string_value(json_object_get(md, "label"))
                 : "unlabelled",
-            edt_blade[i].dir);
+            nm->dir);
     edt_num(f, "%.2f %%", 100 * fit->share);
     fprintf(f, "; rms residual %.3e, largest %.3e (of tip); tip slope FE ", fit->rms,
             fit->max_residual);
@@ -317,16 +392,20 @@ static void edt_write_fit(FILE *f, const json_t *modes, int i, const sm_ed_fit *
     edt_num(f, "%.3g %%", 100 * fit->tip_slope_error);
     fputc('\n', f);
     if (fit->warning) {
-        fprintf(f, "! warning: %s: mode %d is not clean: %s carries ", edt_blade[i].name,
-                fit->mode + 1, edt_blade[i].dir);
+        fprintf(f, "! warning: %s: mode %d is not clean: %s carries ", nm->name, fit->mode + 1,
+                nm->dir);
         edt_num(f, "%.2f %%", 100 * fit->share);
         fprintf(f, " of its bending strain energy (below %.0f %%); fitted anyway\n",
                 100 * SM_ED_CLEAN);
     }
     codec_elastodyn_format(fit->coef, text);
     for (k = 0; k < 5; k++)
-        fprintf(f, "%14s   %s(%d) - %-11s, coeff of x^%d\n", text[k], edt_blade[i].name, k + 2,
-                k ? "" : edt_blade[i].what, k + 2);
+        if (tower) /* the tower file's layout */
+            fprintf(f, "%14s   %s(%d) - %-6s, coefficient of x^%d term\n", text[k], nm->name, k + 2,
+                    k ? "" : nm->what, k + 2);
+        else
+            fprintf(f, "%14s   %s(%d) - %-11s, coeff of x^%d\n", text[k], nm->name, k + 2,
+                    k ? "" : nm->what, k + 2);
 }
 
 /* The header lines of the document. */
@@ -335,6 +414,22 @@ static void edt_header(FILE *f, const json_t *result, const edt_input *in)
     const json_t *solver = json_object_get(result, "solver");
     const char *id = json_string_value(json_object_get(in->layout, "id"));
 
+    if (in->tower) {
+        fprintf(f,
+                "! spinmodal %s ElastoDyn tower mode-shape coefficients (DESIGN.md 9.3)\n"
+                "! request %s\n"
+                "! member %s (%.6g m): x = s from the top of the rigid base, fore-aft (flap) "
+                "and side-side (edge) displacements less the root's rigid motion, divided by "
+                "the top value; least squares on x^k - x^6 (k = 2..5), C6 = 1 - (C2 + ... + "
+                "C5)\n"
+                "! FA 1, FA 2 (SS 1, SS 2): the two lowest modes with more fore-aft than "
+                "side-side (the reverse) kinetic energy, torsion and axial excluded by energy; "
+                "a pair within %g relative in frequency turned to pure directions first\n",
+                json_string_value(json_object_get(solver, "version")),
+                json_string_value(json_object_get(solver, "request_sha256")), id ? id : "0",
+                in->length, SM_ED_DEGENERATE);
+        return;
+    }
     fprintf(f,
             "! spinmodal %s ElastoDyn blade mode-shape coefficients (DESIGN.md 9.3)\n"
             "! request %s\n"
@@ -362,7 +457,7 @@ static double edt_rpm(const json_t *cs)
 int codec_result_elastodyn(char **out, size_t *len, const json_t *result, char *err, size_t errcap)
 {
     const json_t *cases = json_object_get(result, "cases"), *cs;
-    sm_ed_fit fits[SM_ED_BLADE_FITS];
+    sm_ed_fit fits[CODEC_ED_TOWER_FITS];
     char *buf = NULL;
     size_t n = 0, ci;
     edt_input in;
@@ -380,8 +475,7 @@ int codec_result_elastodyn(char **out, size_t *len, const json_t *result, char *
     if (rc)
         goto done;
     edt_header(f, result, &in);
-    json_array_foreach(cases, ci, cs)
-    {
+    json_array_foreach(cases, ci, cs) {
         fprintf(f, "!\n! case %zu of %zu: %.6g rpm (%.6g rad/s), %s\n", ci + 1,
                 json_array_size(cases), edt_rpm(cs),
                 json_number_value(json_object_get(cs, "omega")),
@@ -393,8 +487,9 @@ int codec_result_elastodyn(char **out, size_t *len, const json_t *result, char *
         rc = edt_case_fits(&in, cs, fits, err, errcap);
         if (rc)
             break;
-        for (i = 0; i < SM_ED_BLADE_FITS; i++)
-            edt_write_fit(f, json_object_get(cs, "modes"), i, &fits[i]);
+        for (i = 0; i < (in.tower ? CODEC_ED_TOWER_FITS : SM_ED_BLADE_FITS); i++)
+            edt_write_fit(f, json_object_get(cs, "modes"), in.tower ? &edt_tower[i] : &edt_blade[i],
+                          in.tower, &fits[i]);
     }
     if (rc) {
         fclose(f);

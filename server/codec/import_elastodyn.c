@@ -467,7 +467,7 @@ static void ed_blade_moments(const imp_table *t, double hub, double len, double 
  * NREL 5-MW), the hub HubCM downwind of it with HubIner about the shaft, the blades coned by
  * PreCone about the shaft (an axisymmetric rotor: half the polar inertia about each axis
  * normal to the shaft). */
-static void ed_top_mass(const ed_main *m, const double bmom[3], ed_top *top)
+static void ed_top_mass(const ed_main *m, const double bmom[3], int rigid_rotor, ed_top *top)
 {
     const double *v = m->v;
     double T = v[EM_SHFTTILT] * ED_PI / 180, be = v[EM_PRECONE] * ED_PI / 180;
@@ -497,7 +497,7 @@ static void ed_top_mass(const ed_main *m, const double bmom[3], ed_top *top)
         for (b = 0; b < 3; b++)
             j[3 * a + b] = jr * c1[a] * c1[b] + 0.5 * jr * ((a == b) - c1[a] * c1[b]);
     }
-    ed_top_add(top, nb * mb, p, j);
+    ed_top_add(top, nb * mb, p, rigid_rotor ? j : NULL);
 }
 
 /* The top mass as the tower form takes it: offset = c.m., inertia and products about it. */
@@ -546,8 +546,7 @@ static int ed_tower_doc(json_t *doc, const ed_main *m, json_t *top)
         return -1;
     }
     for (k = 0; k < 2; k++)
-        json_array_foreach(json_object_get(doc, lists[k]), i, w)
-        {
+        json_array_foreach(json_object_get(doc, lists[k]), i, w) {
             const char *p = json_string_value(json_object_get(w, "pointer"));
             char buf[256];
             if (p && !strncmp(p, "/blade", 6)) {
@@ -604,8 +603,7 @@ static int ed_tower_standins(json_t *doc, const imp_table *t, double length)
                         gj);
     }
     if (!(t->mask & (1u << IK_I_FLAP)) && !(t->mask & (1u << IK_I_EDGE))) {
-        json_array_foreach(json_object_get(tw, "stations"), i, st)
-        {
+        json_array_foreach(json_object_get(tw, "stations"), i, st) {
             double mu = json_number_value(json_object_get(st, "mass_per_length"));
             bad |= json_object_set_new(st, "flap_inertia", json_real(imp_round(mu * rg * rg)));
             bad |= json_object_set_new(st, "edge_inertia", json_real(imp_round(mu * rg * rg)));
@@ -663,7 +661,7 @@ static int ed_main_import(json_t **out, const import_file *f, import_loader load
                          m.v[EM_TIPRAD] - m.v[EM_HUBRAD])))
         goto done;
     ed_blade_moments(&tb, m.v[EM_HUBRAD], m.v[EM_TIPRAD] - m.v[EM_HUBRAD], bmom);
-    ed_top_mass(&m, bmom, &tm);
+    ed_top_mass(&m, bmom, 0, &tm);
     if (imp_warn(warn, "/tower/top_mass",
                  "top_mass = ElastoDyn's tower-top mass %.6g kg (YawBrMass + NacMass + HubMass + "
                  "%g blades of %.6g kg from %s) as one rigid body (DESIGN.md 8.5)",
