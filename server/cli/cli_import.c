@@ -290,6 +290,12 @@ static int cli_import_args_parse(int argc, char **argv, cli_import_args *a)
             fputs(cli_import_help_text, stdout);
             return -1; /* done: exit 0 */
         }
+        if (!opts_done && !strcmp(s, "--part")) { /* ElastoDyn main file: tower or blade */
+            if (i + 1 >= argc || (strcmp(argv[i + 1], "blade") && strcmp(argv[i + 1], "tower")))
+                return cli_import_usage("--part needs blade or tower (an ElastoDyn main file)");
+            a->opt.ed_blade = !strcmp(argv[++i], "blade");
+            continue;
+        }
         if (!opts_done && !strcmp(s, "--bmodes-mesh")) {
             double per;
             if (i + 1 >= argc || cli_import_number(argv[i + 1], &per) || per < 1 ||

@@ -42,6 +42,7 @@ void import_default_options(import_options *o)
     o->rpm_speeds = NULL;
     o->max_modes = lim.max_modes;
     o->bmodes_mesh = 0;
+    o->ed_blade = 0;
 }
 
 /*

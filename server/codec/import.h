@@ -71,6 +71,8 @@ typedef struct import_options {
                                  checked by the caller (finite, >= 0); rpm is then its first
                                  speed */
     int max_modes;     /* cap of analysis.modes (the codec's limit) */
+    int ed_blade;      /* ElastoDyn main file only: 1 = its blade (BldFile(1) with TipRad,
+                          HubRad, PreCone(1), RotSpeed), 0 = its tower (CLI --part blade) */
     int bmodes_mesh;   /* BModes only: > 0 = BModes' own model (its nselt elements as uniform
                           members with its midpoint properties, BModes.f90:1110), this many FE
                           elements each, in the structure form; 0 = the blade form */

@@ -335,15 +335,18 @@ enum {
     EM_NACMASS,
     EM_NACYINER,
     EM_YAWBRMASS,
+    EM_ROTSPEED,
     EM_N
 };
 static const char *const em_names[EM_N] = {
-    "TowerHt",    "TowerBsHt", "TwrRBHt",  "NumBl",   "TipRad",   "HubRad",   "PreCone(1)",
-    "HubCM",      "OverHang",  "ShftTilt", "NacCMxn", "NacCMyn",  "NacCMzn",  "Twr2Shft",
-    "TipMass(1)", "HubMass",   "HubIner",  "NacMass", "NacYIner", "YawBrMass"};
-/* optional ones (0 when absent): TowerBsHt and TwrRBHt (one or the other), HubCM, TipMass */
-#define EM_OPTIONAL \
-    ((1u << EM_TOWERBSHT) | (1u << EM_TWRRBHT) | (1u << EM_HUBCM) | (1u << EM_TIPMASS))
+    "TowerHt",    "TowerBsHt", "TwrRBHt",  "NumBl",   "TipRad",   "HubRad",    "PreCone(1)",
+    "HubCM",      "OverHang",  "ShftTilt", "NacCMxn", "NacCMyn",  "NacCMzn",   "Twr2Shft",
+    "TipMass(1)", "HubMass",   "HubIner",  "NacMass", "NacYIner", "YawBrMass", "RotSpeed"};
+/* optional ones (0 when absent): TowerBsHt and TwrRBHt (one or the other), HubCM, TipMass,
+ * RotSpeed */
+#define EM_OPTIONAL                                                                      \
+    ((1u << EM_TOWERBSHT) | (1u << EM_TWRRBHT) | (1u << EM_HUBCM) | (1u << EM_TIPMASS) | \
+     (1u << EM_ROTSPEED))
 
 typedef struct ed_main {
     double v[EM_N];
@@ -558,62 +561,131 @@ static int ed_tower_doc(json_t *doc, const ed_main *m, json_t *top)
     return 0;
 }
 
-/* Stand-ins for what ElastoDyn's tower lacks (DESIGN.md 8.5): EA = 1e7 EI/L^2, GJ = 1e5 EI
- * (ElastoDyn's tower is rigid in extension and torsion; the top mass's c.m. offset and
- * product of inertia couple them to bending, so the blade's 1e4 and 10 would move the bending
- * frequencies by 3e-3; these move them by <= 2e-7 when changed 10x either way, with
- * cond(K) ~ 1e9), and rotary inertias mu (1e-5 L)^2 (ElastoDyn's tower has none; without
- * them the default mu EI/EA would tie the frequencies to the EA stand-in).  Only what the file
- * does not give; each with a warning replacing the blade's. */
+/* Stand-ins for what ElastoDyn's blades and tower lack (DESIGN.md 8.5, 9.3): EA = 1e7 EI/L^2,
+ * GJ = 1e5 EI (ElastoDyn's are rigid in extension and torsion; a tower's top mass, with its
+ * c.m. offset and product of inertia, couples them to bending, so the 1e4 and 10 of the CSV
+ * import moved the NREL tower's bending frequencies by 3e-3 under 10x changes and the blade's
+ * by 1e-3; these move them by <= 2e-7 when changed 10x), and rotary inertias mu (1e-5 L)^2
+ * (ElastoDyn has none; the default mu EI/EA would tie the frequencies to the EA stand-in).
+ * Only what the file does not give; each with a warning replacing imp_assumed_section's. */
 #define ED_TW_EA 1e7
 #define ED_TW_GJ 1e5
 #define ED_TW_RG 1e-5
 
-static int ed_tower_standins(json_t *doc, const imp_table *t, double length)
+static int ed_standins(json_t *doc, const imp_table *t, double length, const char *form)
 {
-    json_t *tw = json_object_get(json_object_get(doc, "request"), "tower");
+    json_t *tw = json_object_get(json_object_get(doc, "request"), form);
     json_t *sec = json_object_get(tw, "section"), *ws = json_object_get(doc, "input_warnings"), *st;
     double ei = imp_table_max(t, IK_EI_FLAP), ea, gj, rg = ED_TW_RG * length;
+    char ptr[3][40];
     size_t i;
-    int bad = 0;
+    int bad = 0, inert;
 
+    snprintf(ptr[0], sizeof(ptr[0]), "/%s/section/EA", form);
+    snprintf(ptr[1], sizeof(ptr[1]), "/%s/section/GJ", form);
+    snprintf(ptr[2], sizeof(ptr[2]), "/%s/stations", form);
     if (imp_table_max(t, IK_EI_EDGE) > ei)
         ei = imp_table_max(t, IK_EI_EDGE);
     ea = imp_round(ED_TW_EA * ei / (length * length));
     gj = imp_round(ED_TW_GJ * ei);
-    for (i = json_array_size(ws); i-- > 0;) { /* the blade's stand-in warnings go */
+    for (i = json_array_size(ws); i-- > 0;) { /* imp_assumed_section's warnings go */
         const char *p = json_string_value(json_object_get(json_array_get(ws, i), "pointer"));
-        if (p && (!strcmp(p, "/tower/section/EA") || !strcmp(p, "/tower/section/GJ")))
+        if (p && (!strcmp(p, ptr[0]) || !strcmp(p, ptr[1])))
             bad |= json_array_remove(ws, i);
     }
-    if (json_object_get(sec, "EA")) {
-        bad |= json_object_set_new(sec, "EA", json_real(ea));
-        bad |= imp_warn(ws, "/tower/section/EA",
-                        "EA is not in the ElastoDyn tower file (rigid "
-                        "in extension): tower.section.EA = %.6g N assumed (1e7 x the largest EI / "
-                        "height^2)",
-                        ea);
-    }
-    if (json_object_get(sec, "GJ")) {
-        bad |= json_object_set_new(sec, "GJ", json_real(gj));
-        bad |= imp_warn(ws, "/tower/section/GJ",
-                        "GJ is not in the ElastoDyn tower file (rigid "
-                        "in torsion): tower.section.GJ = %.6g N m^2 assumed (1e5 x the largest "
-                        "EI)",
-                        gj);
-    }
-    if (!(t->mask & (1u << IK_I_FLAP)) && !(t->mask & (1u << IK_I_EDGE))) {
+    inert = !(t->mask & (1u << IK_I_FLAP)) && !(t->mask & (1u << IK_I_EDGE));
+    if (inert)
         json_array_foreach(json_object_get(tw, "stations"), i, st) {
             double mu = json_number_value(json_object_get(st, "mass_per_length"));
             bad |= json_object_set_new(st, "flap_inertia", json_real(imp_round(mu * rg * rg)));
             bad |= json_object_set_new(st, "edge_inertia", json_real(imp_round(mu * rg * rg)));
         }
-        bad |= imp_warn(ws, "/tower/stations",
-                        "ElastoDyn's tower has no rotary inertia: "
-                        "flap_inertia = edge_inertia = mass_per_length x (1e-5 x height)^2 "
-                        "(negligible, and independent of the EA stand-in)");
+    if (json_object_get(sec, "EA")) {
+        bad |= json_object_set_new(sec, "EA", json_real(ea));
+        bad |= imp_warn(ws, ptr[0],
+                        "EA is not in the ElastoDyn %s file (rigid in extension): "
+                        "%s.section.EA = %.6g N assumed (1e7 x the largest EI / length^2)%s",
+                        form, form, ea,
+                        inert ? "; and as ElastoDyn has no rotary inertia, flap_inertia = "
+                                "edge_inertia = mass_per_length x (1e-5 x length)^2 at each "
+                                "station (negligible, and independent of EA)"
+                              : "");
+    } else if (inert) {
+        bad |= imp_warn(ws, ptr[2],
+                        "ElastoDyn's %s has no rotary inertia: flap_inertia = edge_inertia = "
+                        "mass_per_length x (1e-5 x length)^2 (negligible)",
+                        form);
+    }
+    if (json_object_get(sec, "GJ")) {
+        bad |= json_object_set_new(sec, "GJ", json_real(gj));
+        bad |= imp_warn(ws, ptr[1],
+                        "GJ is not in the ElastoDyn %s file (rigid in torsion): "
+                        "%s.section.GJ = %.6g N m^2 assumed (1e5 x the largest EI)",
+                        form, form, gj);
     }
     return bad || imp_legacy_warnings(doc) ? -1 : 0;
+}
+
+/* ed_standins on a blade document made with status st; the status (SM_NOMEM on failure,
+ * the document freed). */
+static int ed_blade_standins(json_t **out, const imp_table *t, double length, int st)
+{
+    if (st == SM_OK && ed_standins(*out, t, length, "blade")) {
+        json_decref(*out);
+        *out = NULL;
+        st = SM_NOMEM;
+    }
+    return st;
+}
+
+/* The main file's blade (CLI --part blade): BldFile(1) with TipRad, HubRad, PreCone(1),
+ * TipMass(1) and RotSpeed (rpm; the option --rpm overrides it), so that no radius option is
+ * needed. */
+static int ed_main_blade(json_t **out, const import_file *f, const ed_main *m, import_loader load,
+                         void *ctx, const import_options *o, import_diag *d)
+{
+    json_t *warn = json_array(), *src;
+    imp_table t = {NULL, 0, 0, 0};
+    import_file bf = {NULL, NULL, 0};
+    imp_blade bl;
+    ed_params p;
+    int st;
+
+    imp_blade_init(&bl);
+    if (!warn)
+        return SM_NOMEM;
+    if ((st = ed_load(load, ctx, f->name, m->bld, m->bld_line, "BldFile(1)", &bf, d)) ||
+        (st = ed_file(&bf, &ed_blade, d, &p, &t, warn)) ||
+        (st = imp_length(d, f->name, m->line[EM_TIPRAD], "TipRad", m->v[EM_HUBRAD],
+                         m->v[EM_TIPRAD] - m->v[EM_HUBRAD])))
+        goto done;
+    bl.hub_radius = m->v[EM_HUBRAD];
+    bl.length = m->v[EM_TIPRAD] - m->v[EM_HUBRAD];
+    bl.length_line = m->line[EM_TIPRAD];
+    bl.length_field = "TipRad";
+    bl.precone_deg = m->v[EM_PRECONE];
+    bl.has_tip = m->v[EM_TIPMASS] > 0;
+    bl.tip_mass = m->v[EM_TIPMASS];
+    bl.rpm = isnan(o->rpm) ? m->v[EM_ROTSPEED] : o->rpm;
+    bl.rpm_speeds = isnan(o->rpm) ? NULL : o->rpm_speeds;
+    if (isnan(o->rpm) && !m->line[EM_ROTSPEED] &&
+        imp_warn(warn, "/analysis/rpm", "no RotSpeed in the main file: analysis.rpm = [0]")) {
+        st = SM_NOMEM;
+        goto done;
+    }
+    if (!(src = ed_source(&p, bf.name)) ||
+        json_object_set_new(src, "main_file", imp_string(f->name))) {
+        json_decref(src);
+        st = SM_NOMEM;
+        goto done;
+    }
+    st = imp_document_assumed(out, d, bf.name, &bl, &t, "ElastoDyn blade", ed_ei_names, warn, src);
+    warn = NULL;
+    st = ed_blade_standins(out, &t, bl.length, st);
+done:
+    json_decref(warn);
+    imp_table_clear(&t);
+    return st;
 }
 
 /* The main file: the tower form (the file's head comment). */
@@ -633,14 +705,21 @@ static int ed_main_import(json_t **out, const import_file *f, import_loader load
     imp_blade_init(&bl);
     if (!warn)
         return SM_NOMEM;
-    if (!isnan(o->rpm) || !isnan(o->tip_radius) || !isnan(o->hub_radius)) {
-        st = imp_fail(d, f->name, 0, !isnan(o->rpm) ? "rpm" : "tip_radius",
-                      "the main ElastoDyn file gives a tower (it does not spin) and the "
-                      "blade's radii: the rpm, tip and hub radius options do not apply");
+    if ((!isnan(o->rpm) && !o->ed_blade) || !isnan(o->tip_radius) || !isnan(o->hub_radius)) {
+        st = imp_fail(d, f->name, 0,
+                      isnan(o->tip_radius) && isnan(o->hub_radius) ? "rpm" : "tip_radius",
+                      "the main ElastoDyn file gives the blade's radii (TipRad, HubRad), and "
+                      "its tower does not spin: the tip and hub radius options do not apply, "
+                      "nor the rpm without --part blade");
         goto done;
     }
-    if ((st = ed_main_read(f, d, &m)) ||
-        (st = ed_load(load, ctx, f->name, m.twr, m.twr_line, "TwrFile", &tf, d)) ||
+    if ((st = ed_main_read(f, d, &m)))
+        goto done;
+    if (o->ed_blade) {
+        json_decref(warn);
+        return ed_main_blade(out, f, &m, load, ctx, o, d);
+    }
+    if ((st = ed_load(load, ctx, f->name, m.twr, m.twr_line, "TwrFile", &tf, d)) ||
         (st = ed_file(&tf, &ed_tower, d, &p, &t, warn)))
         goto done;
     if (!(src = ed_source(&p, tf.name)) ||
@@ -673,7 +752,7 @@ static int ed_main_import(json_t **out, const import_file *f, import_loader load
                               src);
     warn = src = NULL;
     if (!st && ((top = ed_top_json(&tm)) == NULL || ed_tower_doc(*out, &m, top) ||
-                ed_tower_standins(*out, &t, bl.length))) {
+                ed_standins(*out, &t, bl.length, "tower"))) {
         json_decref(*out);
         *out = NULL;
         st = SM_NOMEM;
@@ -709,6 +788,9 @@ int import_elastodyn_files(json_t **out, const import_file *f, import_loader loa
         return imp_fail(d, f->name, 1, "header",
                         "an ElastoDyn tower file has no height: import the main ElastoDyn file "
                         "that names it (TwrFile)");
+    if (o->ed_blade)
+        return imp_fail(d, f->name, 0, "part",
+                        "--part applies to a main ElastoDyn file (this one is a blade file)");
     if (!(warn = json_array()))
         return SM_NOMEM;
     if ((st = ed_file(&body, &ed_blade, d, &p, &t, warn)) ||
@@ -717,6 +799,7 @@ int import_elastodyn_files(json_t **out, const import_file *f, import_loader loa
     st = imp_document_assumed(out, d, f->name, &bl, &t, "ElastoDyn blade", ed_ei_names, warn,
                               ed_source(&p, f->name));
     warn = NULL;
+    st = ed_blade_standins(out, &t, bl.length, st);
 done:
     json_decref(warn);
     imp_table_clear(&t);

@@ -88,6 +88,49 @@ def compare_deck(orig, patched):
     return fails
 
 
+def blade_from_main():
+    """--part blade: the blade of the main file (TipRad, HubRad, PreCone, RotSpeed) is the blade
+    file's import with --tip-radius 63 --hub-radius 1.5 --rpm 12.1 and precone -2.5; its
+    bending frequencies move <= 1e-6 when the EA/GJ stand-ins change 10x either way."""
+    fails = []
+    p = run("import", "elastodyn", MAIN, "--part", "blade")
+    assert p.returncode == 0, p.stderr
+    main_req = json.loads(p.stdout)
+    p = run("import", "elastodyn", os.path.join(REF, "NRELOffshrBsline5MW_Blade.dat"),
+            "--tip-radius", "63", "--hub-radius", "1.5", "--rpm", "12.1")
+    assert p.returncode == 0, p.stderr
+    file_req = json.loads(p.stdout)
+    if main_req["blade"].pop("precone_deg") != -2.5:
+        fails.append("--part blade: precone is not PreCone(1) = -2.5")
+    file_req["blade"].pop("precone_deg")
+    if main_req != file_req:
+        fails.append("--part blade differs from the blade file's import with the radii")
+    with tempfile.TemporaryDirectory() as tmp:
+        f0 = bending(solve(main_req, tmp))
+        print("blade at 12.1 rpm, bending (Hz):", " ".join(f"{f:.6f}" for f in f0))
+        for key in ("EA", "GJ"):
+            for fac in (10.0, 0.1):
+                r = copy.deepcopy(main_req)
+                r["blade"]["section"][key] *= fac
+                dev = max(abs(a / b - 1) for a, b in zip(bending(solve(r, tmp)), f0))
+                print(f"blade {key} x {fac}: max relative change {dev:.1e}")
+                if dev > 1e-6:
+                    fails.append(f"blade {key} x {fac} moves the frequencies by {dev:.2e}")
+        r = copy.deepcopy(main_req)
+        r["analysis"]["modes"] = 20
+        dev = max(abs(a / b - 1) for a, b in zip(bending(solve(r, tmp)), f0))
+        print(f"blade, 20 modes asked: max relative change {dev:.1e}")
+        if dev > 1e-6:
+            fails.append(f"blade modes 20: {dev:.2e}")
+    for args in (["--part", "blade", "--tip-radius", "63"], ["--part", "wing"]):
+        if run("import", "elastodyn", MAIN, *args).returncode == 0:
+            fails.append(f"{args} accepted")
+    if run("import", "elastodyn", os.path.join(REF, "NRELOffshrBsline5MW_Blade.dat"),
+           "--tip-radius", "63", "--part", "blade").returncode == 0:
+        fails.append("--part on a blade file accepted")
+    return fails
+
+
 def main():
     fails = []
     p = run("import", "elastodyn", MAIN)
@@ -147,6 +190,7 @@ def main():
                            capture_output=True)  # bytes: the deck's CRLF kept
         assert p.returncode == 0, p.stderr
         fails.extend(compare_deck(open(deck, "rb").read(), p.stdout))
+    fails.extend(blade_from_main())
     # a tower file alone has no height; rpm does not apply to the main file
     p = run("import", "elastodyn", os.path.join(REF, "NRELOffshrBsline5MW_Onshore_ElastoDyn_Tower.dat"))
     if p.returncode == 0 or "TwrFile" not in p.stderr:

@@ -33,8 +33,9 @@ static void tw_case(double *x, double *re, double *energy, double *freq)
         for (p = 0; p < SM_ENERGY_PARTS; p++) {
             int part = p % (SM_ENERGY_PARTS / 2);
             double flap = k < 2 ? 0.5 : k == 2 ? 1 : 0;
-            energy[k * SM_ENERGY_PARTS + p] =
-                part == SM_MODE_FLAP ? flap : part == SM_MODE_EDGE ? 1 - flap : 0;
+            energy[k * SM_ENERGY_PARTS + p] = part == SM_MODE_FLAP   ? flap
+                                              : part == SM_MODE_EDGE ? 1 - flap
+                                                                     : 0;
         }
     freq[0] = freq[1] = 0.3366; /* the pair */
     freq[2] = freq[3] = 3.07;
