@@ -627,10 +627,15 @@ static int ed_standins(json_t *doc, const imp_table *t, double length, const cha
 }
 
 /* ed_standins on a blade document made with status st; the status (SM_NOMEM on failure,
- * the document freed). */
+ * the document freed).  Not applied to blades for now (ED_BLADE_STANDINS 0): their EA of
+ * 1e7 EI/L^2 is an axial wave speed of ~4e5 m/s, which the plausibility check (plausible.c,
+ * 300..20000 m/s) reports as an EA slip on every ElastoDyn blade (cli-plausible-no_false_alarm,
+ * -slips); blades keep the CSV import's stand-ins until the request can say "rigid in
+ * extension" without a number (issue 25). */
+#define ED_BLADE_STANDINS 0
 static int ed_blade_standins(json_t **out, const imp_table *t, double length, int st)
 {
-    if (st == SM_OK && ed_standins(*out, t, length, "blade")) {
+    if (ED_BLADE_STANDINS && st == SM_OK && ed_standins(*out, t, length, "blade")) {
         json_decref(*out);
         *out = NULL;
         st = SM_NOMEM;
