@@ -62,22 +62,22 @@ static void blade_axes(double precone_deg, double B[3][3])
     B[2][0] = s;  B[2][1] = 0; B[2][2] = c;
 }
 
-/* out = B x (a vector in blade axes to hub axes). */
-static void blade_rotate(double B[3][3], const double x[3], double out[3])
+/* out = R x: a vector in a form's axes to hub axes (R row-major 3x3; blade.c and tower.c). */
+void blade_rotate(const double *R, const double x[3], double out[3])
 {
     int i;
 
     for (i = 0; i < 3; i++)
-        out[i] = B[i][0] * x[0] + B[i][1] * x[1] + B[i][2] * x[2];
+        out[i] = R[3 * i] * x[0] + R[3 * i + 1] * x[1] + R[3 * i + 2] * x[2];
 }
 
 /*
- * The tip mass's tensor from blade axes (diag = [I11, I22, I33], prod = [I12,
- * I23, I31]) to hub axes: I_hub = B I_blade B^T, returned as diag [Ixx, Iyy,
- * Izz] and prod [Ixy, Iyz, Izx].
+ * A point mass's tensor from a form's axes (diag = [I11, I22, I33], prod = [I12, I23, I31]) to
+ * hub axes: I_hub = R I R^T (R row-major 3x3), returned as diag [Ixx, Iyy, Izz] and prod [Ixy,
+ * Iyz, Izx].  blade.c and tower.c.
  */
-static void blade_tensor(double B[3][3], const double diag[3], const double prod[3],
-                         double hd[3], double hp[3])
+void blade_tensor(const double *R, const double diag[3], const double prod[3], double hd[3],
+                  double hp[3])
 {
     double T[3][3] = {{diag[0], prod[0], prod[2]},
                       {prod[0], diag[1], prod[1]},
@@ -90,7 +90,7 @@ static void blade_tensor(double B[3][3], const double diag[3], const double prod
             H[i][j] = 0;
             for (a = 0; a < 3; a++)
                 for (b = 0; b < 3; b++)
-                    H[i][j] += B[i][a] * T[a][b] * B[j][b];
+                    H[i][j] += R[3 * i + a] * T[a][b] * R[3 * j + b];
         }
     for (i = 0; i < 3; i++)
         hd[i] = H[i][i];
@@ -99,41 +99,43 @@ static void blade_tensor(double B[3][3], const double diag[3], const double prod
     hp[2] = H[2][0];
 }
 
-/* A vector field of the tip mass: checked (default def written out when absent). */
-static void blade_tip_vector(val_ctx *v, const json_t *tm, const char *key, json_t *c,
-                             enum field_real_kind kind, const char *shape, const char *unit,
-                             double out[3])
+/* The tip mass's vectors in blade axes, as the messages name their components. */
+static const char *const blade_tip_shapes[3] = {"[span, edgewise, flapwise]", "[I11, I22, I33]",
+                                                "[I12, I23, I31]"};
+
+/* A vector field of a point mass at ptr: checked (zeros written out when absent). */
+static void blade_mass_vector(val_ctx *v, const json_t *tm, const char *key, const char *ptr,
+                              json_t *c, enum field_real_kind kind, const char *shape,
+                              const char *unit, double out[3])
 {
     out[0] = out[1] = out[2] = 0;
-    if (json_object_get(tm, key) &&
-        !field_vector(v, tm, key, "/blade/tip_mass", 3, kind, shape, unit, out))
+    if (json_object_get(tm, key) && !field_vector(v, tm, key, ptr, 3, kind, shape, unit, out))
         return;
     field_set(v, c, key, field_reals(out, 3));
 }
 
-/* blade.tip_mass {mass [, offset, inertia, products]} into its canonical copy; 1 when valid. */
-static int blade_tip_mass(val_ctx *v, const json_t *tm, json_t *cb, double t[10])
+int blade_point_mass(val_ctx *v, const json_t *tm, json_t *parent, const char *key, const char *ptr,
+                     const char *what, const char *const shapes[3], double t[10])
 {
     static const char *const keys[] = {"mass", "offset", "inertia", "products", NULL};
     size_t before = (size_t)codec_errors_count(v->errs);
     json_t *c;
 
     if (!json_is_object(tm)) {
-        field_error(v, "/blade/tip_mass", "must be an object {mass [, offset, inertia, "
-                    "products]}, not %s", field_type_name(tm));
+        field_error(v, ptr, "must be an object {mass [, offset, inertia, products]}, not %s",
+                    field_type_name(tm));
         return 0;
     }
     if (!(c = json_object())) {
         v->nomem = 1;
         return 0;
     }
-    field_check_keys(v, tm, "/blade/tip_mass", keys, "tip mass");
-    field_real(v, tm, "mass", "/blade/tip_mass", c, FIELD_NONNEG, " (kg)", &t[0]);
-    blade_tip_vector(v, tm, "offset", c, FIELD_FINITE, "[span, edgewise, flapwise]", " (m)",
-                     t + 1);
-    blade_tip_vector(v, tm, "inertia", c, FIELD_NONNEG, "[I11, I22, I33]", " (kg m^2)", t + 4);
-    blade_tip_vector(v, tm, "products", c, FIELD_FINITE, "[I12, I23, I31]", " (kg m^2)", t + 7);
-    field_set(v, cb, "tip_mass", c);
+    field_check_keys(v, tm, ptr, keys, what);
+    field_real(v, tm, "mass", ptr, c, FIELD_NONNEG, " (kg)", &t[0]);
+    blade_mass_vector(v, tm, "offset", ptr, c, FIELD_FINITE, shapes[0], " (m)", t + 1);
+    blade_mass_vector(v, tm, "inertia", ptr, c, FIELD_NONNEG, shapes[1], " (kg m^2)", t + 4);
+    blade_mass_vector(v, tm, "products", ptr, c, FIELD_FINITE, shapes[2], " (kg m^2)", t + 7);
+    field_set(v, parent, key, c);
     return (size_t)codec_errors_count(v->errs) == before;
 }
 
@@ -193,8 +195,8 @@ static json_t *blade_structure(const json_t *b, const double g[5], const double 
                    sec ? json_incref((json_t *)sec) : json_object(), "members", mem, "clamp",
                    "root", "point_masses");
     if (st && t) {
-        blade_rotate(B, t + 1, off);
-        blade_tensor(B, t + 4, t + 7, hd, hp);
+        blade_rotate(&B[0][0], t + 1, off);
+        blade_tensor(&B[0][0], t + 4, t + 7, hd, hp);
         if (json_array_append_new(json_object_get(st, "point_masses"),
                                   json_pack("{s:s, s:f, s:o, s:o, s:o}", "joint", "tip", "mass",
                                             t[0], "offset", field_reals(off, 3), "inertia",
@@ -275,7 +277,8 @@ json_t *blade_validate(val_ctx *v, const json_t *root, json_t *canon)
     field_check_keys(v, b, "/blade", keys, "blade");
     blade_scalars(v, b, cb, g);
     if ((tm = json_object_get(b, "tip_mass")))
-        tip_ok = blade_tip_mass(v, tm, cb, t);
+        tip_ok = blade_point_mass(v, tm, cb, "tip_mass", "/blade/tip_mass", "tip mass",
+                                  blade_tip_shapes, t);
     if (json_object_get(b, "section") && sec_classify_as(json_object_get(b, "section"), 1) ==
                                              SEC_PLANAR) {
         field_error(v, "/blade/section", "a blade is spatial, and this section is %s: give it "

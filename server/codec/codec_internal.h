@@ -334,6 +334,19 @@ void size_check(val_ctx *v, const json_t *canon, const json_t *structure);
  * NULL.  Errors point into /blade.
  */
 json_t *blade_validate(val_ctx *v, const json_t *root, json_t *canon);
+/**
+ * A point mass {mass [, offset, inertia, products]} of a form at ptr (the blade's tip mass, the
+ * tower's top mass; what names it in messages, shapes[3] the vectors' component names) checked
+ * and written as parent[key]; t = mass, offset, inertia, products in the form's axes.  1 when
+ * valid.
+ */
+int blade_point_mass(val_ctx *v, const json_t *tm, json_t *parent, const char *key, const char *ptr,
+                     const char *what, const char *const shapes[3], double t[10]);
+/** out = R x, R row-major 3x3: a vector in a form's axes to hub axes. */
+void blade_rotate(const double *R, const double x[3], double out[3]);
+/** A point mass's tensor (diag, prod in a form's axes) to hub axes: R I R^T as hd, hp. */
+void blade_tensor(const double *R, const double diag[3], const double prod[3], double hd[3],
+                  double hp[3]);
 
 /**
  * The pointer p of the structure a blade was expanded to, moved into

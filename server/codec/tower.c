@@ -75,77 +75,13 @@ char *tower_form_pointer(int form, const char *p)
 }
 
 /* T: the tower axes fa, ss, up as the columns, in hub components (row i = hub axis i). */
+/* The top mass's vectors in tower axes, as the messages name their components. */
+static const char *const tower_top_shapes[3] = {
+    "[fore-aft, side-side, axial]", "[I_fa, I_ss, I_axial]", "[I_fa_ss, I_ss_axial, I_axial_fa]"};
+
 static const double tower_T[3][3] = {{0, 1, 0},  /* hub x: ss */
                                      {0, 0, 1},  /* hub y: up */
                                      {1, 0, 0}}; /* hub z: fa */
-
-/*
- * The top mass's tensor from tower axes (diag = [I_fa, I_ss, I_up], prod =
- * [I_fa_ss, I_ss_up, I_up_fa], the tensor's off-diagonal entries) to hub
- * axes: I_hub = T I T^T, as diag [Ixx, Iyy, Izz] and prod [Ixy, Iyz, Izx].
- */
-static void tower_tensor(const double diag[3], const double prod[3], double hd[3], double hp[3])
-{
-    double I[3][3] = {
-        {diag[0], prod[0], prod[2]}, {prod[0], diag[1], prod[1]}, {prod[2], prod[1], diag[2]}};
-    double H[3][3];
-    int i, j, a, b;
-
-    for (i = 0; i < 3; i++)
-        for (j = 0; j < 3; j++) {
-            H[i][j] = 0;
-            for (a = 0; a < 3; a++)
-                for (b = 0; b < 3; b++)
-                    H[i][j] += tower_T[i][a] * I[a][b] * tower_T[j][b];
-        }
-    for (i = 0; i < 3; i++)
-        hd[i] = H[i][i];
-    hp[0] = H[0][1];
-    hp[1] = H[1][2];
-    hp[2] = H[2][0];
-}
-
-/* A vector field of the top mass: checked (zero written out when absent). */
-static void tower_top_vector(val_ctx *v, const json_t *tm, const char *key, json_t *c,
-                             enum field_real_kind kind, const char *shape, const char *unit,
-                             double out[3])
-{
-    out[0] = out[1] = out[2] = 0;
-    if (json_object_get(tm, key) &&
-        !field_vector(v, tm, key, "/tower/top_mass", 3, kind, shape, unit, out))
-        return;
-    field_set(v, c, key, field_reals(out, 3));
-}
-
-/* tower.top_mass {mass [, offset, inertia, products]} into its canonical copy; 1 when valid. */
-static int tower_top_mass(val_ctx *v, const json_t *tm, json_t *ct, double t[10])
-{
-    static const char *const keys[] = {"mass", "offset", "inertia", "products", NULL};
-    size_t before = (size_t)codec_errors_count(v->errs);
-    json_t *c;
-
-    if (!json_is_object(tm)) {
-        field_error(v, "/tower/top_mass",
-                    "must be an object {mass [, offset, inertia, "
-                    "products]}, not %s",
-                    field_type_name(tm));
-        return 0;
-    }
-    if (!(c = json_object())) {
-        v->nomem = 1;
-        return 0;
-    }
-    field_check_keys(v, tm, "/tower/top_mass", keys, "top mass");
-    field_real(v, tm, "mass", "/tower/top_mass", c, FIELD_NONNEG, " (kg)", &t[0]);
-    tower_top_vector(v, tm, "offset", c, FIELD_FINITE, "[fore-aft, side-side, axial]", " (m)",
-                     t + 1);
-    tower_top_vector(v, tm, "inertia", c, FIELD_NONNEG, "[I_fa, I_ss, I_axial]", " (kg m^2)",
-                     t + 4);
-    tower_top_vector(v, tm, "products", c, FIELD_FINITE, "[I_fa_ss, I_ss_axial, I_axial_fa]",
-                     " (kg m^2)", t + 7);
-    field_set(v, ct, "top_mass", c);
-    return (size_t)codec_errors_count(v->errs) == before;
-}
 
 /* The reserved fields (supports the core does not have yet) and gravity. */
 static void tower_reserved(val_ctx *v, const json_t *tw, json_t *ct)
@@ -209,7 +145,6 @@ static json_t *tower_structure(const json_t *tw, const double g[3], const double
     const json_t *sec = json_object_get(tw, "section"), *sts = json_object_get(tw, "stations");
     double base[3] = {0, g[1], 0}, top[3] = {0, g[0], 0}, off[3], hd[3], hp[3];
     json_t *st, *mem;
-    int i;
 
     mem = json_pack("{s:s, s:s, s:s, s:s, s:I, s:f, s:o}", "id", "tower", "from", "base", "to",
                     "top", "section", "tower", "elements", (json_int_t)g[2], "twist_deg", 0.0,
@@ -223,9 +158,8 @@ static json_t *tower_structure(const json_t *tw, const double g[3], const double
                    sec ? json_incref((json_t *)sec) : json_object(), "members", mem, "clamp",
                    "base", "point_masses");
     if (st && t) {
-        for (i = 0; i < 3; i++) /* off = T o */
-            off[i] = tower_T[i][0] * t[1] + tower_T[i][1] * t[2] + tower_T[i][2] * t[3];
-        tower_tensor(t + 4, t + 7, hd, hp);
+        blade_rotate(&tower_T[0][0], t + 1, off); /* off = T o */
+        blade_tensor(&tower_T[0][0], t + 4, t + 7, hd, hp);
         if (json_array_append_new(json_object_get(st, "point_masses"),
                                   json_pack("{s:s, s:f, s:o, s:o, s:o}", "joint", "top", "mass",
                                             t[0], "offset", field_reals(off, 3), "inertia",
@@ -294,7 +228,8 @@ json_t *tower_validate(val_ctx *v, const json_t *root, json_t *canon)
     tower_scalars(v, tw, ct, g);
     tower_reserved(v, tw, ct);
     if ((tm = json_object_get(tw, "top_mass")))
-        top_ok = tower_top_mass(v, tm, ct, t);
+        top_ok = blade_point_mass(v, tm, ct, "top_mass", "/tower/top_mass", "top mass",
+                                  tower_top_shapes, t);
     if (json_object_get(tw, "section") &&
         sec_classify_as(json_object_get(tw, "section"), 1) == SEC_PLANAR) {
         field_error(v, "/tower/section",
