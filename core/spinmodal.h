@@ -150,6 +150,34 @@ typedef struct sm_point_mass {
                            turns with the joint's node */
 } sm_point_mass;
 
+/** An elastic support (issue 25, DESIGN.md 8.6): a point support at a joint, or a foundation
+ *  (distributed springs and added mass) along a stretch of a member.  A support acts on the
+ *  motion of FE nodes from rest — translation and small rotation, hub axes — through the
+ *  nodes' motion at rest: its matrices in modal coordinates are J0' k J0 and J0' m J0, J0 the
+ *  nodes' Jacobian at q = 0, built once with the model.  That is exact for a structure that
+ *  does not spin (its steady state is rest); at speed it is the support linearised at rest,
+ *  exact to first order in the support's steady deflection and rotation.  Added mass adds
+ *  inertia only (no centrifugal or gyroscopic terms: it is a surrounding fluid's, not the
+ *  structure's mass; a mass that spins is an sm_point_mass).  A foundation is lumped onto the
+ *  nodes of the stretch (each node takes its tributary length, per element with that element's
+ *  axes).  Planar models use the x, y and rz rows and columns, a foundation's lateral p2
+ *  stiffness (the in-plane normal) and its axial one. */
+typedef struct sm_support {
+    int joint;    /* point support: joint index; -1 for a foundation */
+    double K[36]; /* point: stiffness 6x6, column-major over (x, y, z, rx, ry, rz) in hub axes:
+                     N/m, N/rad, N m/rad; symmetric (1e-9 relative), positive semi-definite */
+    double M[36]; /* point: added mass 6x6, same layout: kg, kg m, kg m^2; symmetric, positive
+                     semi-definite */
+    int member;   /* foundation: member index; -1 for a point support */
+    double from_s, to_s;    /* foundation: the stretch, m from the member's `from` joint along it,
+                               0 <= from_s < to_s <= member length */
+    double k_per_length[4]; /* foundation: axial, lateral p2 (edgewise), lateral p3 (flapwise),
+                               torsion, member axes at rest: N/m per m (N/m^2) and N m/rad per m,
+                               >= 0 */
+    double
+        added_mass_per_length; /* foundation: added mass in both lateral directions, kg/m, >= 0 */
+} sm_support;
+
 /** The structure.  Arrays are borrowed; sm_model_new copies what it needs. */
 typedef struct sm_structure {
     int n_joints;
@@ -165,6 +193,8 @@ typedef struct sm_structure {
      * 6 DOF per node, the spatial section data, twist, e3 and point-mass inertia) */
     int spatial;
     const double *joint_z;           /* n_joints z coordinates (m) or NULL (all zero) */
+    int n_supports;                  /* elastic supports (sm_support), 0 for none */
+    const sm_support *supports;      /* n_supports, may be NULL if 0 */
 } sm_structure;
 
 typedef enum sm_frame_scheme {
@@ -254,7 +284,8 @@ typedef enum sm_item {
     SM_ITEM_MEMBER,
     SM_ITEM_POINT_MASS,
     SM_ITEM_CLAMP,
-    SM_ITEM_OPTIONS
+    SM_ITEM_OPTIONS,
+    SM_ITEM_SUPPORT
 } sm_item;
 
 /** Optional diagnostics out-parameter (like jansson's json_error_t). */

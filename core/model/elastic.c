@@ -8,6 +8,8 @@
  */
 #include "internal.h"
 
+#include <cblas.h>
+
 /** P[e] = d_e . q_s, the axial force of every FE element e (eq. 24), N. */
 void lin_axial_forces(const sm_model *m, const double *q, double *P)
 {
@@ -22,7 +24,7 @@ void lin_axial_forces(const sm_model *m, const double *q, double *P)
     }
 }
 
-/** f += blockdiag(K_s) q. */
+/** f += blockdiag(K_s) q, and the supports' K_sup q (supports.c). */
 void lin_elastic_force(const sm_model *m, const double *q, double *f)
 {
     for (int s = 0; s < m->n_subs; s++) {
@@ -34,9 +36,12 @@ void lin_elastic_force(const sm_model *m, const double *q, double *f)
             f[b->q0 + i] += t;
         }
     }
+    if (m->has_supports)
+        cblas_dgemv(CblasColMajor, CblasNoTrans, m->n, m->n, 1.0, m->sup_K.a, m->n, q, 1, 1.0, f,
+                    1);
 }
 
-/** Kt += blockdiag(K_s). */
+/** Kt += blockdiag(K_s), and the supports' K_sup. */
 void lin_elastic_add(const sm_model *m, dmat *Kt)
 {
     for (int s = 0; s < m->n_subs; s++) {
@@ -45,4 +50,6 @@ void lin_elastic_add(const sm_model *m, dmat *Kt)
             for (int i = 0; i < b->m; i++)
                 DM(Kt, b->q0 + i, b->q0 + j) += DM(&b->K, i, j);
     }
+    for (size_t i = 0; m->has_supports && i < (size_t)m->n * (size_t)m->n; i++)
+        Kt->a[i] += m->sup_K.a[i];
 }

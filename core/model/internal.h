@@ -125,6 +125,12 @@ struct sm_model {
     const struct smi_kind *kind; /* planar or spatial (kind.h): picked by mesh_build */
     int n_pt;           /* spatial: points = the FE nodes (0 .. n_nodes-1) + quadrature points */
     struct sp_point *pt; /* spatial: n_pt points (spatial.h) */
+    /* elastic supports (supports.c, DESIGN.md 8.6); has_supports 0: none, all empty */
+    int has_supports;
+    int n_sup;             /* nodes with a support */
+    int *sup_node;         /* n_sup FE nodes */
+    double *sup_k, *sup_m; /* 36 per support node: 6x6 stiffness and added mass, hub axes */
+    dmat sup_K, sup_M;     /* n x n: sum J0' k J0, sum J0' m J0 (J0: the nodes' motion at rest) */
 };
 
 /* ------------------------------------------------------------- fe.c */
@@ -143,6 +149,20 @@ void fe_to_frame(const double kloc[36], double alpha, double kfr[36]);
 void fe_shape(double xi, double l, double s[12]);
 /** g = bending block of G_e (eq. 23) on (v1, phi1, v2, phi2), 4x4 column-major (axial part is zero). */
 void fe_geometric_bending(double l, double g[16]);
+
+/* --------------------------------------------------------- supports.c */
+/** Checks of st's supports (indices, symmetric and positive semi-definite 6x6 matrices, the
+ *  foundations' stretches and values) and that o allows them; diag as mesh_check's. */
+int supports_check(const sm_structure *st, const sm_options *o, sm_diag *d);
+/** The supports of st lumped onto m's nodes (after mesh_build): m->sup_node, sup_k, sup_m.
+ *  SM_OK or SM_NOMEM. */
+int supports_lump(sm_model *m, const sm_structure *st);
+/** m->sup_K and sup_M in modal coordinates (after the bases).  SM_OK or SM_NOMEM. */
+int supports_build(sm_model *m);
+/** Free what supports_lump and supports_build allocated. */
+void supports_free(sm_model *m);
+/** 1/2 x' K_sup x, the supports' strain energy of the modal vector x (0 without supports). */
+double supports_energy(const sm_model *m, const double *x);
 
 /* ------------------------------------------------------------- mesh.c */
 /**

@@ -66,6 +66,9 @@ typedef struct smi_kind {
     void (*kin_free)(void *k);
     /** Kinematics at q (with the Jacobians where the workspace has them). */
     void (*kin_eval)(const sm_model *m, const double *q, void *k);
+    /** J (n x node_dof, column-major) = the motion of FE node nd itself (not of a mass offset
+     *  from it) per modal coordinate, at the kinematics in k (a SMI_USE_MODES workspace). */
+    void (*node_jacobian)(const sm_model *m, const void *k, int nd, double *J);
 
     /* ---- forces and the linearised system ---- */
     /** g (n) with Omega^2 g the centrifugal force at q; leaves the kinematics of q in k (t: the

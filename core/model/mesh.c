@@ -145,6 +145,8 @@ static int mesh_check(const sm_structure *st, const sm_options *o, sm_diag *d)
     }
     if (o->modes < 1)
         return smi_input_fail(d, SM_ITEM_OPTIONS, -1, "modes", "modes must be a positive integer");
+    if ((rc = supports_check(st, o, d)) < 0)
+        return rc;
     if ((o->frames == SM_FRAMES_PER_MEMBER || o->frames == SM_FRAMES_ELEMENTS_PER_FRAME) &&
         o->frames_param < 1)
         return smi_input_fail(d, SM_ITEM_OPTIONS, -1, "frames",

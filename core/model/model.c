@@ -49,6 +49,7 @@ void sm_model_free(sm_model *m)
     free(m->joint_node);
     free(m->mp);
     free(m->pt);
+    supports_free(m);
     free(m);
 }
 
@@ -80,6 +81,8 @@ static int model_mesh(sm_model **out, const sm_structure *st, const sm_options *
     if (!(m->opt.tolerance > 0))
         m->opt.tolerance = 1e-10;
     int rc = mesh_build(m, st, d);
+    if (rc == SM_OK)
+        rc = supports_lump(m, st);
     if (rc < 0) {
         sm_model_free(m);
         return rc;
@@ -126,7 +129,7 @@ int sm_model_build(sm_model **out, const sm_structure *st, const sm_options *opt
     *out = NULL;
     if (rc < 0)
         return model_fail(d, rc);
-    if ((rc = modes_build(m, cb, user, d)) < 0) {
+    if ((rc = modes_build(m, cb, user, d)) < 0 || (rc = supports_build(m)) < 0) {
         sm_model_free(m);
         return model_fail(d, rc);
     }
@@ -151,7 +154,8 @@ int sm_structure_check(const sm_structure *st, const sm_options *opt, sm_model_i
                 info->max_frame_coordinates = k;
         }
         info->structured =
-            tree_choose(m->opt.solver, info->coordinates, info->max_frame_coordinates, m->opt.modes);
+            !m->has_supports && tree_choose(m->opt.solver, info->coordinates,
+                                            info->max_frame_coordinates, m->opt.modes);
     }
     sm_model_free(m);
     return SM_OK;

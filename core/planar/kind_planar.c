@@ -138,6 +138,11 @@ static void planar_kin_eval(const sm_model *m, const double *q, void *k)
     frames_eval(m, q, k);
 }
 
+static void planar_node_jacobian(const sm_model *m, const void *k, int nd, double *J)
+{
+    memcpy(J, &DM(&((const sm_kin *)k)->Jn, 0, 3 * nd), 3 * (size_t)m->n * sizeof(double));
+}
+
 static void planar_centrifugal(const sm_model *m, const double *q, void *k, tree_ws *t, double *g)
 {
     frames_eval(m, q, k);
@@ -282,6 +287,7 @@ const smi_kind smi_kind_planar = {
     .kin_new = planar_kin_new,
     .kin_free = planar_kin_free,
     .kin_eval = planar_kin_eval,
+    .node_jacobian = planar_node_jacobian,
     .centrifugal = planar_centrifugal,
     .geometric_force = lin_geometric_force,
     .dense_alloc = planar_dense_alloc,

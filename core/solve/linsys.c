@@ -145,6 +145,8 @@ int smi_lin_linearize(const sm_model *m, const double *q, double omega, smi_lin 
     if (L->tree) /* K*, P frozen; M*; C* in the local blocks */
         return L->kind->tree_assemble(m, q, L->kin, omega * omega, 1, m->opt.coriolis, &L->t);
     L->kind->dense_linearize(m, q, L->kin, omega, m->opt.coriolis, &L->D, L->work);
+    for (size_t i = 0; m->has_supports && i < (size_t)n * (size_t)n; i++)
+        L->D.M.a[i] += m->sup_M.a[i]; /* the supports' added mass (supports.c) */
     for (int j = 0; j < n; j++) /* symmetric up to round-off: make it exact */
         for (int i = 0; i < j; i++)
             DM(&L->D.K, i, j) = DM(&L->D.K, j, i) = 0.5 * (DM(&L->D.K, i, j) + DM(&L->D.K, j, i));

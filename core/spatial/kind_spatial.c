@@ -46,6 +46,24 @@ static void spatial_kin_eval(const sm_model *m, const double *q, void *k)
     sp_eval(m, q, k);
 }
 
+/* The FE nodes are the first n_nodes points of JW (n x 6 n_pt); a point with a mass offset
+ * moves the offset mass, r_p = r_node + dh: the node's translation is J_p - dtheta x dh. */
+static void spatial_node_jacobian(const sm_model *m, const void *kin, int nd, double *J)
+{
+    const sp_kin *k = kin;
+    size_t n = (size_t)m->n;
+
+    memcpy(J, &DM(&k->JW, 0, 6 * nd), 6 * n * sizeof(double));
+    if (!m->pt[nd].has_c)
+        return;
+    const double *dh = k->dh + 3 * nd, *W = J + 3 * n;
+    for (size_t x = 0; x < n; x++) {
+        J[x] -= W[n + x] * dh[2] - W[2 * n + x] * dh[1];
+        J[n + x] -= W[2 * n + x] * dh[0] - W[x] * dh[2];
+        J[2 * n + x] -= W[x] * dh[1] - W[n + x] * dh[0];
+    }
+}
+
 static void spatial_centrifugal(const sm_model *m, const double *q, void *k, tree_ws *t, double *g)
 {
     (void)t;
@@ -213,6 +231,7 @@ const smi_kind smi_kind_spatial = {
     .kin_new = spatial_kin_new,
     .kin_free = spatial_kin_free,
     .kin_eval = spatial_kin_eval,
+    .node_jacobian = spatial_node_jacobian,
     .centrifugal = spatial_centrifugal,
     .geometric_force = lin3_geometric_force,
     .dense_alloc = spatial_dense_alloc,
