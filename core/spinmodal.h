@@ -214,6 +214,17 @@ typedef enum sm_basis {
     SM_BASIS_PAPER                   /* Kim & Yoo's condensed component modes */
 } sm_basis;
 
+/** Which mass moments of a spatial section act in M*, C* (sm_options.rotary_inertia, DESIGN.md
+ *  8.5).  FULL: i_flap, i_edge are bending rotary inertia of the lumped nodes and their sum the
+ *  torsional inertia.  TORSION: the torsional mass moment only, as BModes (Struct.f90:1222,
+ *  1302).  Either way the centrifugal potential keeps the whole section tensor (the propeller
+ *  moment of torsion, BModes' too), point masses and centre-of-mass offsets keep their inertia,
+ *  and consistent mass is unchanged (its M* has torsion only already); planar models have none. */
+typedef enum sm_rotary_inertia {
+    SM_ROTARY_FULL = 0, /* default */
+    SM_ROTARY_TORSION   /* torsional mass moment only */
+} sm_rotary_inertia;
+
 /** Most engine orders one solve looks for (sm_options.engine_orders, DESIGN.md 9.1). */
 #define SM_MAX_ENGINE_ORDERS 16
 
@@ -238,6 +249,7 @@ typedef struct sm_options {
     int frames_param;                /* k for PER_MEMBER, n for ELEMENTS_PER_FRAME */
     sm_mass_model mass;              /* default lumped */
     sm_basis basis;                  /* default augmented */
+    sm_rotary_inertia rotary_inertia; /* default SM_ROTARY_FULL (spatial sections only) */
     int modes_per_frame;             /* 0 = all component modes */
     int modes;                       /* number of modes reported, default 3 */
     int geometric_stiffening;        /* default 1 */

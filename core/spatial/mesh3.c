@@ -222,6 +222,9 @@ int mesh3_check(const sm_structure *st, const sm_options *o, sm_diag *d)
                 "inertia and products do not form a physical inertia tensor (it must be "
                 "positive semi-definite)");
     }
+    if (o->rotary_inertia != SM_ROTARY_FULL && o->rotary_inertia != SM_ROTARY_TORSION)
+        return smi_input_fail(d, SM_ITEM_OPTIONS, -1, "rotary_inertia",
+                              "unknown rotary_inertia (full or torsion)");
     if (o->basis == SM_BASIS_PAPER)
         return smi_input_fail(
             d, SM_ITEM_OPTIONS, -1, "substructure_modes",
@@ -394,15 +397,19 @@ int mesh3_elements(sm_model *m, const sm_structure *st, sm_diag *d)
         el->sc[0] = sg * sc[0], el->sc[1] = sc[1];
         el->tc[0] = sg * tc[0], el->tc[1] = tc[1];
         /* lumped: half the element's mass and rotary inertia (about its centre of mass, in the
-         * inertia axes; torsion = i_flap + i_edge) on each node, at the centre of mass */
+         * inertia axes; torsion = i_flap + i_edge) on each node, at the centre of mass; the
+         * nodes' bending parts only with SM_ROTARY_FULL (BModes' sections have none, DESIGN.md
+         * 8.5); rot_pl keeps the whole tensor (the propeller moment, modes3.c) */
+        int bend = m->opt.rotary_inertia == SM_ROTARY_FULL;
         double dg[3] = {el->i_flap + el->i_edge, el->i_flap, el->i_edge};
+        double dn[3] = {dg[0], bend ? dg[1] : 0.0, bend ? dg[2] : 0.0};
         double hm = 0.5 * el->mu * el->l;
         memset(el->rot_pl, 0, sizeof el->rot_pl);
         mesh3_add_tensor(el->rot_pl, iax, dg, 1.0);
         sm_node *ends[2] = {na, nz};
         for (int h = 0; h < 2; h++) {
             ends[h]->mass += hm;
-            mesh3_add_tensor(ends[h]->rot, iax, dg, 0.5 * el->l);
+            mesh3_add_tensor(ends[h]->rot, iax, dn, 0.5 * el->l);
             if (el->cg[0] != 0.0 || el->cg[1] != 0.0 || el->cg[2] != 0.0)
                 mesh3_add_offset(ends[h]->first, ends[h]->rot, el->cg, hm);
         }

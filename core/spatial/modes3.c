@@ -337,6 +337,34 @@ static int modes3_elements(const sm_model *m, sm_sub *b)
     return SM_OK;
 }
 
+/*
+ * Lumped mass with SM_ROTARY_TORSION (DESIGN.md 8.5): the nodes' I carries the sections' torsional
+ * mass moment only; their Ic (the propeller moment) gets the bending parts back, half an
+ * element's rot_pl less its torsion on each end, as consistent mass's Gauss points have it and
+ * BModes (Struct.f90:1067, 1298: the torsional stiffness Omega^2 (i_edge - i_flap) cos 2theta).
+ */
+static void modes3_bending_ic(sm_model *m)
+{
+    for (int j = 0; j < m->n_elems; j++) {
+        const sm_elem *e = &m->elems[j];
+        int ends[2] = {e->n1, e->n2};
+        double B[9], Bf[9], ip = e->i_flap + e->i_edge;
+        for (int i = 0; i < 9; i++) /* bending part, hub axes: rot_pl - ip e1 e1' */
+            B[i] = 0.5 * e->l * (e->rot_pl[i] - ip * e->ax[i % 3] * e->ax[i / 3]);
+        for (int h = 0; h < 2; h++) {
+            sp_point *p = &m->pt[ends[h]];
+            if (m->nodes[ends[h]].sub < 0)
+                continue;
+            if (p->has_Ic != 2)
+                memcpy(p->Ic, p->I, sizeof p->Ic);
+            p->has_Ic = 2; /* set: not a copy of I */
+            modes3_to_frame(m->subs[m->nodes[ends[h]].sub].A0, B, Bf);
+            for (int i = 0; i < 9; i++)
+                p->Ic[i] += Bf[i];
+        }
+    }
+}
+
 /* The points: FE nodes first (index = node), then the Gauss points of consistent mass. */
 int modes3_points(sm_model *m)
 {
@@ -392,8 +420,11 @@ int modes3_points(sm_model *m)
         o->has_c = 1;
         p->mass = 0.0;
     }
-    if (!consistent)
+    if (!consistent) {
+        if (m->opt.rotary_inertia == SM_ROTARY_TORSION)
+            modes3_bending_ic(m);
         goto inertia;
+    }
     np = m->n_nodes;
     for (int s = 0; s < m->n_subs; s++) {
         sm_sub *b = &m->subs[s];

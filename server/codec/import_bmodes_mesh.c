@@ -216,11 +216,15 @@ int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *file, impo
         imp_warn(warn, "/structure",
                  "BModes' own model (bmodes_mesh %d): its %zu elements as uniform members "
                  "with the properties at their midpoints (BModes.f90:1110), %d FE elements "
-                 "each, which reproduces BModes' numbers; without the option the "
-                 "properties are interpolated along the span as the file gives them (the "
-                 "finer model: BModes itself refined to 96 elements gives 1.6-5.5 %% "
+                 "each, and the sections' mass moments in torsion only "
+                 "(analysis.rotary_inertia \"torsion\": BModes has no bending rotary "
+                 "inertia, Struct.f90:1222), which reproduces BModes' numbers; without the "
+                 "option the properties are interpolated along the span as the file gives "
+                 "them (the finer model: BModes itself refined to 96 elements gives 1.6-5.5 %% "
                  "higher frequencies on its CertTest blades)",
                  k, n - 1, k) ||
+        json_object_set_new(json_object_get(req, "analysis"), "rotary_inertia",
+                            json_string("torsion")) ||
         json_object_set_new(json_object_get(doc, "source"), "note",
                             json_string("BModes' element boundaries (nselt, el_loc) are the "
                                         "members of the structure (option bmodes_mesh)")))

@@ -288,6 +288,8 @@ static int req_build_options(codec_request *r)
     r->opt.basis = !strcmp(json_string_value(json_object_get(an, "substructure_modes")),
                            "paper") ? SM_BASIS_PAPER : SM_BASIS_AUGMENTED;
     r->opt.modes_per_frame = json_is_integer(mpf) ? (int)json_integer_value(mpf) : 0;
+    r->opt.rotary_inertia =
+        json_object_get(an, "rotary_inertia") ? SM_ROTARY_TORSION : SM_ROTARY_FULL;
     r->opt.modes = (int)json_integer_value(json_object_get(an, "modes"));
     r->opt.geometric_stiffening = json_is_true(json_object_get(an, "geometric_stiffening"));
     r->opt.coriolis = json_is_true(json_object_get(an, "coriolis"));

@@ -697,12 +697,46 @@ static void val_engine_orders(val_ctx *v, const json_t *an, json_t *can)
     field_set(v, can, "engine_orders", c);
 }
 
+/*
+ * analysis.rotary_inertia (DESIGN.md 8.5): "full" (default) or "torsion" (a spatial section's
+ * mass moments act in torsion only, BModes' model).  Only "torsion" goes into the canonical
+ * request, so a request without it (or with "full") keeps its canonical text and job id.
+ */
+static void val_rotary_inertia(val_ctx *v, const json_t *an, json_t *can)
+{
+    const json_t *x = json_object_get(an, "rotary_inertia");
+    const char *s = json_string_value(x);
+
+    if (!x || (s && !strcmp(s, "full")))
+        return;
+    if (!s || strcmp(s, "torsion")) {
+        field_error(v, "/analysis/rotary_inertia", "must be \"full\" or \"torsion\"");
+        return;
+    }
+    if (v->spatial == 0) {
+        field_error(v, "/analysis/rotary_inertia",
+                    "\"torsion\" needs spatial sections (planar sections have no rotary "
+                    "inertia): " VAL_SPATIAL_SECTIONS);
+        return;
+    }
+    field_set(v, can, "rotary_inertia", json_string("torsion"));
+}
+
 /* The analysis object: omega or rpm (speeds.c), modes and the options, with their defaults. */
 static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
 {
-    static const char *const keys[] = {"omega", "rpm", "modes", "geometric_stiffening", "coriolis",
-                                       "mass", "substructure_modes", "modes_per_frame",
-                                       "mode_shapes", "error_estimate", "engine_orders",
+    static const char *const keys[] = {"omega",
+                                       "rpm",
+                                       "modes",
+                                       "geometric_stiffening",
+                                       "coriolis",
+                                       "mass",
+                                       "substructure_modes",
+                                       "modes_per_frame",
+                                       "mode_shapes",
+                                       "error_estimate",
+                                       "engine_orders",
+                                       "rotary_inertia",
                                        NULL};
     static const char *const mass[] = {"lumped", "consistent", NULL};
     static const char *const basis[] = {"augmented", "paper", NULL};
@@ -743,6 +777,7 @@ static void val_analysis(val_ctx *v, const json_t *root, json_t *canon)
     field_bool(v, an, "mode_shapes", base, can, 1);
     val_error_estimate(v, an, can);
     val_engine_orders(v, an, can);
+    val_rotary_inertia(v, an, can);
     field_set(v, canon, "analysis", can);
 }
 

@@ -262,6 +262,8 @@ static void check_options(test_case *tc, const sm_options *o, const json_t *want
         else if (!strcmp(key, "geometric_stiffening")) got = o->geometric_stiffening;
         else if (!strcmp(key, "coriolis")) got = o->coriolis;
         else if (!strcmp(key, "mode_shapes")) got = o->mode_shapes;
+        else if (!strcmp(key, "rotary_inertia"))
+            got = (long)o->rotary_inertia;
         else {
             fail(tc, "unknown option check '%s'", key);
             continue;

@@ -155,6 +155,8 @@ SCHEMA_REJECTS = [
     "blade-length-zero", "blade-length-missing", "blade-precone-90", "blade-hub-radius-negative",
     "blade-elements-zero", "blade-unknown-key", "blade-station-error", "blade-tip-inertia-negative",
     "blade-tip-mass-missing", "blade-paper-basis", "blade-not-object", "blade-planar-section",
+    # analysis.rotary_inertia (DESIGN.md 8.5)
+    "rotary-inertia-unknown", "rotary-inertia-planar",
 ]
 
 # Invalid codec cases a JSON Schema cannot express (not forced; printed for information).
