@@ -120,7 +120,8 @@ static void rot_lumped(void)
                     k ? "edge" : "flap", n, eb);
         }
     double f3 = rot_freq(full, SM_MODE_FLAP, 3) / rot_eb(EI_F, 3);
-    TU_CHECK(f3 < 0.99, "full rotary inertia: flap 3 / Euler-Bernoulli = %.5f, expected < 0.99", f3);
+    TU_CHECK(f3 < 0.99, "full rotary inertia: flap 3 / Euler-Bernoulli = %.5f, expected < 0.99",
+             f3);
     printf("full rotary inertia: flap 3 / Euler-Bernoulli = %.5f\n", f3);
     double tt = rot_freq(tor, SM_MODE_TORSION, 1), tf = rot_freq(full, SM_MODE_TORSION, 1);
     TU_NEAR(tt / tf, 1.0, 1e-12, "torsion 1, torsion-only / full");
@@ -162,8 +163,8 @@ static void rot_propeller(void)
                 TU_CHECK(sm_solve(m, &w, 1, NULL, NULL, &r, &d) == SM_OK, "solve: %s", d.message);
             TU_NEAR(rot_freq(r, SM_MODE_TORSION, 1) / want, 1.0, 2e-3,
                     "%s, %s, Omega %g: torsion 1 / analytic with the propeller moment (%.4f rad/s; "
-                    "without it %.4f)", k ? "consistent" : "lumped", ri ? "torsion-only" : "full",
-                    OMEGA_P, want, w0);
+                    "without it %.4f)",
+                    k ? "consistent" : "lumped", ri ? "torsion-only" : "full", OMEGA_P, want, w0);
             sm_result_free(r);
             sm_model_free(m);
         }
@@ -189,7 +190,8 @@ static void rot_consistent(void)
     sm_diag d;
     sm_default_options(&o);
     o.rotary_inertia = (sm_rotary_inertia)7;
-    TU_CHECK(sm_model_new(&m, &sp.st, &o, &d) == SM_INVALID_INPUT && !strcmp(d.field, "rotary_inertia"),
+    TU_CHECK(sm_model_new(&m, &sp.st, &o, &d) == SM_INVALID_INPUT &&
+                 !strcmp(d.field, "rotary_inertia"),
              "rotary_inertia 7: input error at rotary_inertia (%s)", d.message);
     sm_model_free(m);
 }
