@@ -195,6 +195,11 @@ typedef struct sm_structure {
     const double *joint_z;           /* n_joints z coordinates (m) or NULL (all zero) */
     int n_supports;                  /* elastic supports (sm_support), 0 for none */
     const sm_support *supports;      /* n_supports, may be NULL if 0 */
+    /* 1: the clamp joint is not held by the hub but rests on the point supports at it (an elastic
+     * clamp, a floating platform: their 6x6 stiffness and mass about the clamp joint, hub axes),
+     * six more coordinates (its translation and rotation) ahead of the modal ones (DESIGN.md
+     * 8.6).  Spatial structures, analysed at rest (speeds 0) only. */
+    int base_free;
 } sm_structure;
 
 typedef enum sm_frame_scheme {

@@ -125,6 +125,8 @@ struct sm_model {
     const struct smi_kind *kind; /* planar or spatial (kind.h): picked by mesh_build */
     int n_pt;           /* spatial: points = the FE nodes (0 .. n_nodes-1) + quadrature points */
     struct sp_point *pt; /* spatial: n_pt points (spatial.h) */
+    int base;            /* 6 when the clamp joint moves (sm_structure.base_free): q[0..5] its
+                           translation and rotation, hub axes; 0 otherwise */
     /* elastic supports (supports.c, DESIGN.md 8.6); has_supports 0: none, all empty */
     int has_supports;
     int n_sup;             /* nodes with a support */

@@ -81,8 +81,10 @@ static int model_mesh(sm_model **out, const sm_structure *st, const sm_options *
     if (!(m->opt.tolerance > 0))
         m->opt.tolerance = 1e-10;
     int rc = mesh_build(m, st, d);
-    if (rc == SM_OK)
+    if (rc == SM_OK) {
+        m->base = st->base_free ? 6 : 0;
         rc = supports_lump(m, st);
+    }
     if (rc < 0) {
         sm_model_free(m);
         return rc;
@@ -147,6 +149,7 @@ int sm_structure_check(const sm_structure *st, const sm_options *opt, sm_model_i
         return model_fail(d, rc);
     if (info) {
         model_mesh_info(m, info);
+        info->coordinates = m->base;
         for (int s = 0; s < m->n_subs; s++) {
             int nm, na, k = m->kind->count(&m->opt, &m->subs[s], &nm, &na);
             info->coordinates += k;

@@ -18,7 +18,7 @@ static int modes_fail(sm_diag *d, int rc, const char *msg)
 
 int modes_build(sm_model *m, sm_progress_fn cb, void *user, sm_diag *d)
 {
-    int rc = SM_OK, q0 = 0;
+    int rc = SM_OK, q0 = m->base; /* a free base's coordinates come first */
     for (int s = 0; s < m->n_subs && rc == SM_OK; s++) {
         if (cb && s > 0 && cb(user, s, m->n_subs)) {
             d->status = SM_CANCELED;

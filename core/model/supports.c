@@ -105,10 +105,8 @@ int supports_check(const sm_structure *st, const sm_options *o, sm_diag *d)
                 return rc;
             if (!st->spatial && (s->K[35] != 0 || s->M[35] != 0 || s->K[5] != 0 || s->K[11] != 0 ||
                                  s->M[5] != 0 || s->M[11] != 0))
-                return smi_input_fail(d, SM_ITEM_SUPPORT, i, s->K[35] != 0 || s->K[5] != 0 ||
-                                                                     s->K[11] != 0
-                                                                 ? "K"
-                                                                 : "M",
+                return smi_input_fail(d, SM_ITEM_SUPPORT, i,
+                                      s->K[35] != 0 || s->K[5] != 0 || s->K[11] != 0 ? "K" : "M",
                                       "a rotational support needs spatial sections: the planar "
                                       "basis condenses the rotations of its nodes (DESIGN.md 1.2)");
             continue;
@@ -121,6 +119,38 @@ int supports_check(const sm_structure *st, const sm_options *o, sm_diag *d)
         double dz = st->joint_z ? st->joint_z[b->to] - st->joint_z[b->from] : 0.0;
         if ((rc = sup_check_foundation(s, i, sqrt(dx * dx + dy * dy + dz * dz), d)) < 0)
             return rc;
+    }
+    if (st->base_free) {
+        int held = 0;
+        if (!st->spatial)
+            return smi_input_fail(d, SM_ITEM_CLAMP, -1, "",
+                                  "a free base (elastic clamp, floating platform) needs spatial "
+                                  "sections");
+        double Kb[36] = {0};
+        for (int i = 0; i < st->n_supports; i++)
+            if (st->supports[i].joint == st->clamp) {
+                held = 1;
+                for (int c = 0; c < 36; c++)
+                    Kb[c] += st->supports[i].K[c];
+            }
+        if (held && sup_symmetric(Kb) && !(sup_lowest(Kb) > 1e-12))
+            return smi_input_fail(
+                d, SM_ITEM_CLAMP, -1, "",
+                "a free base needs stiffness in all six directions at the clamp "
+                "joint (hydrostatic and mooring for a platform): rigid-body modes "
+                "at zero frequency are not supported yet");
+        if (!held)
+            return smi_input_fail(d, SM_ITEM_CLAMP, -1, "",
+                                  "a free base needs a point support at the clamp joint (its "
+                                  "stiffness and mass)");
+        for (int i = 0; i < st->n_point_masses; i++) {
+            const sm_point_mass *p = &st->point_masses[i];
+            if (p->joint == st->clamp &&
+                (p->offset[0] != 0 || p->offset[1] != 0 || p->offset[2] != 0))
+                return smi_input_fail(d, SM_ITEM_POINT_MASS, i, "offset",
+                                      "a point mass at a free base's clamp joint cannot be offset: "
+                                      "give the platform's mass as the support's 6x6 mass");
+        }
     }
     if (st->n_supports > 0 && o->solver == SM_SOLVER_TREE)
         return smi_input_fail(d, SM_ITEM_OPTIONS, -1, "solver",
@@ -216,7 +246,8 @@ int supports_lump(sm_model *m, const sm_structure *st)
     if (!kn || !mn)
         goto done;
     sup_spread(m, st, kn, mn);
-    for (int nd = 1; nd < m->n_nodes; nd++) /* node 0, the clamp, does not move */
+    for (int nd = m->base ? 0 : 1; nd < m->n_nodes; nd++) /* node 0, the clamp, moves with a
+                                                               free base only */
         for (int c = 0; c < 36; c++)
             if (kn[36 * nd + c] != 0.0 || mn[36 * nd + c] != 0.0) {
                 count++;
@@ -228,7 +259,7 @@ int supports_lump(sm_model *m, const sm_structure *st)
     if (!m->sup_node || !m->sup_k || !m->sup_m)
         goto done;
     m->n_sup = 0;
-    for (int nd = 1; nd < m->n_nodes; nd++)
+    for (int nd = m->base ? 0 : 1; nd < m->n_nodes; nd++)
         for (int c = 0; c < 36; c++)
             if (kn[36 * nd + c] != 0.0 || mn[36 * nd + c] != 0.0) {
                 m->sup_node[m->n_sup] = nd;
@@ -252,8 +283,7 @@ static void sup_congruence(int n, int nd, const double *J, const double a[36], d
 
     for (int j = 0; j < nd; j++)
         for (int i = 0; i < nd; i++)
-            s[i + nd * j] = nd == 6 ? a[i + 6 * j]
-                                    : a[sup_planar_dof[i] + 6 * sup_planar_dof[j]];
+            s[i + nd * j] = nd == 6 ? a[i + 6 * j] : a[sup_planar_dof[i] + 6 * sup_planar_dof[j]];
     cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, n, nd, nd, 1.0, J, n, s, nd, 0.0, T, n);
     cblas_dgemm(CblasColMajor, CblasNoTrans, CblasTrans, n, n, nd, 1.0, T, n, J, n, 1.0, Out->a, n);
 }

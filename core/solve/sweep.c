@@ -292,6 +292,17 @@ int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress
             snprintf(d->message, sizeof d->message, "speeds must be finite and non-negative (rad/s)");
             return SM_INVALID_INPUT;
         }
+    for (int i = 0; m->base && i < n_omegas; i++)
+        if (omegas[i] != 0) { /* the base's kinematics are linearised at rest (DESIGN.md 8.6) */
+            d->status = SM_INVALID_INPUT;
+            d->item = SM_ITEM_OPTIONS;
+            d->item_index = i;
+            snprintf(d->field, sizeof d->field, "omega");
+            snprintf(d->message, sizeof d->message,
+                     "a structure on a free base (elastic clamp, floating platform) is analysed at "
+                     "rest only: speeds must be 0");
+            return SM_INVALID_INPUT;
+        }
     int rc = SM_NOMEM, n = m->n;
     sm_result *r = calloc(1, sizeof *r);
     sweep_key *key = malloc((size_t)n_omegas * sizeof *key);

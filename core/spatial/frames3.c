@@ -408,16 +408,22 @@ void sp_eval(const sm_model *m, const double *q, sp_kin *k)
     double a[3];
     for (int c = 0; c < m->n_subs; c++) { /* child frames at node e of their parent: R_c = r_e */
         int s = m->subs[c].parent, e = m->subs[c].root;
-        if (s < 0)
+        if (s < 0) { /* a free base moves the root frames rigidly about the clamp (at rest) */
+            for (int i = 0; i < m->base; i++)
+                DM(&k->JRT, i, 6 * c + i) = 1.0;
             continue;
+        }
         double *JRc = &DM(&k->JRT, 0, 6 * c);
         sp_offset(k, e, s, a);
         sp_jac_carry(m, k, s, &m->pt[e], k->AT + 9 * e, a, NULL, JRc, JRc + 3 * (size_t)m->n);
     }
     for (int pi = 0; pi < m->n_pt; pi++) {
         int s = m->pt[pi].sub;
-        if (s < 0)
+        if (s < 0) { /* the clamp point: with a free base it is the base */
+            for (int i = 0; i < m->base; i++)
+                DM(&k->JW, i, 6 * pi + i) = 1.0;
             continue;
+        }
         double *Jp = &DM(&k->JW, 0, 6 * pi);
         sp_offset(k, pi, s, a);
         sp_jac_carry(m, k, s, &m->pt[pi], k->AT + 9 * pi, a, m->pt[pi].has_c ? k->dh + 3 * pi : NULL, Jp,

@@ -117,6 +117,10 @@ void lin3_geometric_tangent(const sm_model *m, const double *q, int frozen, dmat
 void lin3_hub_inertia(const sm_model *m, const sp_kin *k, int pi, double X[9])
 {
     const sp_point *p = &m->pt[pi];
+    if (p->sub < 0) { /* a free base's clamp point, at rest: I is in hub axes */
+        memcpy(X, p->I, 9 * sizeof(double));
+        return;
+    }
     sp_cx psi[3] = {k->psi[3 * pi], k->psi[3 * pi + 1], k->psi[3 * pi + 2]}, L[9], AL[9], Ic[9], t[9], u[9];
     for (int i = 0; i < 9; i++)
         Ic[i] = p->I[i];
@@ -163,7 +167,7 @@ void lin3_mass(const sm_model *m, const sp_kin *k, dmat *M, dmat *Y)
     dm_zero(Y);
     for (int pi = 0; pi < m->n_pt; pi++) {
         const sp_point *p = &m->pt[pi];
-        if (p->sub < 0)
+        if (p->sub < 0 && !m->base) /* the clamp, unless the base is free */
             continue;
         double mI[9] = {p->mass, 0, 0, 0, p->mass, 0, 0, 0, p->mass}, X[9];
         const double *J = &DM(&k->JW, 0, 6 * pi);
@@ -182,7 +186,7 @@ void lin3_gyro(const sm_model *m, const sp_kin *k, double omega, dmat *C, dmat *
     dm_zero(Y);
     for (int pi = 0; pi < m->n_pt; pi++) {
         const sp_point *p = &m->pt[pi];
-        if (p->sub < 0)
+        if (p->sub < 0 && !m->base) /* the clamp, unless the base is free */
             continue;
         /* 2 m S, S = skew(e_z) */
         double S2[9] = {0, 2 * p->mass, 0, -2 * p->mass, 0, 0, 0, 0, 0}, X[9], Yp[9];

@@ -384,6 +384,10 @@ int modes3_points(sm_model *m)
         p->sub = nd->sub;
         if (nd->sub < 0) { /* the clamp: fixed at its hub position */
             p->ub[0] = nd->x, p->ub[1] = nd->y, p->ub[2] = nd->z;
+            if (m->base) { /* a free base: its mass and inertia (hub axes) move with it */
+                p->mass = consistent ? nd->point_mass : nd->mass;
+                memcpy(p->I, consistent ? nd->point_rot : nd->rot, sizeof p->I);
+            }
             continue;
         }
         const sm_sub *b = &m->subs[nd->sub];

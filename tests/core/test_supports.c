@@ -221,8 +221,8 @@ static void test_tip_spring(void)
             continue;
         double want = lam[f] * lam[f] / (SUP_L * SUP_L) * sqrt(SUP_EIF / SUP_MU);
         TU_NEAR(c->frequency[j], want, 1e-3 * want,
-                "tip spring kL^3/EI = %g: flap mode %d (lambda %.6f), 96 lumped elements", K,
-                f + 1, lam[f]);
+                "tip spring kL^3/EI = %g: flap mode %d (lambda %.6f), 96 lumped elements", K, f + 1,
+                lam[f]);
         f++;
     }
 done:
