@@ -315,6 +315,49 @@ json_t *val_request(const json_t *root, const codec_limits *lim, codec_errors *e
  */
 void val_structure(val_ctx *v, const json_t *root, json_t *canon);
 
+/* ===================================================== supports.c: sup_ */
+
+/**
+ * structure.springs (optional) of the input structure st (borrowed) checked into cst["springs"]:
+ * joint (one of joints), stiffness and added_mass (6x6 rows or {translational, rotational}),
+ * axes ("hub" or "member:ID").  Call after the members (v->spatial known).
+ */
+void sup_springs(val_ctx *v, const json_t *st, const json_t *joints, json_t *cst);
+
+/**
+ * mem's "foundation" (present) at p/foundation: one stretch object or an array of them, checked
+ * into c["foundation"]; len the member's length (0 when its joints are not known).
+ */
+void sup_foundation(val_ctx *v, const json_t *mem, const char *p, json_t *c, double len);
+
+/** The joint table sup_build reads (request.c's sorted names and coordinates, borrowed). */
+typedef struct sup_joints {
+    const char **names; /* n, sorted */
+    int n;
+    const double *xy; /* 2n, hub frame, m */
+    const double *z;  /* n or NULL */
+} sup_joints;
+
+/**
+ * The core's supports of a valid canonical structure st (borrowed): the springs in order, then
+ * each member's foundation stretches; *out malloc'd (NULL when none), *n its length.  SM_OK or
+ * SM_NOMEM.
+ */
+int sup_build(const json_t *st, const sup_joints *J, sm_support **out, int *n);
+
+/**
+ * The pointer of core support index (sup_build's order) and core field ("K", "k_per_length"
+ * ...) in the structure st (borrowed); malloc'd, NULL when out of memory.
+ */
+char *sup_pointer(const json_t *st, int index, const char *field);
+
+/**
+ * The reserved supports of the input structure st (borrowed): "platform" and an elastic
+ * ({joint, stiffness, mass}) or absent (null) clamp are "not supported yet" errors.  1 when the
+ * clamp was one of those (the caller then skips its joint check).
+ */
+int sup_reserved(val_ctx *v, const json_t *st);
+
 /* ========================================================= size.c: size_ */
 
 /**

@@ -139,8 +139,9 @@ static char *diag_pointer(const codec_request *r, const sm_diag *d, const char *
     int i = d->item_index;
     char *base, *p;
 
-    static const char *const member_fields[] = {"id", "from", "to", "section", "elements",
-                                                "twist_deg", "flap_direction", "stations", NULL};
+    static const char *const member_fields[] = {
+        "id",        "from",           "to",       "section",    "elements",
+        "twist_deg", "flap_direction", "stations", "foundation", NULL};
     static const char *const pm_fields[] = {"joint", "mass", "inertia", "products", "offset",
                                             NULL};
     const char *const *known;
@@ -172,6 +173,8 @@ static char *diag_pointer(const codec_request *r, const sm_diag *d, const char *
         break;
     case SM_ITEM_CLAMP:
         return strdup("/structure/clamp");
+    case SM_ITEM_SUPPORT: /* springs, then foundations (supports.c) */
+        return sup_pointer(req_structure(r), i, f);
     case SM_ITEM_OPTIONS:
         return diag_options_pointer(r, f, i);
     case SM_ITEM_NONE:

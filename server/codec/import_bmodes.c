@@ -36,6 +36,7 @@
 
 #define BM_MAX_ELEMENTS 10000 /* nselt */
 #define BM_COLUMNS 13
+#define BM_MAX_WIRES 16 /* n_attachments (BModes' comment line says at most 2) */
 
 /* Reading one file of BModes. */
 typedef struct bm_in {
@@ -113,6 +114,8 @@ typedef struct bm_main {
     int beam_line;   /* line of beam_type */
     unsigned tw_zeroed; /* tower: columns (1 << column) the file gives and BModes overwrites */
     int tw_zeroed_line; /* the first line with one of them */
+    long n_att;         /* tow_support 1: wire-attachment locations, 0 without */
+    double wire[4][BM_MAX_WIRES]; /* n_wires, node_attach, wire_stfness, th_wire (deg) */
 } bm_main;
 
 static const char *const bm_mult_names[10] = {
@@ -298,11 +301,53 @@ static void bm_tower_row(bm_main *m, double raw[BM_COLUMNS], int line)
 }
 
 /*
- * A tower's support (BModes.f90:503-612, read after el_loc): tow_support 0 (none) is imported;
- * 1 (tension guy wires) and 2 (monopile or floating platform) need elastic supports that the
- * solver does not have yet and are refused at that line.  A blade has no such lines.
+ * Tension wires (tow_support 1, BModes.f90:573-611): a comment line, n_attachments, then one line
+ * each of n_wires, node_attach, wire_stfness, th_wire with n_attachments numbers, checked as
+ * BModes checks them (n_wires >= 3, 1 < node_attach <= nselt + 1, th_wire 0..90 deg).
  */
-static int bm_support(bm_in *b, const bm_main *m)
+static int bm_wires(bm_in *b, bm_main *m)
+{
+    static const char *const name[4] = {"n_wires", "node_attach", "wire_stfness", "th_wire"};
+    imp_tok t[IMP_MAX_TOKENS];
+    int st, k, i, n;
+    double x;
+
+    if ((st = bm_com(b, "tension-wires data")) ||
+        (st = bm_int(b, "n_attachments", 0, BM_MAX_WIRES, &m->n_att)))
+        return st;
+    for (k = 0; k < 4; k++) {
+        if (!imp_next_nonblank(&b->r))
+            return bm_ends(b, name[k]);
+        n = imp_split(b->r.s, b->r.n, ",", t, IMP_MAX_TOKENS);
+        if (n < m->n_att)
+            return imp_fail(b->d, b->file, b->r.line, name[k],
+                            "%ld numbers expected "
+                            "(n_attachments), got %d",
+                            m->n_att, n);
+        for (i = 0; i < m->n_att; i++) {
+            if ((st = imp_value(b->d, b->file, b->r.line, name[k], &t[i], IMP_NONNEG, &x)))
+                return st;
+            if ((k == 0 && (x != floor(x) || x < 3)) ||
+                (k == 1 && (x != floor(x) || x <= 1 || x > (double)m->nselt + 1)) ||
+                (k == 3 && x > 90))
+                return imp_fail(b->d, b->file, b->r.line, name[k], "%.15g: %s", x,
+                                k == 0   ? "must be an integer, 3 or more (BModes.f90:598)"
+                                : k == 1 ? "must be an integer node number above 1 and at most "
+                                           "nselt + 1 (BModes.f90:599-600)"
+                                         : "must be 0 to 90 degrees (BModes.f90:601)");
+            m->wire[k][i] = x;
+        }
+    }
+    return SM_OK;
+}
+
+/*
+ * A tower's support (BModes.f90:503-612, read after el_loc): tow_support 0 (none) and 1
+ * (tension guy wires, bm_wires) are imported; 2 (monopile or floating platform) needs a
+ * platform and a free base that the solver does not have yet and is refused at that line.  A
+ * blade has no such lines.
+ */
+static int bm_support(bm_in *b, bm_main *m)
 {
     imp_tok t[2];
     double x;
@@ -336,20 +381,16 @@ static int bm_support(bm_in *b, const bm_main *m)
                         "must be an integer in [0, 2] (%.15g)", x);
     ts = (long)x;
     if (ts == 1)
-        return imp_fail(b->d, b->file, b->r.line, "tow_support",
-                        "1 (tension guy wires) is not "
-                        "supported yet: the wires are springs on the tower (n_attachments, "
-                        "n_wires, node_attach, wire_stfness, th_wire) and the solver has no "
-                        "elastic supports yet (issue 25); tow_support 0 imports the tower "
-                        "without them");
+        return bm_wires(b, m);
     if (ts == 2)
         return imp_fail(b->d, b->file, b->r.line, "tow_support",
                         "2 (offshore support: "
-                        "monopile or floating platform) is not supported yet: the platform's "
-                        "mass, hydrodynamic and mooring matrices and the distributed soil "
-                        "springs need elastic supports and a free base, which the solver does "
-                        "not have yet (issue 25); tow_support 0 imports the tower clamped at "
-                        "its base");
+                        "monopile or floating platform) is not supported yet: BModes reads a "
+                        "platform (draft, mass, 6x6 hydrodynamic and mooring matrices) with "
+                        "every monopile, and a platform needs a free base, which the solver "
+                        "does not have yet (issue 25); the tower form's \"foundation\" takes "
+                        "the distributed soil springs and added mass; tow_support 0 imports the "
+                        "tower clamped at its base");
     return SM_OK;
 }
 
@@ -609,6 +650,58 @@ static int bm_tower_own_offset(json_t *doc, const bm_main *m)
                     m->tip[2], m->tip[2], m->tip[1]);
 }
 
+/*
+ * The tension wires (tow_support 1) into doc's request: without own (bmodes_mesh 0) the tower
+ * form's "wires", each at height hub_rad + el_loc[node_attach - 1] (radius - hub_rad) (BModes'
+ * node_attach counts el_loc's boundaries from the base, BldVib.f90:668); with own, BModes' own
+ * model's springs at its joint of that boundary, count stiffness cos^2(th_wire) in fore-aft (hub
+ * z) and side-side (hub x), the spring BModes adds (BModes.f90:607-611, BldVib.f90:667-674).
+ * 0 or -1 (memory).
+ */
+static int bm_tower_wires(json_t *doc, const bm_main *m, const json_t *el_loc, int own)
+{
+    json_t *req = json_object_get(doc, "request"), *arr = json_array();
+    long i;
+
+    if (!arr)
+        return -1;
+    for (i = 0; i < m->n_att; i++) {
+        size_t node = (size_t)m->wire[1][i] - 1;
+        double x = json_number_value(json_array_get(el_loc, node)), c, k[3];
+        char name[32];
+        json_t *w;
+        if (!own) {
+            w = json_pack("{s:f, s:I, s:f, s:f}", "height",
+                          imp_round(m->hub_rad + x * (m->radius - m->hub_rad)), "count",
+                          (json_int_t)m->wire[0][i], "stiffness", m->wire[2][i], "angle_deg",
+                          m->wire[3][i]);
+        } else {
+            c = cos(m->wire[3][i] * 0.017453292519943295769);
+            k[0] = k[2] = m->wire[0][i] * m->wire[2][i] * c * c;
+            k[1] = 0.0;
+            if (node + 1 == json_array_size(el_loc))
+                snprintf(name, sizeof name, "top");
+            else
+                snprintf(name, sizeof name, "x%zu", node);
+            w = json_pack("{s:s, s:{s:[f, f, f]}}", "joint", name, "stiffness", "translational",
+                          k[0], k[1], k[2]);
+        }
+        if (!w || json_array_append_new(arr, w)) {
+            json_decref(arr);
+            return -1;
+        }
+    }
+    if (!m->n_att) {
+        json_decref(arr);
+        return 0;
+    }
+    return json_object_set_new(own ? json_object_get(req, "structure")
+                                   : json_object_get(req, "tower"),
+                               own ? "springs" : "wires", arr)
+               ? -1
+               : 0;
+}
+
 /* "source": what the .bmi said that the request does not carry. */
 static json_t *bm_source(const bm_main *m, const char *bmi, json_t *el_loc)
 {
@@ -716,6 +809,8 @@ int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void
         if (!st && bm_mesh_warnings(*out, m.tower))
             st = SM_NOMEM;
     }
+    if (!st && m.tower && bm_tower_wires(*out, &m, el_loc, o->bmodes_mesh > 0))
+        st = SM_NOMEM;
     if (st && *out) {
         json_decref(*out);
         *out = NULL;

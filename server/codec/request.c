@@ -41,6 +41,7 @@ struct codec_request {
     sm_section *sections;       /* n_sections */
     sm_member *members;         /* n_members */
     sm_point_mass *point_masses;/* n_point_masses (NULL if 0) */
+    sm_support *supports;       /* n_supports (NULL if 0): springs, then foundations */
     sm_station *stations;       /* every member's stations, member after member (or NULL) */
     double *speeds;             /* n_speeds, request order, rad/s */
     double *rpm;                /* n_speeds, the same in rev/min */
@@ -248,6 +249,12 @@ static int req_build_structure(codec_request *r)
     r->st.point_masses = r->point_masses;
     r->st.clamp = req_name_index(r->joint_names, nj,
                                  json_string_value(json_object_get(st, "clamp")));
+    {
+        sup_joints J = {r->joint_names, nj, r->joint_xy, r->joint_z};
+        if (sup_build(st, &J, &r->supports, &r->st.n_supports))
+            return SM_NOMEM;
+        r->st.supports = r->supports;
+    }
     return req_build_stations(r, mems);
 }
 
@@ -730,6 +737,7 @@ void codec_request_free(codec_request *r)
     json_decref(r->structure);
     json_decref(r->warnings);
     free(r->point_masses);
+    free(r->supports);
     free(r->members);
     free(r->sections);
     free(r->joint_xy);

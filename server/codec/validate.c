@@ -309,8 +309,9 @@ static void val_member(val_ctx *v, const json_t *mem, size_t i, const json_t *jo
                        const json_t *secs, json_t *cm, json_t *ids, json_t *ends,
                        int *ends_ok, long *total)
 {
-    static const char *const keys[] = {"id", "from", "to", "section", "elements", "twist_deg",
-                                       "flap_direction", "stations", NULL};
+    static const char *const keys[] = {
+        "id",        "from",           "to",       "section",    "elements",
+        "twist_deg", "flap_direction", "stations", "foundation", NULL};
     char *p = err_ptr_idx("/structure/members", i);
     const json_t *id;
     const char *from, *to;
@@ -368,6 +369,12 @@ static void val_member(val_ctx *v, const json_t *mem, size_t i, const json_t *jo
             field_error(v, p, "zero-length member: joints '%s' and '%s' are at the same position",
                         field_short_name(from).s, field_short_name(to).s);
     }
+    if (json_object_get(mem, "foundation")) /* supports.c; its length when its joints are known */
+        sup_foundation(v, mem, p, c,
+                       from && to && val_joint_pos(joints, from, a) && val_joint_pos(joints, to, b)
+                           ? sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
+                                  (b[2] - a[2]) * (b[2] - a[2]))
+                           : 0.0);
 done:
     free(p);
     if (c && cm && json_array_append_new(cm, c))
@@ -539,8 +546,8 @@ static void val_unused_joints(val_ctx *v, const json_t *joints, const json_t *en
 /* The structure object. */
 void val_structure(val_ctx *v, const json_t *root, json_t *canon)
 {
-    static const char *const keys[] = {"joints", "sections", "members", "point_masses",
-                                       "clamp", NULL};
+    static const char *const keys[] = {"joints", "sections", "members",  "point_masses",
+                                       "clamp",  "springs",  "platform", NULL};
     const json_t *st = field_object(v, root, "structure", "");
     const json_t *joints, *secs, *clamp;
     const char *first_z;
@@ -564,6 +571,7 @@ void val_structure(val_ctx *v, const json_t *root, json_t *canon)
     if (ends)
         val_members(v, st, joints, secs, cst, ends, &ends_ok);
     val_point_masses(v, st, joints, cst);
+    sup_springs(v, st, joints, cst);
     if (ends_ok)
         val_unused_joints(v, joints, ends);
     clamp = json_object_get(st, "clamp");
@@ -572,7 +580,8 @@ void val_structure(val_ctx *v, const json_t *root, json_t *canon)
         !json_object_get(ends, json_string_value(clamp)))
         field_error(v, "/structure/clamp", "joint '%s' is not an end of any member",
                     field_short_name(json_string_value(clamp)).s);
-    field_ref(v, st, "clamp", "/structure", cst, joints, "joint");
+    if (!sup_reserved(v, st))
+        field_ref(v, st, "clamp", "/structure", cst, joints, "joint");
     json_decref(ends);
     json_decref(cover);
     v->cover = NULL;

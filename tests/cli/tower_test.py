@@ -14,7 +14,7 @@ Usage: tower_test.py SPINMODAL REFERENCE_BLADES_DIR
   every mode, torsion included, and doubling ixx_tip
   (BModes' "tower s-s" moment, about the fore-aft x axis) lowers the mode BModes prints in
   its "s-s" column and ours labels "edge" (side-side), not the fore-aft one.
-- Bad files: a tower file given as a blade and the reverse, guy wires (tow_support 1), a
+- Bad files: a tower file given as a blade and the reverse, two guy wires a set (BModes wants 3), a
   rotor speed for a tower: each refused with FILE:LINE: FIELD.
 """
 import json
@@ -139,8 +139,10 @@ def bad_files(exe, ref, tmp):
               "6) is 1 (blade)"),
              ("blade_as_tower.bmi", blade.replace("1         beam_type", "2         beam_type"),
               "blade_as_tower.bmi:51: tow_support: missing: beam_type (line 6) is 2 (tower)"),
-             ("wires.bmi", tower.replace("0         tow_support", "1         tow_support"),
-              "wires.bmi:51: tow_support: 1 (tension guy wires) is not supported yet"),
+             ("wires.bmi", tower.replace("0         tow_support", "1         tow_support")
+              .replace("0         n_attachments", "1         n_attachments")
+              .replace("3 3       n_wires", "2 3       n_wires"),
+              "wires.bmi:54: n_wires: 2: must be an integer, 3 or more (BModes.f90:598)"),
              ("platform.bmi", tower.replace("0         tow_support", "2         tow_support"),
               "platform.bmi:51: tow_support: 2 (offshore support: monopile or floating platform) "
               "is not supported yet"))
