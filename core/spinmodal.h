@@ -486,6 +486,10 @@ typedef struct sm_case {
     int *label_ordinal;       /* 1-based count among the modes of the same kind of this case in
                                  ascending frequency; 0 for SM_MODE_COUPLED */
     double *label_confidence; /* the dominant strain fraction */
+    double *support_share;    /* n_modes: the elastic supports' share of the mode's strain energy
+                                 (their springs over springs + members; DESIGN.md 8.7), NULL for a
+                                 model without supports; the members' fractions in energy and
+                                 the label stay the members' own */
     int *tracked_index;       /* the Campbell line (tracked mode) this mode belongs to, 0-based */
     int *track_flag;          /* 0, SM_TRACK_CROSSING or SM_TRACK_VEERING */
     int *track_partner;       /* tracked index of the other mode of the flagged pair, or -1 */

@@ -95,8 +95,28 @@ static void lab_element(const sm_model *m, const sm_case *c, int el, const doubl
     K->label_strain(E, v, w, tx, r2, r3, e);
 }
 
-/* Energy fractions of one nodal shape (re, and im or NULL) into f[SM_ENERGY_PARTS]. */
-static void lab_energy(const sm_model *m, const sm_case *c, const double *re, const double *im, double f[SM_ENERGY_PARTS])
+/* The supports' strain energy x' K x (the members' convention: no 1/2) of the nodal shape s. */
+static double lab_support(const sm_model *m, const double *s)
+{
+    static const int planar_dof[3] = {0, 1, 5};
+    int nd = m->kind->node_dof;
+    double e = 0;
+
+    for (int i = 0; i < m->n_sup; i++) {
+        const double *K = m->sup_k + 36 * i, *x = s + (size_t)nd * m->sup_node[i];
+        for (int a = 0; a < nd; a++)
+            for (int b = 0; b < nd; b++) {
+                int ra = nd == 6 ? a : planar_dof[a], rb = nd == 6 ? b : planar_dof[b];
+                e += x[a] * K[ra + 6 * rb] * x[b];
+            }
+    }
+    return e;
+}
+
+/* Energy fractions of one nodal shape (re, and im or NULL) into f[SM_ENERGY_PARTS]; *support
+ * (may be NULL) = the supports' share of the strain energy. */
+static void lab_energy(const sm_model *m, const sm_case *c, const double *re, const double *im,
+                       double f[SM_ENERGY_PARTS], double *support)
 {
     double e[SM_ENERGY_PARTS] = {0};
 
@@ -114,6 +134,11 @@ static void lab_energy(const sm_model *m, const sm_case *c, const double *re, co
         double sum = e[4 * h] + e[4 * h + 1] + e[4 * h + 2] + e[4 * h + 3];
         for (int k = 0; k < 4; k++)
             f[4 * h + k] = sum > 0 ? e[4 * h + k] / sum : 0.0;
+    }
+    if (support) {
+        double es = lab_support(m, re) + (im ? lab_support(m, im) : 0.0);
+        double all = es + e[4] + e[5] + e[6] + e[7];
+        *support = all > 0 ? es / all : 0.0;
     }
 }
 
@@ -145,11 +170,14 @@ int lab_case(const sm_model *m, sm_case *c)
     c->label_kind = malloc((size_t)k * sizeof(int));
     c->label_ordinal = malloc((size_t)k * sizeof(int));
     c->label_confidence = malloc((size_t)k * sizeof(double));
+    if (m->has_supports && !(c->support_share = malloc((size_t)k * sizeof(double))))
+        return SM_NOMEM;
     if (!c->energy || !c->label_kind || !c->label_ordinal || !c->label_confidence)
         return SM_NOMEM;
     for (int j = 0; j < k; j++) { /* modes are in ascending frequency: ordinals count up */
         double *f = c->energy + (size_t)j * SM_ENERGY_PARTS;
-        lab_energy(m, c, c->shape_re + j * stride, c->shape_im ? c->shape_im + j * stride : NULL, f);
+        lab_energy(m, c, c->shape_re + j * stride, c->shape_im ? c->shape_im + j * stride : NULL, f,
+                   c->support_share ? c->support_share + j : NULL);
         c->label_kind[j] = lab_kind(m, f, &c->label_confidence[j]);
         c->label_ordinal[j] = c->label_kind[j] == SM_MODE_COUPLED ? 0 : ++count[c->label_kind[j]];
     }

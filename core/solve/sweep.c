@@ -42,6 +42,7 @@ void sm_result_free(sm_result *r)
         free(c->label_kind);
         free(c->label_ordinal);
         free(c->label_confidence);
+        free(c->support_share);
         free(c->tracked_index);
         free(c->track_flag);
         free(c->track_partner);

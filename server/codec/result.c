@@ -158,7 +158,7 @@ static json_t *res_parts(const double *f, int spatial)
 
 /*
  * DESIGN.md 9.1, appended to mode k: "label", "label_confidence", "energy" {"kinetic",
- * "strain"}, "tracked_index", "tracking_flag" ("crossing", "veering" or null) and
+ * "strain", and "support" for a model with supports (DESIGN.md 8.7)}, "tracked_index", "tracking_flag" ("crossing", "veering" or null) and
  * "tracking_partner" (the other tracked index of the flagged pair, or null).  Nothing for a
  * case the core gave no labels (hand-built results).  Returns 0, or -1 out of memory.
  */
@@ -176,6 +176,10 @@ static int res_trust(json_t *md, const sm_case *c, int k)
             json_object_set_new(md, "energy", json_pack("{s:o, s:o}", "kinetic",
                                                         res_parts(f, spatial), "strain",
                                                         res_parts(f + 4, spatial))))
+            return -1;
+        if (c->support_share && /* DESIGN.md 8.7: only models with supports */
+            json_object_set_new(json_object_get(md, "energy"), "support",
+                                res_real(c->support_share[k])))
             return -1;
     }
     if (c->tracked_index) {

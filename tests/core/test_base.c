@@ -83,7 +83,8 @@ static void test_rigid(void)
     b.sup.K[0 + 6 * 5] = b.sup.K[5 + 6 * 0] = 1e6; /* surge-yaw coupling, still definite */
     sm_diag d;
     sm_result *r = base_solve(&b.st, 6, 0.0, &d);
-    TU_CHECK(r && r->cases[0].status == SM_CASE_SOLVED, "solved: %s", r ? r->cases[0].message : d.message);
+    TU_CHECK(r && r->cases[0].status == SM_CASE_SOLVED, "solved: %s",
+             r ? r->cases[0].message : d.message);
     if (!r || r->cases[0].status != SM_CASE_SOLVED)
         goto done;
     /* by hand: M = Mp + sum_k m_k [I, -[r]x; [r]x, -[r]x[r]x] over the lumped nodes r_k = (0, y_k, 0) */
@@ -107,8 +108,13 @@ static void test_rigid(void)
     }
     TU_CHECK(LAPACKE_dsygv(LAPACK_COL_MAJOR, 1, 'N', 'L', 6, A, 6, B, 6, w) == 0, "dsygv");
     for (int j = 0; j < 6; j++)
+        TU_CHECK(r->cases[0].support_share && r->cases[0].support_share[j] > 0.99999,
+                 "rigid-body mode %d: the supports hold the strain energy (share %.9f)", j + 1,
+                 r->cases[0].support_share ? r->cases[0].support_share[j] : -1.0);
+    for (int j = 0; j < 6; j++)
         TU_NEAR(r->cases[0].frequency[j], sqrt(w[j]), 1e-5 * sqrt(w[j]),
-                "rigid mast on a platform: mode %d (rad/s) against the 6x6 rigid-body problem", j + 1);
+                "rigid mast on a platform: mode %d (rad/s) against the 6x6 rigid-body problem",
+                j + 1);
 done:
     sm_result_free(r);
 }
@@ -116,8 +122,8 @@ done:
 /* det of the spring-hinged cantilever's boundary matrix at lambda = beta L, kappa = k L / EI */
 static double base_det(double l, double kap)
 {
-    double a[16] = {1, -l, -cos(l), sin(l),    0,  -kap, -sin(l),  -cos(l),
-                    1, l,  cosh(l), sinh(l),   0,  -kap, sinh(l),  cosh(l)};
+    double a[16] = {1, -l, -cos(l), sin(l),  0, -kap, -sin(l), -cos(l),
+                    1, l,  cosh(l), sinh(l), 0, -kap, sinh(l), cosh(l)};
     int ipiv[4];
     if (LAPACKE_dgetrf(LAPACK_COL_MAJOR, 4, 4, a, 4, ipiv) != 0)
         return 0;
@@ -134,11 +140,12 @@ static void test_elastic_clamp(void)
     base_mast b;
     base_init(&b, H, 96, EI, mu);
     for (int i = 0; i < 6; i++)
-        b.sup.K[i + 6 * i] = 1e12; /* held */
+        b.sup.K[i + 6 * i] = 1e12;     /* held */
     b.sup.K[3 + 6 * 3] = kap * EI / H; /* rx: the flapwise (z) bending rotation */
     sm_diag d;
     sm_result *r = base_solve(&b.st, 6, 0.0, &d);
-    TU_CHECK(r && r->cases[0].status == SM_CASE_SOLVED, "solved: %s", r ? r->cases[0].message : d.message);
+    TU_CHECK(r && r->cases[0].status == SM_CASE_SOLVED, "solved: %s",
+             r ? r->cases[0].message : d.message);
     if (!r || r->cases[0].status != SM_CASE_SOLVED)
         goto done;
     double lam[3];

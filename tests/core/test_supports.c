@@ -157,7 +157,13 @@ static void test_foundation(int torsion)
         TU_NEAR(c1->frequency[j], want, 1e-7 * want,
                 "foundation: %s mode %d, omega (rad/s) from %.5f by sqrt(w0^2 + k/m)", names[d],
                 ++seen[d], w0);
+        /* the supports' share of the strain energy: k |phi|^2 over mu omega^2 |phi|^2 */
+        double share = k[d] / per[d] / (c1->frequency[j] * c1->frequency[j]);
+        TU_CHECK(c1->support_share && fabs(c1->support_share[j] - share) <= 1e-6,
+                 "%s mode %d: support share %.9f, want (k/m)/omega^2 = %.9f", names[d], seen[d],
+                 c1->support_share ? c1->support_share[j] : -1.0, share);
     }
+    TU_CHECK(!c0->support_share, "no support share without supports");
     TU_CHECK(torsion ? seen[3] >= 1 : seen[1] >= 2 && seen[2] >= 2 && seen[0] >= 1,
              "modes of every direction compared (axial %d edge %d flap %d torsion %d)", seen[0],
              seen[1], seen[2], seen[3]);
