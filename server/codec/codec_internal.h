@@ -418,6 +418,9 @@ void tower_check_speeds(val_ctx *v, const json_t *canon);
 
 /** The pointer p of a tower's expanded structure moved into /tower; malloc'd, NULL = NOMEM. */
 char *tower_pointer(const char *p);
+/** sm_mode_label of a mode of r's result; a tower form's flap and edge modes are named by the
+ *  direction they move: "1st fore-aft", "2nd side-side" (DESIGN.md 8.5).  Returns buf. */
+char *codec_mode_label(const codec_request *r, int kind, int ordinal, char *buf, size_t size);
 
 /** CODEC_FORM_* of a canonical (or input) request object (borrowed). */
 int tower_form(const json_t *canon);

@@ -58,13 +58,14 @@ static void csv_tail(FILE *f, double freq, double omega, double rpm)
 
 /* The columns after rpm (DESIGN.md 9.1): label, label_confidence, tracked_index (0-based, as
  * in the JSON), tracking_flag; empty where the case has none (k < 0: a row without a mode). */
-static void csv_trust(FILE *f, const sm_case *c, int k)
+static void csv_trust(FILE *f, const codec_request *r, const sm_case *c, int k)
 {
     char lab[32];
     int flag = k >= 0 && c->track_flag ? c->track_flag[k] : 0;
 
     if (k >= 0 && c->label_kind) {
-        fprintf(f, ",%s,", sm_mode_label(c->label_kind[k], c->label_ordinal[k], lab, sizeof(lab)));
+        fprintf(f, ",%s,",
+                codec_mode_label(r, c->label_kind[k], c->label_ordinal[k], lab, sizeof(lab)));
         csv_num(f, c->label_confidence[k]);
     } else {
         fputs(",,", f);
@@ -118,7 +119,7 @@ int codec_result_csv(char **out, size_t *len, const codec_request *r, const sm_r
             csv_num(f, c->omega);
             fprintf(f, ",,,,,,,%s", st);
             csv_tail(f, NAN, 0, case_rpm);
-            csv_trust(f, c, -1);
+            csv_trust(f, r, c, -1);
             csv_est(f, est, NAN);
         }
         for (k = 0; k < c->n_modes; k++) {
@@ -137,7 +138,7 @@ int codec_result_csv(char **out, size_t *len, const codec_request *r, const sm_r
                 csv_num(f, mac);
             fprintf(f, ",%s", st);
             csv_tail(f, c->frequency[k], c->omega, case_rpm);
-            csv_trust(f, c, k);
+            csv_trust(f, r, c, k);
             csv_est(f, est, c->error_estimate ? c->error_estimate[k] : NAN);
         }
     }

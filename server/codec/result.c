@@ -39,6 +39,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 const char *codec_case_status_name(sm_case_status s)
 {
@@ -156,13 +157,35 @@ static json_t *res_parts(const double *f, int spatial)
                      "flap", res_real(f[2]), "torsion", res_real(f[3]));
 }
 
+char *codec_mode_label(const codec_request *r, int kind, int ordinal, char *buf, size_t size)
+{
+    char tmp[32];
+    const char *name = kind == SM_MODE_FLAP   ? "fore-aft"
+                       : kind == SM_MODE_EDGE ? "side-side"
+                                              : NULL;
+
+    sm_mode_label(kind, ordinal, buf, size);
+    if (!name || !json_object_get(codec_request_canonical(r), "tower"))
+        return buf;
+    /* a tower's flap (e3) is fore-aft and its edge (e2) side-side (tower.c, DESIGN.md 8.5):
+     * name the mode by the direction it moves */
+    snprintf(tmp, sizeof tmp, "%s", buf);
+    char *sp = strrchr(tmp, ' ');
+    if (sp)
+        sp[1] = '\0';
+    else
+        tmp[0] = '\0';
+    snprintf(buf, size, "%s%s", tmp, name);
+    return buf;
+}
+
 /*
  * DESIGN.md 9.1, appended to mode k: "label", "label_confidence", "energy" {"kinetic",
  * "strain", and "support" for a model with supports (DESIGN.md 8.7)}, "tracked_index", "tracking_flag" ("crossing", "veering" or null) and
  * "tracking_partner" (the other tracked index of the flagged pair, or null).  Nothing for a
  * case the core gave no labels (hand-built results).  Returns 0, or -1 out of memory.
  */
-static int res_trust(json_t *md, const sm_case *c, int k)
+static int res_trust(const codec_request *r, json_t *md, const sm_case *c, int k)
 {
     char lab[32];
     int spatial = res_node_dof(c) == 6, flag;
@@ -170,7 +193,7 @@ static int res_trust(json_t *md, const sm_case *c, int k)
 
     if (c->label_kind && c->energy) {
         f = c->energy + (size_t)k * SM_ENERGY_PARTS;
-        sm_mode_label(c->label_kind[k], c->label_ordinal[k], lab, sizeof(lab));
+        codec_mode_label(r, c->label_kind[k], c->label_ordinal[k], lab, sizeof(lab));
         if (json_object_set_new(md, "label", json_string(lab)) ||
             json_object_set_new(md, "label_confidence", res_real(c->label_confidence[k])) ||
             json_object_set_new(md, "energy", json_pack("{s:o, s:o}", "kinetic",
@@ -197,7 +220,7 @@ static int res_trust(json_t *md, const sm_case *c, int k)
 }
 
 /* One mode of a case. */
-static json_t *res_mode(const sm_case *c, int k, int shapes)
+static json_t *res_mode(const codec_request *r, const sm_case *c, int k, int shapes)
 {
     int dof = res_node_dof(c);
     size_t stride = (size_t)dof * (size_t)c->n_nodes;
@@ -226,7 +249,7 @@ static json_t *res_mode(const sm_case *c, int k, int shapes)
             goto fail;
     }
     if (json_object_set_new(md, "per_rev", res_per_rev(c->frequency[k], c->omega)) ||
-        res_trust(md, c, k))
+        res_trust(r, md, c, k))
         goto fail;
     if (c->error_estimate &&
         json_object_set_new(md, "error_estimate", res_real(c->error_estimate[k])))
@@ -258,7 +281,7 @@ static json_t *res_case(const codec_request *r, const sm_model *m, const sm_case
     if (json_object_set_new(o, "modes", modes))
         goto fail;
     for (k = 0; k < c->n_modes; k++)
-        if (json_array_append_new(modes, res_mode(c, k, shapes)))
+        if (json_array_append_new(modes, res_mode(r, c, k, shapes)))
             goto fail;
     if (c->warning[0] &&
         json_object_set_new(o, "warnings", json_pack("[s]", c->warning)))

@@ -83,6 +83,10 @@ def test03(exe, ref, tmp):
           "Test03: top mass in tower axes (fa, ss, up): offset [cm_loc, 0, cm_axial], inertia "
           "[ixx, iyy, izz], products [ixy, iyz, izx]")
     check("reads cm_axial into cm_loc" in err, "Test03: the warning names BModes' cm_axial slip")
+    labels = [m.get("label") for m in solve(exe, req, tmp, "test03_tower_form")]
+    check("1st fore-aft" in labels and "1st side-side" in labels and
+          not any(x and ("flap" in x or "edge" in x) for x in labels),
+          "Test03 tower form: modes named by the direction they move (%s)" % labels[:6])
     own = own_model(exe, bmi)
     pm = own.get("structure", {}).get("point_masses", [{}])[0]
     check(pm.get("offset") == [0, 0, 1.1] and pm.get("products") == [0, -18400, 0],
