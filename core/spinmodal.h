@@ -200,6 +200,11 @@ typedef struct sm_structure {
      * six more coordinates (its translation and rotation) ahead of the modal ones (DESIGN.md
      * 8.6).  Spatial structures, analysed at rest (speeds 0) only. */
     int base_free;
+    /* the acceleration of gravity, m/s^2, hub frame (e.g. {0, -9.80665, 0} for a tower whose up
+     * is hub y), a steady load on the structure at rest: the steady state under its own weight
+     * and the linearisation there (DESIGN.md 8.8); all zero: none.  Spatial structures, speeds 0
+     * only, not with a free base. */
+    double gravity[3];
 } sm_structure;
 
 typedef enum sm_frame_scheme {

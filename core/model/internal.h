@@ -125,6 +125,9 @@ struct sm_model {
     const struct smi_kind *kind; /* planar or spatial (kind.h): picked by mesh_build */
     int n_pt;           /* spatial: points = the FE nodes (0 .. n_nodes-1) + quadrature points */
     struct sp_point *pt; /* spatial: n_pt points (spatial.h) */
+    int gravity;         /* 1: grav is a steady load at rest (sm_structure.gravity): the kind's
+                           "centrifugal" force is the weight's and the load factor s is 1 */
+    double grav[3];      /* m/s^2, hub frame */
     int base;            /* 6 when the clamp joint moves (sm_structure.base_free): q[0..5] its
                            translation and rotation, hub axes; 0 otherwise */
     /* elastic supports (supports.c, DESIGN.md 8.6); has_supports 0: none, all empty */
@@ -151,6 +154,13 @@ void fe_to_frame(const double kloc[36], double alpha, double kfr[36]);
 void fe_shape(double xi, double l, double s[12]);
 /** g = bending block of G_e (eq. 23) on (v1, phi1, v2, phi2), 4x4 column-major (axial part is zero). */
 void fe_geometric_bending(double l, double g[16]);
+
+/** The load factor of the continuation and of K* at speed omega: Omega^2, or 1 for a model
+ *  loaded by gravity at rest (its "centrifugal" force is then the weight's, DESIGN.md 8.8). */
+static inline double smi_load(const sm_model *m, double omega)
+{
+    return m->gravity ? 1.0 : omega * omega;
+}
 
 /* --------------------------------------------------------- supports.c */
 /** Checks of st's supports (indices, symmetric and positive semi-definite 6x6 matrices, the

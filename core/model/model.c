@@ -83,6 +83,8 @@ static int model_mesh(sm_model **out, const sm_structure *st, const sm_options *
     int rc = mesh_build(m, st, d);
     if (rc == SM_OK) {
         m->base = st->base_free ? 6 : 0;
+        m->gravity = st->gravity[0] != 0 || st->gravity[1] != 0 || st->gravity[2] != 0;
+        memcpy(m->grav, st->gravity, sizeof m->grav);
         rc = supports_lump(m, st);
     }
     if (rc < 0) {
@@ -156,9 +158,9 @@ int sm_structure_check(const sm_structure *st, const sm_options *opt, sm_model_i
             if (k > info->max_frame_coordinates)
                 info->max_frame_coordinates = k;
         }
-        info->structured =
-            !m->has_supports && tree_choose(m->opt.solver, info->coordinates,
-                                            info->max_frame_coordinates, m->opt.modes);
+        info->structured = !m->has_supports && !m->gravity &&
+                           tree_choose(m->opt.solver, info->coordinates,
+                                       info->max_frame_coordinates, m->opt.modes);
     }
     sm_model_free(m);
     return SM_OK;

@@ -152,6 +152,20 @@ int supports_check(const sm_structure *st, const sm_options *o, sm_diag *d)
                                       "give the platform's mass as the support's 6x6 mass");
         }
     }
+    int grav = st->gravity[0] != 0 || st->gravity[1] != 0 || st->gravity[2] != 0;
+    for (int i = 0; i < 3; i++)
+        if (!isfinite(st->gravity[i]))
+            return smi_input_fail(d, SM_ITEM_OPTIONS, -1, "gravity",
+                                  "gravity must be three finite numbers (m/s^2)");
+    if (grav && !st->spatial)
+        return smi_input_fail(d, SM_ITEM_OPTIONS, -1, "gravity", "gravity needs spatial sections");
+    if (grav && st->base_free)
+        return smi_input_fail(d, SM_ITEM_OPTIONS, -1, "gravity",
+                              "gravity on a free base (a platform's weight against its buoyancy) "
+                              "is not supported yet");
+    if (grav && o->solver == SM_SOLVER_TREE)
+        return smi_input_fail(d, SM_ITEM_OPTIONS, -1, "solver",
+                              "gravity needs the dense solver (solver auto or dense)");
     if (st->n_supports > 0 && o->solver == SM_SOLVER_TREE)
         return smi_input_fail(d, SM_ITEM_OPTIONS, -1, "solver",
                               "elastic supports couple the frames: they need the dense solver "

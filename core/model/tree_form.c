@@ -32,7 +32,8 @@ int tree_choose(int solver, int n, int max_m, int modes)
 int tree_use(const sm_model *m)
 {
     int mx = 0;
-    if (m->has_supports) /* K_sup and M_sup couple every frame they reach (supports.c) */
+    if (m->has_supports || m->gravity) /* K_sup and M_sup couple every frame they reach
+                                          (supports.c); the weight has no tree form yet */
         return 0;
     for (int s = 0; s < m->n_subs; s++)
         mx = m->subs[s].m > mx ? m->subs[s].m : mx;

@@ -293,6 +293,16 @@ int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress
             snprintf(d->message, sizeof d->message, "speeds must be finite and non-negative (rad/s)");
             return SM_INVALID_INPUT;
         }
+    for (int i = 0; m->gravity && i < n_omegas; i++)
+        if (omegas[i] != 0) { /* the weight turns with the hub: not steady in its frame */
+            d->status = SM_INVALID_INPUT;
+            d->item = SM_ITEM_OPTIONS;
+            d->item_index = i;
+            snprintf(d->field, sizeof d->field, "omega");
+            snprintf(d->message, sizeof d->message,
+                     "gravity is a steady load at rest only: speeds must be 0");
+            return SM_INVALID_INPUT;
+        }
     for (int i = 0; m->base && i < n_omegas; i++)
         if (omegas[i] != 0) { /* the base's kinematics are linearised at rest (DESIGN.md 8.6) */
             d->status = SM_INVALID_INPUT;
@@ -328,7 +338,7 @@ int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress
     int from_rest = 1;
     for (int t = 0; t < n_omegas; t++) {
         sm_case *c = &r->cases[key[t].index];
-        double s = c->omega * c->omega, t0 = sweep_ms();
+        double s = smi_load(m, c->omega), t0 = sweep_ms();
         sm_eq_out eo;
         if (from_rest) {
             memset(q, 0, (size_t)n * sizeof(double));
@@ -394,7 +404,7 @@ int sweep_lowest(const sm_model *m, double omega, sm_progress_fn cb, void *user,
     rc = SM_NOMEM;
     if (!q)
         goto done;
-    if ((rc = eq_solve(m, q, 0, omega * omega, 1, &pr, &eo)) < 0)
+    if ((rc = eq_solve(m, q, 0, smi_load(m, omega), 1, &pr, &eo)) < 0)
         goto done;
     rc = eo.canceled ? SM_CANCELED : SM_NO_EQUILIBRIUM;
     if (!eo.converged)

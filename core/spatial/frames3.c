@@ -240,10 +240,24 @@ void sp_apply(const sm_sub *b, const sp_point *p, const sp_cx A[9], const sp_cx 
 /* Force and moment (hub frame) of the centrifugal potential on point p of frame s at its local
  * state (w, L), aw = A_s w: F = m P r (r = R + A w, + A Lambda c for an offset mass), Mo = the
  * moment of F about the node at the offset plus (X e) x e, X e = A Lambda I Lambda' A' e. */
-static void sp_point_wrench(const sp_point *p, const sp_cx R[3], const sp_cx A[9], const sp_cx aw[3],
-                            const sp_cx L[9], sp_cx F[3], sp_cx Mo[3])
+static void sp_point_wrench(const sp_point *p, const sp_cx R[3], const sp_cx A[9],
+                            const sp_cx aw[3], const sp_cx L[9], const double *grav, sp_cx F[3],
+                            sp_cx Mo[3])
 {
     static const sp_cx ez[3] = {0, 0, 1};
+    if (grav) { /* the weight m g at the centre of mass (DESIGN.md 8.8): no moment about it */
+        if (p->mass == 0)
+            return;
+        for (int i = 0; i < 3; i++)
+            F[i] = p->mass * grav[i];
+        if (p->has_c) {
+            sp_cx cc[3] = {p->c[0], p->c[1], p->c[2]}, lc[3], dh[3];
+            rot3_mv(L, cc, lc);
+            rot3_mv(A, lc, dh);
+            rot3_cross(dh, F, Mo);
+        }
+        return;
+    }
     if (p->mass != 0) {
         sp_cx dh[3] = {0, 0, 0};
         if (p->has_c) {
@@ -287,7 +301,7 @@ void sp_frame_wrench(const sm_model *m, sp_kin *k, int s, const sp_cx *q)
         sp_cx w[3], psi[3], aw[3], F[3] = {0, 0, 0}, Mo[3] = {0, 0, 0}, L[9], T[9];
         sp_point_state(m, k, pi, q, rot, w, psi, L, T);
         rot3_mv(A, w, aw);
-        sp_point_wrench(p, k->cR + 3 * s, A, aw, L, F, Mo);
+        sp_point_wrench(p, k->cR + 3 * s, A, aw, L, m->gravity ? m->grav : NULL, F, Mo);
         sp_apply(b, p, A, rot ? T : NULL, aw, F, Mo, gs, Fs, Ms);
     }
     for (int t = k->ch_ptr[s]; t < k->ch_ptr[s + 1]; t++) { /* the subtree wrench of each child */

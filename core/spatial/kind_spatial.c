@@ -95,7 +95,7 @@ static void spatial_dense_linearize(const sm_model *m, const double *q, void *k,
                                     int gyro, smi_dense *D, double *work)
 {
     sp_eval(m, q, k);
-    lin3_tangent(m, q, k, omega * omega, 1, &D->K, &D->H, work);
+    lin3_tangent(m, q, k, smi_load(m, omega), 1, &D->K, &D->H, work);
     lin3_mass(m, k, &D->M, &D->W);
     if (gyro)
         lin3_gyro(m, k, omega, &D->C, &D->W);
