@@ -577,9 +577,10 @@ static int ed_standins(json_t *doc, const imp_table *t, double length, const cha
     json_t *tw = json_object_get(json_object_get(doc, "request"), form);
     json_t *sec = json_object_get(tw, "section"), *ws = json_object_get(doc, "input_warnings"), *st;
     double ei = imp_table_max(t, IK_EI_FLAP), ea, gj, rg = ED_TW_RG * length;
+    json_t *marks = json_array();
     char ptr[3][40];
     size_t i;
-    int bad = 0, inert;
+    int bad = !marks, inert;
 
     snprintf(ptr[0], sizeof(ptr[0]), "/%s/section/EA", form);
     snprintf(ptr[1], sizeof(ptr[1]), "/%s/section/GJ", form);
@@ -601,7 +602,8 @@ static int ed_standins(json_t *doc, const imp_table *t, double length, const cha
             bad |= json_object_set_new(st, "edge_inertia", json_real(imp_round(mu * rg * rg)));
         }
     if (json_object_get(sec, "EA")) {
-        bad |= json_object_set_new(sec, "EA", json_real(ea));
+        bad |= json_object_set_new(sec, "EA", json_real(ea)) ||
+               json_array_append_new(marks, json_string("EA"));
         bad |= imp_warn(ws, ptr[0],
                         "EA is not in the ElastoDyn %s file (rigid in extension): "
                         "%s.section.EA = %.6g N assumed (1e7 x the largest EI / length^2)%s",
@@ -617,25 +619,27 @@ static int ed_standins(json_t *doc, const imp_table *t, double length, const cha
                         form);
     }
     if (json_object_get(sec, "GJ")) {
-        bad |= json_object_set_new(sec, "GJ", json_real(gj));
+        bad |= json_object_set_new(sec, "GJ", json_real(gj)) ||
+               json_array_append_new(marks, json_string("GJ"));
         bad |= imp_warn(ws, ptr[1],
                         "GJ is not in the ElastoDyn %s file (rigid in torsion): "
                         "%s.section.GJ = %.6g N m^2 assumed (1e5 x the largest EI)",
                         form, form, gj);
     }
+    /* marked, so that the plausibility check reads EA through EI (DESIGN.md 8.4) */
+    if (json_array_size(marks))
+        bad |= json_object_set(sec, "stand_ins", marks);
+    json_decref(marks);
     return bad || imp_legacy_warnings(doc) ? -1 : 0;
 }
 
 /* ed_standins on a blade document made with status st; the status (SM_NOMEM on failure,
- * the document freed).  Not applied to blades for now (ED_BLADE_STANDINS 0): their EA of
- * 1e7 EI/L^2 is an axial wave speed of ~4e5 m/s, which the plausibility check (plausible.c,
- * 300..20000 m/s) reports as an EA slip on every ElastoDyn blade (cli-plausible-no_false_alarm,
- * -slips); blades keep the CSV import's stand-ins until the request can say "rigid in
- * extension" without a number (issue 25). */
-#define ED_BLADE_STANDINS 0
+ * the document freed).  Their EA of 1e7 EI/L^2 is an axial wave speed of ~4e5 m/s: the
+ * section's "stand_ins" mark lets the plausibility check (plausible.c) read it through EI
+ * instead of reporting an EA slip on every ElastoDyn blade (DESIGN.md 8.4). */
 static int ed_blade_standins(json_t **out, const imp_table *t, double length, int st)
 {
-    if (ED_BLADE_STANDINS && st == SM_OK && ed_standins(*out, t, length, "blade")) {
+    if (st == SM_OK && ed_standins(*out, t, length, "blade")) {
         json_decref(*out);
         *out = NULL;
         st = SM_NOMEM;

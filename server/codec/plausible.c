@@ -44,6 +44,7 @@ typedef struct plaus_member {
                                 EI_edge NAN for a planar member */
     char *ptr[PQ_N];         /* pointer of the request field behind each (malloc'd), or NULL */
     const char *field[PQ_N]; /* its name ("E" for EA of a material section, "I" ...) */
+    int ea_stand_in;         /* EA is the section's, marked in its "stand_ins" (section.c) */
     char name[96];           /* "member 3 ('arm')" or "the blade", for messages */
 } plaus_member;
 
@@ -174,7 +175,9 @@ static void plaus_member_fill(plaus_ctx *c, size_t i, plaus_member *pm)
     const json_t *id = json_object_get(json_array_get(json_object_get(req_structure(c->r),
                                                                       "members"), i), "id");
     sec_form f = sec_classify_as(sec, c->st->spatial);
+    const json_t *x;
     double a[3], b[3];
+    size_t k;
     int q;
 
     memset(pm, 0, sizeof(*pm));
@@ -209,6 +212,11 @@ static void plaus_member_fill(plaus_ctx *c, size_t i, plaus_member *pm)
         if (pm->field[q] && !pm->ptr[q])
             c->w->nomem = 1;
     }
+    if (!(m->n_stations && (m->station_mask & SM_ST_EA)))
+        json_array_foreach(json_object_get(sec, "stand_ins"), k, x) {
+            const char *name = json_string_value(x);
+            pm->ea_stand_in |= name && !strcmp(name, "EA");
+        }
 }
 
 /* Free the pointers of *pm. */
@@ -238,11 +246,14 @@ static int plaus_wave_speed(plaus_ctx *c, const plaus_member *pm, int ei_hi)
 {
     const warn_rule *r = &warn_rules[WARN_WAVE_SPEED];
     double cs = sqrt(pm->q[PQ_EA] / pm->q[PQ_MU]);
-    char slip[160], alt[224] = "", ea[96], b1[32], b2[32];
+    char slip[160], alt[224] = "", ea[96], b1[32], b2[32], note[96] = "";
     int on_ea, k;
 
     if (!(pm->q[PQ_MU] > 0 && pm->q[PQ_EA] > 0) || plaus_in(cs, r))
         return 0;
+    if (pm->ea_stand_in)
+        snprintf(note, sizeof(note), "; EA a stand-in, read as EI / (%g x length)^2",
+                 warn_rules[WARN_GYRATION].typical);
     on_ea = cs > r->hi || ei_hi;
     k = plaus_slip(cs, r, on_ea ? 0.5 : -0.5);
     plaus_slip_text(slip, sizeof(slip), pm->field[on_ea ? PQ_EA : PQ_MU], k);
@@ -253,8 +264,8 @@ static int plaus_wave_speed(plaus_ctx *c, const plaus_member *pm, int ei_hi)
                  plaus_slip_text(ea, sizeof(ea), "EA", -k));
     warn_add(c->w, pm->ptr[on_ea ? PQ_EA : PQ_MU],
              "the axial wave speed sqrt(EA / mass_per_length) of %s is %.4g m/s, outside %s to "
-             "%s m/s (any structural material; span means): likely slip: %s%s",
-             pm->name, cs, warn_g(b1, r->lo), warn_g(b2, r->hi), slip, alt);
+             "%s m/s (any structural material; span means%s): likely slip: %s%s",
+             pm->name, cs, warn_g(b1, r->lo), warn_g(b2, r->hi), note, slip, alt);
     return on_ea;
 }
 
@@ -292,6 +303,47 @@ static void plaus_gyration(plaus_ctx *c, const plaus_member *pm, int q)
     free(lp);
 }
 
+/*
+ * A stand-in EA (the section's "stand_ins"): set stiff on purpose, it says nothing of its own
+ * units, but an importer derives it from EI, so a slip in EI or mu is what to look for.  Per
+ * bending direction, the wave speed of the EA a section of that EI would have with the typical
+ * radius of gyration, EA_q = EI_q / (typical L)^2: too fast blames that EI field, too slow
+ * mass_per_length (once).  The radius of gyration would be typical by construction, and the
+ * strain of a rigid member is nil (plaus_strain).  Returns 1 when it warned.
+ */
+static int plaus_stand_in_wave(plaus_ctx *c, const plaus_member *pm)
+{
+    const warn_rule *r = &warn_rules[WARN_WAVE_SPEED];
+    double rg = warn_rules[WARN_GYRATION].typical * pm->len;
+    char slip[160], b1[32], b2[32];
+    int q, slow = 0, warned = 0;
+
+    for (q = PQ_EI_FLAP; q <= PQ_EI_EDGE && rg > 0 && pm->q[PQ_MU] > 0; q++) {
+        double cs = sqrt(pm->q[q] / (rg * rg) / pm->q[PQ_MU]);
+        if (!(pm->q[q] > 0) || !pm->ptr[q] || plaus_in(cs, r))
+            continue;
+        if (cs < r->lo) {
+            slow = q;
+            continue;
+        }
+        plaus_slip_text(slip, sizeof(slip), pm->field[q], plaus_slip(cs, r, 0.5));
+        warn_add(c->w, pm->ptr[q],
+                 "the axial wave speed of %s, its stand-in EA read as %s / (%g x length)^2, is "
+                 "%.4g m/s, outside %s to %s m/s (any structural material; span means): likely "
+                 "slip: %s",
+                 pm->name, pm->field[q], warn_rules[WARN_GYRATION].typical, cs, warn_g(b1, r->lo),
+                 warn_g(b2, r->hi), slip);
+        warned = 1;
+    }
+    if (slow && !warned) {
+        plaus_member eq = *pm;
+        eq.q[PQ_EA] = pm->q[slow] / (rg * rg);
+        plaus_wave_speed(c, &eq, 0); /* too slow: it blames mass_per_length */
+        warned = 1;
+    }
+    return warned;
+}
+
 /* The checks of one member that need no speed; returns 1 when its wave speed warned. */
 static int plaus_member_groups(plaus_ctx *c, const plaus_member *pm)
 {
@@ -300,6 +352,8 @@ static int plaus_member_groups(plaus_ctx *c, const plaus_member *pm)
 
     if (!pm->ptr[PQ_MU] || !pm->ptr[PQ_EA])
         return 0;
+    if (pm->ea_stand_in)
+        return plaus_stand_in_wave(c, pm);
     for (q = PQ_EI_FLAP; q <= PQ_EI_EDGE; q++)
         ei_hi |= pm->q[q] > 0 && pm->q[PQ_EA] > 0 && pm->beam > 0 &&
                  sqrt(pm->q[q] / pm->q[PQ_EA]) / pm->beam > g->hi;
@@ -385,7 +439,7 @@ static void plaus_strain(plaus_ctx *c, const plaus_member *pm)
     char slip[160], alt[128] = "", ea[96], b[32];
     int k = plaus_slip(e, r, 1.0);
 
-    if (!(pm->q[PQ_EA] > 0) || !pm->ptr[PQ_MU] || plaus_in(e, r))
+    if (!(pm->q[PQ_EA] > 0) || !pm->ptr[PQ_MU] || pm->ea_stand_in || plaus_in(e, r))
         return;
     plaus_slip_text(slip, sizeof(slip), pm->field[PQ_MU], k);
     if (k > 0)

@@ -36,11 +36,28 @@ static const char *const sec_mat_units[] = {" (Pa)", " (Pa)", " (m^2)", " (m^4)"
                                             " (m^4)", " (kg/m)"};
 static const char *const sec_inertia_keys[] = {"flap_inertia", "edge_inertia", NULL};
 /* Every key a section may have, for the unknown-key check and its suggestions. */
-static const char *const sec_all_keys[] = {"E", "A", "I", "mass_per_length", "EA", "EI_flap",
-                                           "EI_edge", "GJ", "G", "I_flap", "I_edge", "J",
-                                           "flap_inertia", "edge_inertia", "cg_offset",
-                                           "shear_center_offset", "tension_center_offset",
-                                           "ip_over_a", NULL};
+static const char *const sec_all_keys[] = {"E",
+                                           "A",
+                                           "I",
+                                           "mass_per_length",
+                                           "EA",
+                                           "EI_flap",
+                                           "EI_edge",
+                                           "GJ",
+                                           "G",
+                                           "I_flap",
+                                           "I_edge",
+                                           "J",
+                                           "flap_inertia",
+                                           "edge_inertia",
+                                           "cg_offset",
+                                           "shear_center_offset",
+                                           "tension_center_offset",
+                                           "ip_over_a",
+                                           "stand_ins",
+                                           NULL};
+/* The fields a section may mark as stand-ins (DESIGN.md 8.4, 8.5), in canonical order. */
+static const char *const sec_stand_in_keys[] = {"EA", "GJ", NULL};
 /* Offsets from the member axis (DESIGN.md 8), [edgewise, flapwise] in m, spatial only. */
 static const char *const sec_offset_keys[] = {"cg_offset", "shear_center_offset",
                                               "tension_center_offset", NULL};
@@ -296,6 +313,53 @@ static void sec_offsets(val_ctx *v, const json_t *sec, const char *ptr, json_t *
             field_set(v, c, sec_offset_keys[k], field_reals(x, 2));
 }
 
+/*
+ * "stand_ins": the stiffness-form fields (EA, GJ) the section gives as stand-ins for what its
+ * source lacks, set stiff on purpose (an ElastoDyn file is rigid in extension and torsion): the
+ * plausibility check reads such an EA through EI (plausible.c).  Each once, given by the
+ * section itself; the canonical copy lists them in sec_stand_in_keys' order, none when empty.
+ */
+static void sec_stand_ins(val_ctx *v, const json_t *sec, const char *ptr, sec_form f, json_t *c)
+{
+    const json_t *a = json_object_get(sec, "stand_ins"), *x;
+    unsigned seen = 0;
+    json_t *out;
+    size_t i;
+    int k;
+
+    if (!a)
+        return;
+    if (!json_is_array(a) || (f != SEC_STIFFNESS && json_array_size(a))) {
+        field_error_key(v, ptr, "stand_ins",
+                        "must be a list of the fields a section in stiffness form gives as "
+                        "stand-ins (\"EA\", \"GJ\"), not %s",
+                        json_is_array(a) ? "a list in this form" : field_type_name(a));
+        return;
+    }
+    json_array_foreach(a, i, x) {
+        const char *name = json_string_value(x);
+        for (k = 0; name && sec_stand_in_keys[k] && strcmp(name, sec_stand_in_keys[k]); k++)
+            ;
+        if (!name || !sec_stand_in_keys[k] || (seen & (1u << k)) || !json_object_get(sec, name))
+            field_error_key(v, ptr, "stand_ins",
+                            "entry %zu (%s): each entry names once a field the section gives, "
+                            "\"EA\" or \"GJ\"",
+                            i, name ? name : field_type_name(x));
+        else
+            seen |= 1u << k;
+    }
+    if (!seen)
+        return;
+    if (!(out = json_array())) {
+        v->nomem = 1;
+        return;
+    }
+    for (k = 0; sec_stand_in_keys[k]; k++)
+        if ((seen & (1u << k)) && json_array_append_new(out, json_string(sec_stand_in_keys[k])))
+            v->nomem = 1;
+    field_set(v, c, "stand_ins", out);
+}
+
 json_t *sec_validate(val_ctx *v, const json_t *sec, const char *ptr, sec_form f,
                      unsigned cover)
 {
@@ -318,6 +382,7 @@ json_t *sec_validate(val_ctx *v, const json_t *sec, const char *ptr, sec_form f,
         double ip;
         sec_inertias(v, sec, ptr, f, c, val, ok);
         sec_offsets(v, sec, ptr, c);
+        sec_stand_ins(v, sec, ptr, f, c);
         /* the Wagner ratio I_p/A given (DESIGN.md 8.1): it replaces the one derived from the
          * section (0 switches the tension-torsion term off, as BModes has none) */
         if (json_object_get(sec, "ip_over_a"))

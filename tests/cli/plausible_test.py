@@ -131,12 +131,13 @@ def t_slips(tmp):
     expect_slip(path, "/blade/stations/0/EI_flap", "EI_flap x1e6 (N mm^2 for N m^2)",
                 "EI in N mm^2 (stations x1e6)", solve=True)
     expect_slip(path, "/blade/stations/0/EI_edge", "EI_edge x1e6", "EI in N mm^2, edgewise")
-    # the file itself in N mm^2: the importer's stand-in EA (1e4 EI / L^2) follows EI
+    # the file itself in N mm^2: the importer's EA is a stand-in (section "stand_ins"), read
+    # through EI, so the slip is named at EI (DESIGN.md 8.4)
     dat = scaled_dat(tmp, "ei.dat", {3: 1e6, 4: 1e6})
     req = nrel(tmp, "--tip-radius", "63", "--hub-radius", "1.5", "--rpm", "12.1", dat=dat)
     if req:
-        expect_slip(write(tmp, "ei-file.json", req), "/blade/section/EA",
-                    "EA x1e6 (or every stiffness x1e6", "the ElastoDyn file in N mm^2")
+        expect_slip(write(tmp, "ei-file.json", req), "/blade/stations/0/EI_flap",
+                    "EI_flap x1e6 (N mm^2 for N m^2)", "the ElastoDyn file in N mm^2")
     req = nrel(tmp, "--tip-radius", "63000", "--hub-radius", "1.5", "--rpm", "12.1")
     if req:
         expect_slip(write(tmp, "mm.json", req), "/blade/length", "lengths in mm for m",
@@ -163,8 +164,11 @@ def t_slips(tmp):
         expect_slip(write(tmp, "g-file.json", req), "/blade/stations/0/mass_per_length",
                     "g for kg", "the ElastoDyn file in g/m")
 
-    def ea(req):
-        req["blade"]["section"]["EA"] *= 1e3
+    def ea(req):  # a request with a real EA (no stand-in): 1e4 EI_max / L^2, 13.5 km/s, x1e3
+        sec = req["blade"]["section"]
+        sec.pop("stand_ins", None)
+        ei = max(max(s["EI_flap"], s["EI_edge"]) for s in req["blade"]["stations"])
+        sec["EA"] = 1e3 * 1e4 * ei / req["blade"]["length"] ** 2
     expect_slip(edited("ea.json", ea), "/blade/section/EA", "EA x1e3", "EA x1e3", solve=True)
 
 
