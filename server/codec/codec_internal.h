@@ -352,11 +352,59 @@ int sup_build(const json_t *st, const sup_joints *J, sm_support **out, int *n);
 char *sup_pointer(const json_t *st, int index, const char *field);
 
 /**
- * The reserved supports of the input structure st (borrowed): "platform" and an elastic
- * ({joint, stiffness, mass}) or absent (null) clamp are "not supported yet" errors.  1 when the
- * clamp was one of those (the caller then skips its joint check).
+ * The 6x6 matrix obj[key] (rows or {translational, rotational}) at p/key checked into a
+ * (column-major) and c[key] (canonical): symmetric, its diagonal >= 0 unless any_sign (a
+ * hydrostatic stiffness); unit goes into messages.  1 when valid.
  */
-int sup_reserved(val_ctx *v, const json_t *st);
+int sup_matrix6(val_ctx *v, const json_t *obj, const char *p, const char *key, const char *unit,
+                int any_sign, json_t *c, double a[36]);
+
+/** Index of name among the n sorted joint names, -1 when absent. */
+int sup_joint(const char **names, int n, const char *name);
+
+/** A canonical 6x6 (rows or diagonal form; absent: zero) into a, column-major. */
+void sup_read(const json_t *x, double a[36]);
+
+/** The position of joint j of J (hub frame, m). */
+void sup_pos(const sup_joints *J, int j, double p[3]);
+
+/* ===================================================== platform.c: plat_ */
+
+/**
+ * The clamp of the input structure st (borrowed) checked into cst["clamp"] (and
+ * cst["platform"]): a joint's name (rigid), {joint, stiffness, mass} (an elastic clamp) or null
+ * with a "platform" {joint, mass, added_mass, hydrostatic, mooring, reference, mass_reference}
+ * (floating).  joints the input joints (NULL when invalid).
+ */
+void plat_clamp(val_ctx *v, const json_t *st, const json_t *joints, json_t *cst);
+
+/** The clamp joint's name of a canonical structure st: the clamp's, or its platform's. */
+const char *plat_clamp_name(const json_t *st);
+
+/** 1 when the canonical structure st has a free base (elastic clamp or platform), else 0. */
+int plat_base_free(const json_t *st);
+
+/**
+ * The free base's point support of the canonical st (plat_base_free 1) into s: at the clamp
+ * joint, K = stiffness (hydrostatic + mooring), M = mass (mass + added_mass), each carried
+ * rigidly from its reference point to the joint (K' = T^T K T).
+ */
+void plat_fill(const json_t *st, const sup_joints *J, sm_support *s);
+
+/** The pointer of the free base's support field ("K", "M", other) in st; malloc'd. */
+char *plat_pointer(const json_t *st, const char *field);
+
+/** The pointer of a core SM_ITEM_CLAMP diagnostic in st (the clamp or the platform); malloc'd. */
+char *plat_clamp_pointer(const json_t *st);
+
+/**
+ * The tower form's "platform" of tw (borrowed; optional): {mass, added_mass, hydrostatic,
+ * mooring (6x6 in tower axes fa, ss, up), reference_height, mass_height (m, like height; default
+ * base_height)} checked at /tower/platform into ct, and written into the expanded structure st
+ * as "clamp": null and a "platform" at joint "base" in hub axes (T: tower -> hub, row i = hub axis i).
+ */
+void plat_tower(val_ctx *v, const json_t *tw, json_t *ct, json_t *st, const double T[3][3],
+                double base_height);
 
 /* ========================================================= size.c: size_ */
 

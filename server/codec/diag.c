@@ -172,7 +172,7 @@ static char *diag_pointer(const codec_request *r, const sm_diag *d, const char *
         known = pm_fields;
         break;
     case SM_ITEM_CLAMP:
-        return strdup("/structure/clamp");
+        return plat_clamp_pointer(req_structure(r));
     case SM_ITEM_SUPPORT: /* springs, then foundations (supports.c) */
         return sup_pointer(req_structure(r), i, f);
     case SM_ITEM_OPTIONS:

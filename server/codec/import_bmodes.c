@@ -17,14 +17,15 @@
  * iyz/ixy/izx_tip -> products [I12, I23, I31] (x = lag axis 3, y = flap
  * axis 2, z = span axis 1); every station property times its multiplier.
  * nselt and el_loc are kept in "source" only: the blade gets
- * IMPORT_ELEMENTS equal elements.  hub_conn other than 1 is refused.
+ * IMPORT_ELEMENTS equal elements.  hub_conn other than 1 is refused (a tower's 2 goes with its
+ * platform).
  *
  * Towers (bm_tower, bm_tower_doc): radius -> height, hub_rad -> base_height,
  * the sections as BModes reads a tower's (symmetric: edge = flap, twists and
  * offsets 0), the top mass in tower axes (fa, ss, up) = BModes' tower-top
  * (x, y, z): offset [cm_loc, 0, cm_axial], inertia [ixx, iyy, izz],
- * products [ixy, iyz, izx]; speed 0.  tow_support 1 (guy wires) and 2
- * (offshore) are refused at their line (bm_support).
+ * products [ixy, iyz, izx]; speed 0.  tow_support 1: guy wires (bm_wires); 2 with hub_conn 2:
+ * a platform (bm_platform, bm_tower_platform: the tower form's "platform", DESIGN.md 8.6).
  */
 #include "import_internal.h"
 #include "codec.h"
@@ -101,6 +102,7 @@ static int bm_int(bm_in *b, const char *field, long lo, long hi, long *v)
 typedef struct bm_main {
     char title[200];
     long beam_type, hub_conn, modepr, nselt;
+    int hub_conn_line; /* line of hub_conn */
     double rot_rpm, rpm_mult, radius, hub_rad, precone, bl_thp;
     double rpm;         /* rot_rpm x rpm_mult, finite (checked where it is made) */
     int length_line;    /* line of hub_rad, which makes the length radius - hub_rad */
@@ -116,6 +118,11 @@ typedef struct bm_main {
     int tw_zeroed_line; /* the first line with one of them */
     long n_att;         /* tow_support 1: wire-attachment locations, 0 without */
     double wire[4][BM_MAX_WIRES]; /* n_wires, node_attach, wire_stfness, th_wire (deg) */
+    int platform; /* tow_support 2: a platform (bm_platform), BModes' axes = tower axes */
+    double draft, cm_pform, ref_msl; /* m below the MSL: tower base, platform c.m., ref. point */
+    double pf[4][36]; /* mass (about the c.m.), hydro_M, hydro_K, mooring_K: row-major 6x6 */
+    long n_distr[2];  /* n_secs_m_distr, n_secs_k_distr: read, unused by BModes v3.00 */
+    double asym[4];   /* the largest |a_ij - a_ji| of each of pf before symmetrising it */
 } bm_main;
 
 static const char *const bm_mult_names[10] = {
@@ -171,7 +178,8 @@ static int bm_general(bm_in *b, bm_main *m)
         (st = bm_num(b, "bl_thp", IMP_ANY, &m->bl_thp)) ||
         (st = bm_int(b, "hub_conn", 1, 3, &m->hub_conn)))
         return st;
-    if (m->hub_conn != 1)
+    m->hub_conn_line = b->r.line;
+    if (m->hub_conn != 1 && !m->tower) /* a tower's free root goes with its platform */
         return imp_fail(b->d, b->file, b->r.line, "hub_conn",
                         "only 1 (cantilevered) is supported (%ld)", m->hub_conn);
     if ((st = bm_int(b, "modepr", 1, 100000, &m->modepr)) ||
@@ -341,10 +349,82 @@ static int bm_wires(bm_in *b, bm_main *m)
     return SM_OK;
 }
 
+/* n numbers of the next non-blank line (ReadAry) into x[0], x[step] ...; SM_OK or the error. */
+static int bm_row(bm_in *b, const char *field, int n, int step, double *x)
+{
+    imp_tok t[IMP_MAX_TOKENS];
+    int i, st, got;
+
+    if (!imp_next_nonblank(&b->r))
+        return bm_ends(b, field);
+    got = imp_split(b->r.s, b->r.n, ",", t, IMP_MAX_TOKENS);
+    if (got < n)
+        return imp_fail(b->d, b->file, b->r.line, field, "%d numbers expected, got %d", n, got);
+    for (i = 0; i < n; i++)
+        if ((st = imp_value(b->d, b->file, b->r.line, field, &t[i], IMP_ANY, &x[i * step])))
+            return st;
+    return SM_OK;
+}
+
+/* Six rows of a 6x6 (after its comment line) into a, row-major. */
+static int bm_six(bm_in *b, const char *field, double *a)
+{
+    int st = bm_com(b, field), i;
+
+    for (i = 0; !st && i < 6; i++)
+        st = bm_row(b, field, 6, 1, a + 6 * i);
+    return st;
+}
+
 /*
- * A tower's support (BModes.f90:503-612, read after el_loc): tow_support 0 (none) and 1
- * (tension guy wires, bm_wires) are imported; 2 (monopile or floating platform) needs a
- * platform and a free base that the solver does not have yet and is refused at that line.  A
+ * The platform (tow_support 2, BModes.f90:510-571): draft, cm_pform, mass_pform, the 3x3
+ * inertia about the c.m., ref_msl, hydro_M, hydro_K, mooring_K (6x6 over surge, sway, heave,
+ * roll, pitch, yaw = the tower axes fa, ss, up), then the distributed added mass and stiffness
+ * (read: BModes v3.00 reads them and never uses them).  radius becomes the length from the
+ * tower's base, radius + draft, as BModes makes it (BModes.f90:616).
+ */
+static int bm_platform(bm_in *b, bm_main *m)
+{
+    static const char *const mats[3] = {"hydro_M", "hydro_K", "mooring_K"};
+    double dummy[1];
+    int st, k, i;
+
+    m->platform = 1;
+    if ((st = bm_num(b, "draft", IMP_ANY, &m->draft)) ||
+        (st = bm_num(b, "cm_pform", IMP_ANY, &m->cm_pform)) ||
+        (st = bm_num(b, "mass_pform", IMP_NONNEG, &m->pf[0][0])) ||
+        (st = bm_com(b, "platform inertia matrix")))
+        return st;
+    m->pf[0][7] = m->pf[0][14] = m->pf[0][0];
+    for (i = 0; i < 3; i++)
+        if ((st = bm_row(b, "i_matrix_pform", 3, 1, &m->pf[0][6 * (3 + i) + 3])))
+            return st;
+    if ((st = bm_num(b, "ref_msl", IMP_ANY, &m->ref_msl)))
+        return st;
+    for (k = 0; k < 3; k++)
+        if ((st = bm_six(b, mats[k], m->pf[k + 1])))
+            return st;
+    for (k = 0; k < 2; k++) {
+        if ((st = bm_com(b, "blank line")) || (st = bm_com(b, "distributed data")) ||
+            (st = bm_int(b, k ? "n_secs_k_distr" : "n_secs_m_distr", 0, 100000, &m->n_distr[k])))
+            return st;
+        for (i = 0; i < 2; i++)
+            if ((st = bm_row(b, k ? "distr_k" : "distr_m", 0, 1, dummy)))
+                return st;
+    }
+    for (k = 0; k < 4; k++) /* symmetric: (a + a^T) / 2, the asymmetry kept for a warning */
+        for (i = 0; i < 36; i++) {
+            double *x = &m->pf[k][i], *y = &m->pf[k][6 * (i % 6) + i / 6];
+            m->asym[k] = fmax(m->asym[k], fabs(*x - *y));
+            *x = *y = 0.5 * (*x + *y);
+        }
+    m->radius += m->draft;
+    return SM_OK;
+}
+
+/*
+ * A tower's support (BModes.f90:503-612, read after el_loc): tow_support 0 (none), 1 (tension
+ * guy wires, bm_wires) and 2 (a platform or a monopile's 6x6 at the base, bm_platform).  A
  * blade has no such lines.
  */
 static int bm_support(bm_in *b, bm_main *m)
@@ -382,16 +462,21 @@ static int bm_support(bm_in *b, bm_main *m)
     ts = (long)x;
     if (ts == 1)
         return bm_wires(b, m);
-    if (ts == 2)
-        return imp_fail(b->d, b->file, b->r.line, "tow_support",
-                        "2 (offshore support: "
-                        "monopile or floating platform) is not supported yet: BModes reads a "
-                        "platform (draft, mass, 6x6 hydrodynamic and mooring matrices) with "
-                        "every monopile, and a platform needs a free base, which the solver "
-                        "does not have yet (issue 25); the tower form's \"foundation\" takes "
-                        "the distributed soil springs and added mass; tow_support 0 imports the "
-                        "tower clamped at its base");
-    return SM_OK;
+    if (ts == 2 && m->hub_conn == 2)
+        return bm_platform(b, m);
+    if (m->hub_conn == 1 && ts < 2)
+        return SM_OK;
+    return imp_fail(b->d, b->file, m->hub_conn_line, "hub_conn",
+                    m->hub_conn == 2   ? "2 (free root) needs tow_support 2 (a platform): "
+                                         "without one the tower has no support"
+                    : m->hub_conn == 3 ? "3 (base held in heave and torsion, free laterally on "
+                                         "the platform's matrices) is not supported yet: the "
+                                         "solver's free base moves in all six directions; give "
+                                         "hub_conn 2 with stiffness in every direction"
+                                       : "1 (cantilevered) with tow_support 2: BModes adds the "
+                                         "platform's matrices to the clamped root, where they "
+                                         "do nothing; give hub_conn 2 (free root) or "
+                                         "tow_support 0");
 }
 
 /* The section-properties file into t, multipliers applied. */
@@ -629,6 +714,70 @@ static int bm_tower_doc(json_t *doc, const bm_main *m)
     return 0;
 }
 
+/* The rows of the row-major 6x6 a as a JSON array. */
+static json_t *bm_rows(const double *a)
+{
+    json_t *rows = json_array();
+    int i;
+
+    for (i = 0; rows && i < 6; i++)
+        if (json_array_append_new(rows, bm_vec(a + 6 * i, 6))) {
+            json_decref(rows);
+            return NULL;
+        }
+    return rows;
+}
+
+/*
+ * tow_support 2 into doc's tower: "platform" {mass (mass_pform and the inertia, about the
+ * c.m.), added_mass hydro_M, hydrostatic hydro_K, mooring mooring_K, reference_height
+ * draft - ref_msl, mass_height draft - cm_pform} — heights above the tower's base, where the
+ * tower form's height and base_height now start (radius + draft, hub_rad: BModes.f90:616);
+ * BModes' platform axes (surge, sway, heave) are the tower axes (fa, ss, up): its T_pform
+ * (BModes.f90:749-782) carries surge to the fore-aft displacement v.  Warnings for what
+ * BModes reads and does not use.  0 or -1 (memory).
+ */
+static int bm_tower_platform(json_t *doc, const bm_main *m)
+{
+    json_t *tw = json_object_get(json_object_get(doc, "request"), "tower"), *pf;
+    json_t *warn = json_object_get(doc, "input_warnings");
+    int k;
+
+    if (!m->platform)
+        return 0;
+    pf = json_pack("{s:o, s:o, s:o, s:o, s:f, s:f}", "mass", bm_rows(m->pf[0]), "added_mass",
+                   bm_rows(m->pf[1]), "hydrostatic", bm_rows(m->pf[2]), "mooring",
+                   bm_rows(m->pf[3]), "reference_height", imp_round(m->draft - m->ref_msl),
+                   "mass_height", imp_round(m->draft - m->cm_pform));
+    if (!pf || json_object_set_new(tw, "platform", pf))
+        return -1;
+    for (k = 0; k < 4; k++)
+        if (m->asym[k] > 0 &&
+            imp_warn(warn, "/tower/platform",
+                     "%s is not symmetric (entries differ by up to %g from their transposes): "
+                     "the import takes (K + K^T)/2, the symmetric part (the solver's matrices "
+                     "are symmetric; BModes' eigensolver takes it as it is)",
+                     k == 0   ? "i_matrix_pform"
+                     : k == 1 ? "hydro_M"
+                     : k == 2 ? "hydro_K"
+                              : "mooring_K",
+                     m->asym[k]))
+            return -1;
+    for (k = 0; k < 2; k++)
+        if (m->n_distr[k] > 0 &&
+            imp_warn(warn, "/tower/platform",
+                     "%s = %ld is not used: BModes v3.00 reads the distributed %s and never "
+                     "uses it (BModes.f90:551-571); the tower form's \"foundation\" takes it",
+                     k ? "n_secs_k_distr" : "n_secs_m_distr", m->n_distr[k],
+                     k ? "stiffness" : "added mass"))
+            return -1;
+    return imp_warn(warn, "/tower/height",
+                    "tow_support 2: heights are measured from the tower's base (draft = %g m "
+                    "below the MSL): height = radius + draft = %g m, the platform's reference "
+                    "point at %g m and its c.m. at %g m",
+                    m->draft, m->radius, m->draft - m->ref_msl, m->draft - m->cm_pform);
+}
+
 /*
  * Option bmodes_mesh on a tower: BModes' own model takes the top mass's offset as BModes reads
  * it, [cm_axial, 0, 0] (BModes.f90:448-449 reads cm_axial into cm_loc and leaves cm_axial 0).
@@ -799,7 +948,7 @@ int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void
     *out = imp_document(&bl, &t, sec, warn, src);
     warn = NULL;
     st = *out ? SM_OK : SM_NOMEM;
-    if (!st && m.tower && bm_tower_doc(*out, &m))
+    if (!st && m.tower && (bm_tower_doc(*out, &m) || bm_tower_platform(*out, &m)))
         st = SM_NOMEM;
     if (!st && m.tower && o->bmodes_mesh > 0 && bm_tower_own_offset(*out, &m))
         st = SM_NOMEM;

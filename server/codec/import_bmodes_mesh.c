@@ -145,7 +145,9 @@ int bm_own_mesh(json_t *doc, const json_t *el_loc, int k, const char *file, impo
     st = json_pack("{s:{}, s:O, s:[], s:s, s:O}", "joints", "sections",
                    json_object_get(ex, "sections"), "members", "clamp", rname, "point_masses",
                    json_object_get(ex, "point_masses"));
-    if (!st)
+    if (!st || (json_object_get(ex, "platform") && /* a free base (tower platform) */
+                (json_object_set_new(st, "clamp", json_null()) ||
+                 json_object_set(st, "platform", json_object_get(ex, "platform")))))
         goto done;
     joints = json_object_get(st, "joints");
     mems = json_object_get(st, "members");

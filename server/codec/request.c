@@ -247,8 +247,8 @@ static int req_build_structure(codec_request *r)
     r->st.members = r->members;
     r->st.n_point_masses = (int)np;
     r->st.point_masses = r->point_masses;
-    r->st.clamp = req_name_index(r->joint_names, nj,
-                                 json_string_value(json_object_get(st, "clamp")));
+    r->st.clamp = req_name_index(r->joint_names, nj, plat_clamp_name(st));
+    r->st.base_free = plat_base_free(st);
     {
         sup_joints J = {r->joint_names, nj, r->joint_xy, r->joint_z};
         if (sup_build(st, &J, &r->supports, &r->st.n_supports))

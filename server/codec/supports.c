@@ -7,7 +7,7 @@
  * member); request.c calls sup_build with the joint table it built; diag.c calls sup_pointer
  * for SM_ITEM_SUPPORT.  The core's support index runs over the springs in request order, then
  * over the members' foundations member by member (a foundation object is one stretch, an array
- * one per entry).  The codec checks what it can name precisely (numbers, signs, symmetry, the
+ * one per entry), then the free base's support at the clamp joint when there is one (platform.c).  The codec checks what it can name precisely (numbers, signs, symmetry, the
  * stretch inside the member); positive semi-definiteness of a 6x6 is the core's check
  * (core/model/supports.c), reported at the matrix.
  *
@@ -63,15 +63,17 @@ static int sup_rows(val_ctx *v, const json_t *x, const char *p, const char *unit
     return ok;
 }
 
-/* a symmetric (1e-9 of its largest entry, as the core) with a diagonal >= 0; errors at p/i/j. */
-static int sup_check_sym(val_ctx *v, const char *p, const char *unit, const double a[36])
+/* a symmetric (1e-9 of its largest entry, as the core) with a diagonal >= 0 unless any_sign;
+ * errors at p/i/j. */
+static int sup_check_sym(val_ctx *v, const char *p, const char *unit, int any_sign,
+                         const double a[36])
 {
     double mx = 0;
     int i, j;
 
     for (i = 0; i < 36; i++)
         mx = fmax(mx, fabs(a[i]));
-    for (i = 0; i < 6; i++)
+    for (i = 0; i < 6 && !any_sign; i++)
         if (a[i + 6 * i] < 0) {
             char *pe = err_fmt("%s/%d/%d", p, i, i);
             field_error(v, pe, "a negative diagonal entry (%g%s): a stiffness or mass is >= 0",
@@ -93,8 +95,9 @@ static int sup_check_sym(val_ctx *v, const char *p, const char *unit, const doub
     return 1;
 }
 
-/* The diagonal form {translational, rotational} at p into a; 1 when valid. */
-static int sup_diag(val_ctx *v, const json_t *x, const char *p, double a[36])
+/* The diagonal form {translational, rotational} at p into a (>= 0 unless any_sign); 1 when
+ * valid. */
+static int sup_diag(val_ctx *v, const json_t *x, const char *p, int any_sign, double a[36])
 {
     static const char *const keys[] = {"translational", "rotational", NULL};
     double d[6] = {0, 0, 0, 0, 0, 0};
@@ -103,8 +106,8 @@ static int sup_diag(val_ctx *v, const json_t *x, const char *p, double a[36])
     field_check_keys(v, x, p, keys, "diagonal 6x6");
     for (k = 0; k < 2; k++)
         if (json_object_get(x, keys[k]) &&
-            !field_vector(v, x, keys[k], p, 3, FIELD_NONNEG, k ? "[rx, ry, rz]" : "[x, y, z]", "",
-                          d + 3 * k))
+            !field_vector(v, x, keys[k], p, 3, any_sign ? FIELD_FINITE : FIELD_NONNEG,
+                          k ? "[rx, ry, rz]" : "[x, y, z]", "", d + 3 * k))
             ok = 0;
     memset(a, 0, 36 * sizeof(double));
     for (k = 0; k < 6; k++)
@@ -137,11 +140,11 @@ static json_t *sup_canon(const double a[36], int diag)
     return rows;
 }
 
-/* Spring matrix m (0 stiffness, 1 added mass) of sp at p into a and canonical c; 1 when valid. */
-static int sup_matrix(val_ctx *v, const json_t *sp, const char *p, int m, json_t *c, double a[36])
+int sup_matrix6(val_ctx *v, const json_t *obj, const char *p, const char *key, const char *unit,
+                int any_sign, json_t *c, double a[36])
 {
-    const json_t *x = json_object_get(sp, sup_mat_key[m]);
-    char *pm = err_ptr_key(p, sup_mat_key[m]);
+    const json_t *x = json_object_get(obj, key);
+    char *pm = err_ptr_key(p, key);
     int ok;
 
     if (!pm) {
@@ -149,13 +152,19 @@ static int sup_matrix(val_ctx *v, const json_t *sp, const char *p, int m, json_t
         return 0;
     }
     if (json_is_object(x))
-        ok = sup_diag(v, x, pm, a);
+        ok = sup_diag(v, x, pm, any_sign, a);
     else
-        ok = sup_rows(v, x, pm, sup_mat_unit[m], a) && sup_check_sym(v, pm, sup_mat_unit[m], a);
+        ok = sup_rows(v, x, pm, unit, a) && sup_check_sym(v, pm, unit, any_sign, a);
     free(pm);
     if (ok)
-        field_set(v, c, sup_mat_key[m], sup_canon(a, json_is_object(x)));
+        field_set(v, c, key, sup_canon(a, json_is_object(x)));
     return ok;
+}
+
+/* Spring matrix m (0 stiffness, 1 added mass) of sp at p into a and canonical c; 1 when valid. */
+static int sup_matrix(val_ctx *v, const json_t *sp, const char *p, int m, json_t *c, double a[36])
+{
+    return sup_matrix6(v, sp, p, sup_mat_key[m], sup_mat_unit[m], 0, c, a);
 }
 
 /* "axes": "hub" (default) or "member:ID" with ID a member id of the input members. */
@@ -357,8 +366,7 @@ void sup_foundation(val_ctx *v, const json_t *mem, const char *p, json_t *c, dou
         field_set(v, c, "foundation", cf);
 }
 
-/* Index of name among the n sorted joint names, -1 when absent. */
-static int sup_joint(const char **names, int n, const char *name)
+int sup_joint(const char **names, int n, const char *name)
 {
     int lo = 0, hi = n - 1;
 
@@ -374,8 +382,7 @@ static int sup_joint(const char **names, int n, const char *name)
     return -1;
 }
 
-/* A canonical matrix (rows or diagonal form) into a, column-major. */
-static void sup_read(const json_t *x, double a[36])
+void sup_read(const json_t *x, double a[36])
 {
     int i, j;
 
@@ -394,8 +401,7 @@ static void sup_read(const json_t *x, double a[36])
             a[i + 6 * j] = json_number_value(json_array_get(json_array_get(x, i), j));
 }
 
-/* The position of joint j (hub frame). */
-static void sup_pos(const sup_joints *J, int j, double p[3])
+void sup_pos(const sup_joints *J, int j, double p[3])
 {
     p[0] = J->xy[2 * j];
     p[1] = J->xy[2 * j + 1];
@@ -524,6 +530,7 @@ int sup_build(const json_t *st, const sup_joints *J, sm_support **out, int *n)
     *n = 0;
     json_array_foreach(mems, i, x)
         total += sup_stretches(json_object_get(x, "foundation"));
+    total += (size_t)plat_base_free(st);
     if (!total)
         return SM_OK;
     if (!(*out = calloc(total, sizeof(sm_support))))
@@ -535,6 +542,8 @@ int sup_build(const json_t *st, const sup_joints *J, sm_support **out, int *n)
         for (j = 0; j < sup_stretches(f); j++)
             sup_fill_stretch(json_is_object(f) ? f : json_array_get(f, j), (int)i, &(*out)[k++]);
     }
+    if (k < total)
+        plat_fill(st, J, &(*out)[k]);
     *n = (int)total;
     return SM_OK;
 }
@@ -578,6 +587,8 @@ char *sup_pointer(const json_t *st, int index, const char *field)
             k -= sup_stretches(f);
         }
     }
+    if (!base && plat_base_free(st))
+        return plat_pointer(st, field);
     if (!base)
         return strdup(ns ? "/structure/springs" : "/structure/members");
     if (!rf)
@@ -585,26 +596,4 @@ char *sup_pointer(const json_t *st, int index, const char *field)
     p = err_ptr_key(base, rf);
     free(base);
     return p;
-}
-
-int sup_reserved(val_ctx *v, const json_t *st)
-{
-    const json_t *cl = json_object_get(st, "clamp");
-
-    if (json_object_get(st, "platform"))
-        field_error(v, "/structure/platform",
-                    "not supported yet: a floating platform (6x6 mass, added mass, hydrostatic "
-                    "and mooring matrices) needs a free base, which the solver does not have yet "
-                    "(issue 25)");
-    if (json_is_object(cl))
-        field_error(v, "/structure/clamp",
-                    "not supported yet: an elastic clamp {joint, stiffness, mass} needs base "
-                    "coordinates, which the solver does not have yet (issue 25); give the joint's "
-                    "name for a rigid clamp, or add a spring at a joint (\"springs\")");
-    else if (json_is_null(cl))
-        field_error(v, "/structure/clamp",
-                    "not supported yet: a free-floating structure (\"clamp\": null with a "
-                    "\"platform\") needs base coordinates, which the solver does not have yet "
-                    "(issue 25); give the name of the joint rigidly attached to the hub");
-    return json_is_object(cl) || json_is_null(cl);
 }

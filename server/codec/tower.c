@@ -24,9 +24,9 @@
  * tensor given in tower axes and turned into hub axes (I_hub = T I T^T,
  * T = [fa ss up] in hub components).
  *
- * Guy wires, a foundation and a floating platform need elastic supports
- * the core does not have yet: "wires", "foundation" and "platform" are
- * reserved and refused with "not supported yet", as is "gravity": true.
+ * "wires" and "foundation" are elastic supports (DESIGN.md 8.6); "platform" (a floating or
+ * elastic base: 6x6 matrices in tower axes) is platform.c's plat_tower, which writes the
+ * structure's "clamp": null and "platform" in hub axes.  "gravity": true is refused.
  */
 #include "codec_internal.h"
 
@@ -47,6 +47,8 @@ static const struct {
     {"/structure/sections", "/tower/section"},
     {"/structure/point_masses/0", "/tower/top_mass"},
     {"/structure/joints", "/tower/height"},
+    {"/structure/platform", "/tower/platform"},
+    {"/structure/clamp", "/tower/platform"},
     {"/structure/members", "/tower"}, /* a piece between wires (tower_split) */
     {"/structure", "/tower"},
 };
@@ -86,24 +88,9 @@ static const double tower_T[3][3] = {{0, 1, 0},  /* hub x: ss */
                                      {0, 0, 1},  /* hub y: up */
                                      {1, 0, 0}}; /* hub z: fa */
 
-/* The reserved fields (supports the core does not have yet) and gravity. */
+/* "gravity": only false (reserved). */
 static void tower_reserved(val_ctx *v, const json_t *tw, json_t *ct)
 {
-    static const struct {
-        const char *key, *what;
-    } r[] = {
-        {"platform", "a floating platform (6x6 mass, added mass, hydrostatic and mooring "
-                     "matrices)"},
-    };
-    size_t k;
-
-    for (k = 0; k < sizeof(r) / sizeof(r[0]); k++)
-        if (json_object_get(tw, r[k].key))
-            field_error_key(v, "/tower", r[k].key,
-                            "not supported yet: %s needs a free base, "
-                            "which the solver does not have yet (issue 25); leave "
-                            "'%s' out for a tower clamped at its base",
-                            r[k].what, r[k].key);
     field_bool(v, tw, "gravity", "/tower", ct, 0);
     if (json_is_true(json_object_get(tw, "gravity")))
         field_error(v, "/tower/gravity",
@@ -429,7 +416,8 @@ json_t *tower_validate(val_ctx *v, const json_t *root, json_t *canon)
     st = tower_structure(tw, g, top_ok ? t : NULL);
     if (!st)
         v->nomem = 1;
-    else
+    plat_tower(v, tw, ct, st, tower_T, g[1]);
+    if (st)
         cst = tower_check_structure(v, st);
     json_decref(st);
     mem = json_array_get(json_object_get(cst, "members"), 0);

@@ -580,8 +580,7 @@ void val_structure(val_ctx *v, const json_t *root, json_t *canon)
         !json_object_get(ends, json_string_value(clamp)))
         field_error(v, "/structure/clamp", "joint '%s' is not an end of any member",
                     field_short_name(json_string_value(clamp)).s);
-    if (!sup_reserved(v, st))
-        field_ref(v, st, "clamp", "/structure", cst, joints, "joint");
+    plat_clamp(v, st, joints, cst);
     json_decref(ends);
     json_decref(cover);
     v->cover = NULL;

@@ -148,8 +148,8 @@ def bad_files(exe, ref, tmp):
               .replace("3 3       n_wires", "2 3       n_wires"),
               "wires.bmi:54: n_wires: 2: must be an integer, 3 or more (BModes.f90:598)"),
              ("platform.bmi", tower.replace("0         tow_support", "2         tow_support"),
-              "platform.bmi:51: tow_support: 2 (offshore support: monopile or floating platform) "
-              "is not supported yet"))
+              "platform.bmi:13: hub_conn: 1 (cantilevered) with tow_support 2: BModes adds the "
+              "platform's matrices to the clamped root"))
     for name, text, want in cases:
         with open(os.path.join(tmp, name), "w") as f:
             f.write(text)
