@@ -165,7 +165,7 @@ char *codec_mode_label(const codec_request *r, int kind, int ordinal, char *buf,
                                               : NULL;
 
     sm_mode_label(kind, ordinal, buf, size);
-    if (!name || !json_object_get(codec_request_canonical(r), "tower"))
+    if (!name || !r || !json_object_get(codec_request_canonical(r), "tower"))
         return buf;
     /* a tower's flap (e3) is fore-aft and its edge (e2) side-side (tower.c, DESIGN.md 8.5):
      * name the mode by the direction it moves */
