@@ -106,6 +106,8 @@ static char *diag_options_pointer(const codec_request *r, const char *f, int ind
         }
         return strdup("/frames");
     }
+    if (!strcmp(f, "gravity")) /* DESIGN.md 8.8 */
+        return strdup(json_object_get(canon, "tower") ? "/tower/gravity" : "/structure/gravity");
     if (f[0] == '\0')
         return strdup("/analysis");
     return err_ptr_key("/analysis", diag_field_name(f));

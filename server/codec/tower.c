@@ -26,7 +26,8 @@
  *
  * "wires" and "foundation" are elastic supports (DESIGN.md 8.6); "platform" (a floating or
  * elastic base: 6x6 matrices in tower axes) is platform.c's plat_tower, which writes the
- * structure's "clamp": null and "platform" in hub axes.  "gravity": true is refused.
+ * structure's "clamp": null and "platform" in hub axes.  "gravity": true is the structure's
+ * "gravity" [0, -9.80665, 0] (DESIGN.md 8.8).
  */
 #include "codec_internal.h"
 
@@ -46,6 +47,7 @@ static const struct {
     {"/structure/sections/tower", "/tower/section"},
     {"/structure/sections", "/tower/section"},
     {"/structure/point_masses/0", "/tower/top_mass"},
+    {"/structure/gravity", "/tower/gravity"},
     {"/structure/joints", "/tower/height"},
     {"/structure/platform", "/tower/platform"},
     {"/structure/clamp", "/tower/platform"},
@@ -88,15 +90,14 @@ static const double tower_T[3][3] = {{0, 1, 0},  /* hub x: ss */
                                      {0, 0, 1},  /* hub y: up */
                                      {1, 0, 0}}; /* hub z: fa */
 
-/* "gravity": only false (reserved). */
-static void tower_reserved(val_ctx *v, const json_t *tw, json_t *ct)
+/* Standard gravity, m/s^2 (CGPM 1901): a tower's "gravity": true is this along -up. */
+#define TOWER_G 9.80665
+
+/* "gravity": false (default) or true: the weight of the tower and its top mass as a steady load
+ * (DESIGN.md 8.8), the expanded structure's "gravity" [0, -g, 0] (up = hub y). */
+static void tower_gravity(val_ctx *v, const json_t *tw, json_t *ct)
 {
     field_bool(v, tw, "gravity", "/tower", ct, 0);
-    if (json_is_true(json_object_get(tw, "gravity")))
-        field_error(v, "/tower/gravity",
-                    "not supported yet: the weight of the tower and top "
-                    "mass as an axial load needs the solver's support (issue 25); give false "
-                    "or leave it out (BModes and ElastoDyn's modes leave gravity out too)");
 }
 
 /* Most wires and foundation stretches of a tower. */
@@ -398,7 +399,7 @@ json_t *tower_validate(val_ctx *v, const json_t *root, json_t *canon)
     }
     field_check_keys(v, tw, "/tower", keys, "tower");
     tower_scalars(v, tw, ct, g);
-    tower_reserved(v, tw, ct);
+    tower_gravity(v, tw, ct);
     tower_supports(v, tw, ct, g, &sup);
     if ((tm = json_object_get(tw, "top_mass")))
         top_ok = blade_point_mass(v, tm, ct, "top_mass", "/tower/top_mass", "top mass",
@@ -414,6 +415,9 @@ json_t *tower_validate(val_ctx *v, const json_t *root, json_t *canon)
         return NULL;
     }
     st = tower_structure(tw, g, top_ok ? t : NULL);
+    if (st && json_is_true(json_object_get(tw, "gravity")) &&
+        json_object_set_new(st, "gravity", json_pack("[f, f, f]", 0.0, -TOWER_G, 0.0)))
+        v->nomem = 1;
     if (!st)
         v->nomem = 1;
     plat_tower(v, tw, ct, st, tower_T, g[1]);

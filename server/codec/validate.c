@@ -543,11 +543,25 @@ static void val_unused_joints(val_ctx *v, const json_t *joints, const json_t *en
     }
 }
 
+/* "gravity": [gx, gy, gz] (m/s^2, hub axes; DESIGN.md 8.8), spatial sections only; written to
+ * the canonical structure only when not zero (a request without it keeps its id). */
+static void val_gravity(val_ctx *v, const json_t *st, json_t *cst)
+{
+    double g[3];
+
+    if (json_object_get(st, "gravity") && val_spatial_field(v, st, "gravity", "/structure") &&
+        field_vector(v, st, "gravity", "/structure", 3, FIELD_FINITE, "[gx, gy, gz]", " (m/s^2)",
+                     g) &&
+        (g[0] != 0 || g[1] != 0 || g[2] != 0))
+        field_set(v, cst, "gravity", field_reals(g, 3));
+}
+
 /* The structure object. */
 void val_structure(val_ctx *v, const json_t *root, json_t *canon)
 {
-    static const char *const keys[] = {"joints", "sections", "members",  "point_masses",
-                                       "clamp",  "springs",  "platform", NULL};
+    static const char *const keys[] = {"joints",       "sections", "members",
+                                       "point_masses", "clamp",    "springs",
+                                       "platform",     "gravity",  NULL};
     const json_t *st = field_object(v, root, "structure", "");
     const json_t *joints, *secs, *clamp;
     const char *first_z;
@@ -571,6 +585,7 @@ void val_structure(val_ctx *v, const json_t *root, json_t *canon)
     if (ends)
         val_members(v, st, joints, secs, cst, ends, &ends_ok);
     val_point_masses(v, st, joints, cst);
+    val_gravity(v, st, cst);
     sup_springs(v, st, joints, cst);
     if (ends_ok)
         val_unused_joints(v, joints, ends);

@@ -15,7 +15,7 @@
  *       same_sha_as / different_sha_from (other files of the folder),
  *       joint_names, speeds, options, structure (with the spatial arrays:
  *       spatial, joint_z, joint_xy, member_spatial, point_mass_inertia,
- *       point_mass_products, point_mass_offset, member_stations), sections
+ *       point_mass_products, point_mass_offset, member_stations, gravity), sections
  *       (sm_section values, offsets), model (sizes from sm_model_get_info),
  *       rpm (codec_request_rpm) and input_warnings (exactly these); name (the
  *       request's "name", null for none), canonical_lacks, stored_contains (the
@@ -387,6 +387,9 @@ static void check_structure_spatial(test_case *tc, const sm_structure *st, const
     }
     if ((x = json_object_get(want, "joint_xy")) && !numbers_match(st->joint_xy, 2 * st->n_joints, x))
         fail(tc, "joint_xy differs");
+    if ((x = json_object_get(want, "gravity")) && !numbers_match(st->gravity, 3, x))
+        fail(tc, "gravity [%.17g, %.17g, %.17g] differs", st->gravity[0], st->gravity[1],
+             st->gravity[2]);
     check_stations(tc, st, json_object_get(want, "member_stations"));
 }
 

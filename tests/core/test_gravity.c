@@ -111,8 +111,9 @@ static void test_tip_mass(void)
         if (r && r->cases[0].status == SM_CASE_SOLVED) {
             double want = sqrt(k / M);
             TU_NEAR(gr_flap1(&r->cases[0]), want, 1e-5 * want,
-                    "%s tip mass, %s = %g (g = %.4g m/s^2): flap 1 against k = %s", hang ? "hanging" : "standing",
-                    hang ? "aL" : "bL", x, g, hang ? "T/(L - tanh(aL)/a)" : "P/(tan(bL)/b - L)");
+                    "%s tip mass, %s = %g (g = %.4g m/s^2): flap 1 against k = %s",
+                    hang ? "hanging" : "standing", hang ? "aL" : "bL", x, g,
+                    hang ? "T/(L - tanh(aL)/a)" : "P/(tan(bL)/b - L)");
         }
         sm_result_free(r);
     }
@@ -147,15 +148,19 @@ static void test_buckling(void)
 {
     const double M = 1000, Pcr = PI * PI * GR_EI / (4 * GR_L * GR_L), gcr = Pcr / M;
     int below = gr_stable(1e-4, M, 0.99 * gcr), above = gr_stable(1e-4, M, 1.01 * gcr);
-    TU_CHECK(below && !above, "top mass: stable at 0.99 of Euler's pi^2 EI/(4 L^2) (%d), unstable "
-                              "at 1.01 (%d)", below, above);
+    TU_CHECK(below && !above,
+             "top mass: stable at 0.99 of Euler's pi^2 EI/(4 L^2) (%d), unstable "
+             "at 1.01 (%d)",
+             below, above);
     printf("%s top mass on a light column: stable at 0.99 P_cr, unstable at 1.01 P_cr\n",
            below && !above ? "ok  " : "FAIL");
     const double mu = 10, qcr = 7.837 * GR_EI / (GR_L * GR_L * GR_L), g2 = qcr / mu;
     below = gr_stable(mu, 0, 0.99 * g2);
     above = gr_stable(mu, 0, 1.01 * g2);
-    TU_CHECK(below && !above, "own weight: stable at 0.99 of Greenhill's 7.837 EI/L^3 (%d), "
-                              "unstable at 1.01 (%d)", below, above);
+    TU_CHECK(below && !above,
+             "own weight: stable at 0.99 of Greenhill's 7.837 EI/L^3 (%d), "
+             "unstable at 1.01 (%d)",
+             below, above);
     printf("%s column under its own weight: stable at 0.99, unstable at 1.01 of Greenhill's load\n",
            below && !above ? "ok  " : "FAIL");
 }
