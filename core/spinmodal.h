@@ -200,6 +200,9 @@ typedef struct sm_structure {
      * six more coordinates (its translation and rotation) ahead of the modal ones (DESIGN.md
      * 8.6).  Spatial structures, analysed at rest (speeds 0) only. */
     int base_free;
+    /* with base_free: the directions the base is held in, bits 0..5 = x, y, z, rx, ry, rz (hub
+     * axes; e.g. BModes' hub_conn 3 holds a tower's heave and yaw); 0: free in all six */
+    unsigned base_held;
     /* the acceleration of gravity, m/s^2, hub frame (e.g. {0, -9.80665, 0} for a tower whose up
      * is hub y), a steady load on the structure at rest: the steady state under its own weight
      * and the linearisation there (DESIGN.md 8.8); all zero: none.  Spatial structures, speeds 0

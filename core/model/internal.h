@@ -128,8 +128,10 @@ struct sm_model {
     int gravity;         /* 1: grav is a steady load at rest (sm_structure.gravity): the kind's
                            "centrifugal" force is the weight's and the load factor s is 1 */
     double grav[3];      /* m/s^2, hub frame */
-    int base;            /* 6 when the clamp joint moves (sm_structure.base_free): q[0..5] its
-                           translation and rotation, hub axes; 0 otherwise */
+    int base;            /* base coordinates when the clamp joint moves (sm_structure.base_free):
+                           q[i] (i < base) its motion in direction base_dir[i] (0..5: x, y, z,
+                           rx, ry, rz, hub axes), the directions not held; 0 otherwise */
+    int base_dir[6];
     /* elastic supports (supports.c, DESIGN.md 8.6); has_supports 0: none, all empty */
     int has_supports;
     int n_sup;             /* nodes with a support */

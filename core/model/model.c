@@ -82,7 +82,10 @@ static int model_mesh(sm_model **out, const sm_structure *st, const sm_options *
         m->opt.tolerance = 1e-10;
     int rc = mesh_build(m, st, d);
     if (rc == SM_OK) {
-        m->base = st->base_free ? 6 : 0;
+        m->base = 0;
+        for (int i = 0; st->base_free && i < 6; i++)
+            if (!(st->base_held & (1u << i)))
+                m->base_dir[m->base++] = i;
         m->gravity = st->gravity[0] != 0 || st->gravity[1] != 0 || st->gravity[2] != 0;
         memcpy(m->grav, st->gravity, sizeof m->grav);
         rc = supports_lump(m, st);

@@ -89,6 +89,20 @@ static int sup_check_foundation(const sm_support *s, int i, double L, sm_diag *d
     return SM_OK;
 }
 
+/* K (6x6) restricted to the directions not in held: the held rows and columns become those of
+ * the identity scaled to K's largest entry (they have no coordinate; this keeps the definiteness
+ * test of the free block). */
+static void sup_free_block(double K[36], unsigned held)
+{
+    double mx = 0;
+    for (int i = 0; i < 36; i++)
+        mx = fmax(mx, fabs(K[i]));
+    for (int i = 0; i < 6; i++)
+        if (held & (1u << i))
+            for (int j = 0; j < 6; j++)
+                K[i + 6 * j] = K[j + 6 * i] = i == j ? (mx > 0 ? mx : 1.0) : 0.0;
+}
+
 int supports_check(const sm_structure *st, const sm_options *o, sm_diag *d)
 {
     for (int i = 0; i < st->n_supports; i++) {
@@ -133,11 +147,20 @@ int supports_check(const sm_structure *st, const sm_options *o, sm_diag *d)
                 for (int c = 0; c < 36; c++)
                     Kb[c] += st->supports[i].K[c];
             }
+        if (st->base_held & ~0x3fu)
+            return smi_input_fail(
+                d, SM_ITEM_CLAMP, -1, "",
+                "the held directions of a base are bits 0..5 (x, y, z, rx, ry, rz)");
+        if ((st->base_held & 0x3fu) == 0x3fu)
+            return smi_input_fail(d, SM_ITEM_CLAMP, -1, "",
+                                  "a base held in all six directions is a clamp: give the clamp "
+                                  "joint without base_free");
+        sup_free_block(Kb, st->base_held);
         if (held && sup_symmetric(Kb) && !(sup_lowest(Kb) > 1e-12))
             return smi_input_fail(
                 d, SM_ITEM_CLAMP, -1, "",
-                "a free base needs stiffness in all six directions at the clamp "
-                "joint (hydrostatic and mooring for a platform): rigid-body modes "
+                "a free base needs stiffness in every direction it is free in at the "
+                "clamp joint (hydrostatic and mooring for a platform): rigid-body modes "
                 "at zero frequency are not supported yet");
         if (!held)
             return smi_input_fail(d, SM_ITEM_CLAMP, -1, "",

@@ -424,7 +424,7 @@ void sp_eval(const sm_model *m, const double *q, sp_kin *k)
         int s = m->subs[c].parent, e = m->subs[c].root;
         if (s < 0) { /* a free base moves the root frames rigidly about the clamp (at rest) */
             for (int i = 0; i < m->base; i++)
-                DM(&k->JRT, i, 6 * c + i) = 1.0;
+                DM(&k->JRT, i, 6 * c + m->base_dir[i]) = 1.0;
             continue;
         }
         double *JRc = &DM(&k->JRT, 0, 6 * c);
@@ -435,7 +435,7 @@ void sp_eval(const sm_model *m, const double *q, sp_kin *k)
         int s = m->pt[pi].sub;
         if (s < 0) { /* the clamp point: with a free base it is the base */
             for (int i = 0; i < m->base; i++)
-                DM(&k->JW, i, 6 * pi + i) = 1.0;
+                DM(&k->JW, i, 6 * pi + m->base_dir[i]) = 1.0;
             continue;
         }
         double *Jp = &DM(&k->JW, 0, 6 * pi);

@@ -4,7 +4,8 @@
  *  1. rigid body on a platform: a nearly rigid, light mast on a base with a 6x6 stiffness and
  *     mass; its six lowest frequencies are those of the 6x6 rigid-body problem K v = w^2 M v,
  *     M = the platform's mass + the mast's lumped masses carried rigidly, solved here with LAPACK
- *     (dsygv) from the same numbers: 1e-5;
+ *     (dsygv) from the same numbers: 1e-5; and held in y and ry (heave and yaw of a tower along
+ *     y, BModes' hub_conn 3): the 4x4 problem of the free directions;
  *  2. an elastic clamp: a cantilever on a rotational spring k (translations held stiff) against
  *     the spring-hinged cantilever's frequency equation (the 4x4 boundary determinant of
  *     Euler-Bernoulli modes; k -> infinity gives the clamped roots 1.875, 4.694): 0.1 %;
@@ -68,8 +69,9 @@ static sm_result *base_solve(const sm_structure *st, int modes, double omega, sm
     return r;
 }
 
-/* 1. the six rigid-body frequencies of a stiff, light mast on a platform. */
-static void test_rigid(void)
+/* 1. the rigid-body frequencies of a stiff, light mast on a platform free in the directions not
+ * in held (bits x, y, z, rx, ry, rz). */
+static void test_rigid(unsigned held)
 {
     const double H = 10, mu = 2.0, K[6] = {4e5, 9e5, 6e5, 3e7, 5e7, 2e7};
     const double Mp[6] = {1000, 1200, 900, 4000, 3000, 5000};
@@ -81,8 +83,13 @@ static void test_rigid(void)
         b.sup.M[i + 6 * i] = Mp[i];
     }
     b.sup.K[0 + 6 * 5] = b.sup.K[5 + 6 * 0] = 1e6; /* surge-yaw coupling, still definite */
+    b.st.base_held = held;
+    int fr[6], nf = 0;
+    for (int i = 0; i < 6; i++)
+        if (!(held & (1u << i)))
+            fr[nf++] = i;
     sm_diag d;
-    sm_result *r = base_solve(&b.st, 6, 0.0, &d);
+    sm_result *r = base_solve(&b.st, nf, 0.0, &d);
     TU_CHECK(r && r->cases[0].status == SM_CASE_SOLVED, "solved: %s",
              r ? r->cases[0].message : d.message);
     if (!r || r->cases[0].status != SM_CASE_SOLVED)
@@ -106,15 +113,22 @@ static void test_rigid(void)
             }
         }
     }
-    TU_CHECK(LAPACKE_dsygv(LAPACK_COL_MAJOR, 1, 'N', 'L', 6, A, 6, B, 6, w) == 0, "dsygv");
-    for (int j = 0; j < 6; j++)
+    double Af[36], Bf[36]; /* the free directions' block */
+    for (int j = 0; j < nf; j++)
+        for (int i = 0; i < nf; i++) {
+            Af[i + nf * j] = A[fr[i] + 6 * fr[j]];
+            Bf[i + nf * j] = B[fr[i] + 6 * fr[j]];
+        }
+    TU_CHECK(LAPACKE_dsygv(LAPACK_COL_MAJOR, 1, 'N', 'L', nf, Af, nf, Bf, nf, w) == 0, "dsygv");
+    for (int j = 0; j < nf; j++)
         TU_CHECK(r->cases[0].support_share && r->cases[0].support_share[j] > 0.99999,
                  "rigid-body mode %d: the supports hold the strain energy (share %.9f)", j + 1,
                  r->cases[0].support_share ? r->cases[0].support_share[j] : -1.0);
-    for (int j = 0; j < 6; j++)
+    for (int j = 0; j < nf; j++)
         TU_NEAR(r->cases[0].frequency[j], sqrt(w[j]), 1e-5 * sqrt(w[j]),
-                "rigid mast on a platform: mode %d (rad/s) against the 6x6 rigid-body problem",
-                j + 1);
+                "rigid mast on a platform held in 0x%02x: mode %d (rad/s) against the %dx%d "
+                "rigid-body problem",
+                held, j + 1, nf, nf);
 done:
     sm_result_free(r);
 }
@@ -213,7 +227,8 @@ static void test_refusals(void)
 
 int main(void)
 {
-    test_rigid();
+    test_rigid(0);
+    test_rigid(0x12); /* held in y and ry: a tower's heave and yaw (BModes hub_conn 3) */
     test_elastic_clamp();
     test_refusals();
     return tu_finish("base");
