@@ -383,6 +383,9 @@ const char *plat_clamp_name(const json_t *st);
 
 /** 1 when the canonical structure st has a free base (elastic clamp or platform), else 0. */
 int plat_base_free(const json_t *st);
+/** sm_structure.base_held of the canonical st: its platform's "held" directions (bits x, y, z,
+ *  rx, ry, rz), 0 without a floating platform. */
+unsigned plat_base_held(const json_t *st);
 
 /**
  * The free base's point support of the canonical st (plat_base_free 1) into s: at the clamp

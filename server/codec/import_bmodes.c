@@ -462,17 +462,16 @@ static int bm_support(bm_in *b, bm_main *m)
     ts = (long)x;
     if (ts == 1)
         return bm_wires(b, m);
-    if (ts == 2 && m->hub_conn == 2)
-        return bm_platform(b, m);
+    if (ts == 2 && (m->hub_conn == 2 || m->hub_conn == 3))
+        return bm_platform(b, m); /* 3: held in heave and yaw (bm_tower_platform) */
     if (m->hub_conn == 1 && ts < 2)
         return SM_OK;
     return imp_fail(b->d, b->file, m->hub_conn_line, "hub_conn",
                     m->hub_conn == 2   ? "2 (free root) needs tow_support 2 (a platform): "
                                          "without one the tower has no support"
                     : m->hub_conn == 3 ? "3 (base held in heave and torsion, free laterally on "
-                                         "the platform's matrices) is not supported yet: the "
-                                         "solver's free base moves in all six directions; give "
-                                         "hub_conn 2 with stiffness in every direction"
+                                         "the platform's matrices) needs tow_support 2 (the "
+                                         "platform or monopile matrices)"
                                        : "1 (cantilevered) with tow_support 2: BModes adds the "
                                          "platform's matrices to the clamped root, where they "
                                          "do nothing; give hub_conn 2 (free root) or "
@@ -750,6 +749,10 @@ static int bm_tower_platform(json_t *doc, const bm_main *m)
                    bm_rows(m->pf[3]), "reference_height", imp_round(m->draft - m->ref_msl),
                    "mass_height", imp_round(m->draft - m->cm_pform));
     if (!pf || json_object_set_new(tw, "platform", pf))
+        return -1;
+    /* hub_conn 3: BModes' iartic 10 (BModes.f90:917-919, BldVib.f90:450-454) frees the root's
+     * lateral displacements and slopes and holds its axial displacement and twist */
+    if (m->hub_conn == 3 && json_object_set_new(pf, "held", json_pack("[s, s]", "up", "r_up")))
         return -1;
     for (k = 0; k < 4; k++)
         if (m->asym[k] > 0 &&

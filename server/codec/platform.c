@@ -50,11 +50,66 @@ static void plat_elastic(val_ctx *v, const json_t *cl, const json_t *joints, jso
         sup_matrix6(v, cl, p, "mass", PLAT_M_UNIT, 0, c, a);
 }
 
+/* Direction names of a base, hub axes (bit i of sm_structure.base_held) and the tower form's
+ * (tower axes fa, ss, up = hub z, x, y: tower name k is hub direction plat_tower_dir[k]). */
+static const char *const plat_dirs[6] = {"x", "y", "z", "rx", "ry", "rz"};
+static const char *const plat_tower_dirs[6] = {"fa", "ss", "up", "r_fa", "r_ss", "r_up"};
+static const int plat_tower_dir[6] = {2, 0, 1, 5, 3, 4};
+
+/* "held" of pf at p: the directions (names, one each, not all six) the base is held in, as a
+ * mask of bits over names[]; -1 when invalid (reported). */
+static int plat_held(val_ctx *v, const json_t *pf, const char *p, const char *const names[6])
+{
+    const json_t *h = json_object_get(pf, "held"), *x;
+    char ptr[64];
+    size_t i;
+    int mask = 0, k;
+
+    if (!h)
+        return 0;
+    snprintf(ptr, sizeof ptr, "%s/held", p);
+    if (!json_is_array(h) || json_array_size(h) < 1 || json_array_size(h) > 5) {
+        field_error(v, ptr,
+                    "must be an array of 1 to 5 direction names among %s, %s, %s, %s, %s, %s "
+                    "(held in all six is a rigid clamp)",
+                    names[0], names[1], names[2], names[3], names[4], names[5]);
+        return -1;
+    }
+    json_array_foreach(h, i, x) {
+        for (k = 0; k < 6; k++)
+            if (json_is_string(x) && !strcmp(json_string_value(x), names[k]))
+                break;
+        if (k == 6 || (mask & (1 << k))) {
+            char q[128];
+            snprintf(q, sizeof q, "%s/%zu", ptr, i);
+            field_error(v, q, "%s: each direction once, among %s, %s, %s, %s, %s, %s",
+                        k == 6 ? "unknown direction" : "given twice", names[0], names[1], names[2],
+                        names[3], names[4], names[5]);
+            return -1;
+        }
+        mask |= 1 << k;
+    }
+    return mask;
+}
+
+/* The names of mask's bits over names[] (new). */
+static json_t *plat_held_names(int mask, const char *const names[6])
+{
+    json_t *a = json_array();
+    for (int k = 0; a && k < 6; k++)
+        if ((mask & (1 << k)) && json_array_append_new(a, json_string(names[k]))) {
+            json_decref(a);
+            return NULL;
+        }
+    return a;
+}
+
 /* The platform object pf at /structure/platform into canonical c. */
 static void plat_floating(val_ctx *v, const json_t *pf, const json_t *joints, json_t *c)
 {
-    static const char *const keys[] = {"joint",   "mass",      "added_mass",     "hydrostatic",
-                                       "mooring", "reference", "mass_reference", NULL};
+    static const char *const keys[] = {"joint",          "mass",    "added_mass",
+                                       "hydrostatic",    "mooring", "reference",
+                                       "mass_reference", "held",    NULL};
     static const char *const mats[] = {"mass", "added_mass", "hydrostatic", "mooring"};
     static const char *const pt[] = {"reference", "mass_reference"};
     static const char *p = "/structure/platform";
@@ -72,6 +127,8 @@ static void plat_floating(val_ctx *v, const json_t *pf, const json_t *joints, js
         if (json_object_get(pf, pt[k]) &&
             field_vector(v, pf, pt[k], p, 3, FIELD_FINITE, "[x, y, z]", " (m)", r))
             field_set(v, c, pt[k], field_reals(r, 3));
+    if ((k = plat_held(v, pf, p, plat_dirs)) > 0)
+        field_set(v, c, "held", plat_held_names(k, plat_dirs));
 }
 
 void plat_clamp(val_ctx *v, const json_t *st, const json_t *joints, json_t *cst)
@@ -130,6 +187,19 @@ int plat_base_free(const json_t *st)
     const json_t *cl = json_object_get(st, "clamp");
 
     return json_is_object(cl) || (json_is_null(cl) && json_object_get(st, "platform"));
+}
+
+unsigned plat_base_held(const json_t *st)
+{
+    const json_t *h = json_object_get(json_object_get(st, "platform"), "held"), *x;
+    unsigned mask = 0;
+    size_t i;
+
+    json_array_foreach(h, i, x)
+        for (int k = 0; k < 6; k++)
+            if (json_is_string(x) && !strcmp(json_string_value(x), plat_dirs[k]))
+                mask |= 1u << k;
+    return json_is_null(json_object_get(st, "clamp")) ? mask : 0;
 }
 
 /* a (6x6, column-major) about the point r from the joint moved to the joint: T^T a T. */
@@ -264,7 +334,8 @@ void plat_tower(val_ctx *v, const json_t *tw, json_t *ct, json_t *st, const doub
                 double base_height)
 {
     static const char *const keys[] = {
-        "mass", "added_mass", "hydrostatic", "mooring", "reference_height", "mass_height", NULL};
+        "mass",        "added_mass", "hydrostatic", "mooring", "reference_height",
+        "mass_height", "held",       NULL};
     static const char *p = "/tower/platform";
     const json_t *pf = json_object_get(tw, "platform");
     double a[36], h[2] = {base_height, base_height}, pt[3] = {0, 0, 0};
@@ -306,6 +377,16 @@ void plat_tower(val_ctx *v, const json_t *tw, json_t *ct, json_t *st, const doub
     for (k = 0; k < 2; k++) { /* the points on the tower's axis: up = hub y */
         pt[1] = h[k];
         field_set(v, sp, k ? "mass_reference" : "reference", field_reals(pt, 3));
+    }
+    if ((k = plat_held(v, pf, p, plat_tower_dirs)) > 0) { /* tower names -> hub directions */
+        int hub = 0;
+        for (int i = 0; i < 6; i++)
+            if (k & (1 << i))
+                hub |= 1 << plat_tower_dir[i];
+        field_set(v, c, "held", plat_held_names(k, plat_tower_dirs));
+        field_set(v, sp, "held", plat_held_names(hub, plat_dirs));
+    } else if (k < 0) {
+        ok = 0;
     }
     if (ok) {
         field_set(v, st, "clamp", json_null());

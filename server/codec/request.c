@@ -249,6 +249,7 @@ static int req_build_structure(codec_request *r)
     r->st.point_masses = r->point_masses;
     r->st.clamp = req_name_index(r->joint_names, nj, plat_clamp_name(st));
     r->st.base_free = plat_base_free(st);
+    r->st.base_held = plat_base_held(st);
     for (int k = 0; k < 3; k++) /* DESIGN.md 8.8: absent = none */
         r->st.gravity[k] = req_number(json_array_get(json_object_get(st, "gravity"), (size_t)k));
     {

@@ -16,7 +16,12 @@ Usage: platform_test.py SPINMODAL REFERENCE_DIR
 - The tower form's platform (tower axes fa, ss, up) equals the structure form's in hub axes
   (fa = z, ss = x, up = y).
 - Refusals with pointers: a speed other than 0, "clamp": null without a platform, a planar
-  structure on a free base, a negative mass; hub_conn 3 in a .bmi (file:line:field).
+  structure on a free base, a negative mass; hub_conn 3 without a platform in a .bmi
+  (file:line:field); a direction held twice.
+- BModes' CS_Monopile example (docs/examples/CS_Monopile.bmi, hub_conn 3: the base held in heave
+  and yaw, free laterally on the mudline's 6x6 soil springs) through `--bmodes-mesh 1` against
+  BModes v3.00 run by us (tests/reference/bmodes_offshore/cs_monopile_frequencies.csv): modes
+  1-10 within 0.5 %, all 20 within 1 %.
 """
 import copy
 import csv
@@ -75,6 +80,33 @@ def oc3(exe, ref):
         print("     mode %2d: %.8g Hz, BModes %.8g Hz (%+.4f %%)" % (i + 1, g, w, 100 * e))
     check(max(abs(e) for e in dev) < 5e-3,
           "OC3 Hywind: modes 1-%d within 0.5 %% of BModes (max %.4f %%)"
+          % (len(want), 100 * max(abs(e) for e in dev)))
+
+
+def monopile(exe, ref):
+    """BModes' CS_Monopile (hub_conn 3: the base held in heave and yaw on 6x6 soil springs)."""
+    src = os.path.join(ref, "bmodes_offshore")
+    with open(os.path.join(src, "cs_monopile_frequencies.csv")) as f:
+        want = [float(r["freq_Hz"]) for r in csv.DictReader(l for l in f if not l.startswith("#"))]
+    rc, out, err = run(exe, ["import", "bmodes", "--bmodes-mesh", "1", "CS_Monopile.bmi"], cwd=src)
+    if not check(rc == 0, "CS_Monopile --bmodes-mesh 1 imported (%s)" % err.strip()[-300:]):
+        return
+    req = json.loads(out)
+    check(req["structure"]["platform"].get("held") == ["y", "ry"],
+          "CS_Monopile: hub_conn 3 holds the base in heave and yaw (hub y, ry): %s"
+          % req["structure"]["platform"].get("held"))
+    req["analysis"]["modes"] = len(want)
+    got = freqs(exe, req, "CS_Monopile")
+    if not check(len(got) >= len(want), "CS_Monopile: %d modes" % len(got)):
+        return
+    dev = [(g - w) / w for g, w in zip(got, want)]
+    for i, (g, w, e) in enumerate(zip(got, want, dev)):
+        print("     mode %2d: %.8g Hz, BModes %.8g Hz (%+.4f %%)" % (i + 1, g, w, 100 * e))
+    check(max(abs(e) for e in dev[:10]) < 5e-3,
+          "CS_Monopile: modes 1-10 within 0.5 %% of BModes (max %.4f %%)"
+          % (100 * max(abs(e) for e in dev[:10])))
+    check(max(abs(e) for e in dev) < 1e-2,
+          "CS_Monopile: modes 1-%d within 1 %% of BModes (max %.4f %%)"
           % (len(want), 100 * max(abs(e) for e in dev)))
 
 
@@ -228,10 +260,17 @@ def refusals(exe, ref, tmp):
     with open(os.path.join(src, "OC3Hywind.bmi")) as f:
         text = f.read()
     with open(os.path.join(tmp, "held.bmi"), "w") as f:
-        f.write(text.replace("2         hub_conn", "3         hub_conn"))
+        f.write(text.replace("2         hub_conn", "3         hub_conn")
+                .replace("2          tow_support", "0          tow_support"))
     rc, out, err = run(exe, ["import", "bmodes", "held.bmi"], cwd=tmp)
-    check(rc == 2 and "held.bmi:13: hub_conn: 3" in err,
-          "hub_conn 3 with a platform: exit 2 at file:line:field (%s)" % err.strip()[:200])
+    check(rc == 2 and "held.bmi:13: hub_conn: 3" in err and "tow_support 2" in err,
+          "hub_conn 3 without a platform: exit 2 at file:line:field (%s)" % err.strip()[:200])
+    req = platform_req()
+    req["structure"]["platform"]["held"] = ["y", "y"]
+    rc, d = solve_doc(exe, req)
+    e = d.get("errors", [{}])[0]
+    check(rc == 2 and e.get("pointer") == "/structure/platform/held/1",
+          "a direction held twice: 422 at its entry (%s)" % e)
 
 
 def main():
@@ -239,6 +278,7 @@ def main():
     tmp = tempfile.mkdtemp(prefix="spinmodal-platform-")
     try:
         oc3(exe, ref)
+        monopile(exe, ref)
         rigid(exe)
         tower_form(exe)
         refusals(exe, ref, tmp)
