@@ -150,6 +150,10 @@ typedef int (*import_parse_fn)(json_t **out, const import_file *f, import_loader
                               the CLI's --allow-outside applies */
 #define IMPORT_OWN_MESH 2u /* import_options.bmodes_mesh applies (CLI --bmodes-mesh, HTTP
                               ?bmodes_mesh=) */
+#define IMPORT_NAMED_FILES \
+    4u /* the main file may name other files (an ElastoDyn main file's
+                                 TwrFile, BldFile): HTTP takes JSON {main, files: {NAME: text},
+                                 name}, each file under the name the main file gives it */
 
 /**
  * One import format (import_formats.c).  The CLI and the HTTP route do for a format only what

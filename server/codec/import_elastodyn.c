@@ -417,8 +417,8 @@ static int ed_load(import_loader load, void *ctx, const char *main, const char *
     }
     if (!st && (!out->text || !out->len))
         return imp_fail(d, main, line, field,
-                        "the file it names was not given (over HTTP the "
-                        "main file's tower and blade files cannot be sent yet: use the CLI)");
+                        "the file it names was not given (over HTTP: JSON {\"main\", "
+                        "\"files\": {NAME: text}} with each file the main file names)");
     if (!st && !out->name)
         out->name = name;
     return st ? st : imp_encoding(d, out, out);

@@ -40,7 +40,7 @@ const import_format import_formats[] = {
      IMPORT_SEC_FILE | IMPORT_OWN_MESH, import_bmodes},
     {"elastodyn", "ElastoDyn", "blade.dat",
      "BLADE.dat --tip-radius R [--hub-radius H] [--rpm SPEEDS] | MAIN.dat [--part blade [--rpm SPEEDS]]",
-     0, imf_elastodyn},
+     IMPORT_NAMED_FILES, imf_elastodyn},
     {"csv", "CSV", "stations.csv", "FILE [--tip-radius R] [--hub-radius H] [--rpm SPEEDS]", 0,
      imf_csv},
     {NULL, NULL, NULL, NULL, 0, NULL},

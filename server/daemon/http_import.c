@@ -37,6 +37,7 @@ typedef struct http_import_in {
     int json;              /* the body is JSON */
     import_file main;      /* the .bmi / blade file / CSV */
     import_file sec;       /* BModes section file (JSON "sec_props") */
+    const json_t *files;   /* IMPORT_NAMED_FILES: JSON "files" {NAME: text} (borrowed), or NULL */
     import_options opt;
     json_t *rpm_speeds;    /* ?rpm= as a list or range (opt.rpm_speeds), NULL for one speed */
 } http_import_in;
@@ -163,6 +164,7 @@ static int http_import_json(struct MHD_Connection *c, http_req *r, http_import_i
                             json_t **doc, enum MHD_Result *q)
 {
     int two = (in->format->flags & IMPORT_SEC_FILE) != 0; /* main and sec_props */
+    int named = (in->format->flags & IMPORT_NAMED_FILES) != 0; /* main and files */
     const char *key;
     json_error_t jerr;
     json_t *v;
@@ -173,12 +175,30 @@ static int http_import_json(struct MHD_Connection *c, http_req *r, http_import_i
         return -1;
     }
     json_object_foreach(*doc, key, v) {
-        if (strcmp(key, "main") && strcmp(key, "name") && (!two || strcmp(key, "sec_props"))) {
+        if (strcmp(key, "main") && strcmp(key, "name") && (!two || strcmp(key, "sec_props")) &&
+            (!named || strcmp(key, "files"))) {
             char pointer[80];
             snprintf(pointer, sizeof(pointer), "/%.60s", key);
-            *q = http_import_bad(c, r, pointer, two ? "unknown key; expected main, sec_props "
-                                 "and name" : "unknown key; expected main and name");
+            *q = http_import_bad(c, r, pointer,
+                                 two     ? "unknown key; expected main, sec_props and name"
+                                 : named ? "unknown key; expected main, files and name"
+                                         : "unknown key; expected main and name");
             return -1;
+        }
+        if (named && !strcmp(key, "files")) { /* {NAME: text}: the files the main file names */
+            const char *fk;
+            json_t *fv;
+            int ok = json_is_object(v);
+            json_object_foreach(v, fk, fv)
+                ok &= json_is_string(fv);
+            if (!ok) {
+                *q = http_import_bad(c, r, "/files",
+                                     "must be an object of the named files' texts {\"NAME\": "
+                                     "\"text\"}, NAME as the main file writes it");
+                return -1;
+            }
+            in->files = v;
+            continue;
         }
         if (!json_is_string(v)) {
             char pointer[80];
@@ -206,17 +226,29 @@ static int http_import_json(struct MHD_Connection *c, http_req *r, http_import_i
     return 0;
 }
 
-/* import_loader: the JSON's sec_props, under the name the .bmi gives it. */
+/* import_loader: the JSON's sec_props, under the name the .bmi gives it; with "files", the
+ * text given under the name the main file writes (or its last path component). */
 static int http_import_load(void *ctx, const char *name, import_file *out, char *why,
                             size_t cap)
 {
     const http_import_in *in = ctx;
+    const json_t *t;
+    const char *base = strrchr(name, '/');
 
-    (void)name;
-    (void)why;
-    (void)cap;
     *out = in->sec;
     out->name = NULL;
+    if (!(in->format->flags & IMPORT_NAMED_FILES))
+        return SM_OK;
+    t = json_object_get(in->files, name);
+    if (!t && base)
+        t = json_object_get(in->files, base + 1);
+    if (!t) {
+        snprintf(why, cap, "not in the request's \"files\": give its text as files[\"%s\"]",
+                 base ? base + 1 : name);
+        return SM_INVALID_INPUT;
+    }
+    out->text = json_string_value(t);
+    out->len = json_string_length(t);
     return SM_OK;
 }
 
@@ -231,9 +263,25 @@ static enum MHD_Result http_import_refused(struct MHD_Connection *c, http_req *r
     if (d->line == 0 && (!strcmp(d->field, "tip_radius") || !strcmp(d->field, "hub_radius") ||
                          !strcmp(d->field, "rpm")))
         snprintf(pointer, sizeof(pointer), "/query/%s", d->field);
-    else if (in->json)
-        snprintf(pointer, sizeof(pointer), "%s",
-                 in->main.name && !strcmp(d->file, in->main.name) ? "/main" : "/sec_props");
+    else if (in->json && in->main.name && !strcmp(d->file, in->main.name))
+        snprintf(pointer, sizeof(pointer), "/main");
+    else if (in->json && in->files) { /* a named file: /files/NAME (as a JSON pointer) */
+        const char *base = strrchr(d->file, '/'), *key = d->file;
+        if (!json_object_get(in->files, key) && base)
+            key = base + 1;
+        size_t n = strlen("/files/");
+        memcpy(pointer, "/files/", n + 1);
+        for (; *key && n + 3 < sizeof(pointer); key++) { /* RFC 6901: ~ -> ~0, / -> ~1 */
+            if (*key == '~' || *key == '/') {
+                pointer[n++] = '~';
+                pointer[n++] = *key == '~' ? '0' : '1';
+            } else {
+                pointer[n++] = *key;
+            }
+        }
+        pointer[n] = '\0';
+    } else if (in->json)
+        snprintf(pointer, sizeof(pointer), "/sec_props");
     if (errs && codec_errors_add(errs, pointer, "%s", d->text) == SM_OK)
         p = codec_problem_new(MHD_HTTP_UNPROCESSABLE_CONTENT, HTTP_PROBLEMS "import-invalid",
                               "Unprocessable Content", d->text, errs);

@@ -5,7 +5,8 @@ Usage: import_test.py SPINMODALD REFERENCE_BLADES_DIR
 
 Starts one daemon (harness: daemon.py) with a small --max-body and checks: the
 BModes JSON body {"main", "sec_props"} gives the import document (200); elastodyn
-and csv take the raw text or JSON {"main"}, with ?tip_radius= etc.; a refused file is
+and csv take the raw text or JSON {"main"}, with ?tip_radius= etc.; a main ElastoDyn file
+takes the files it names as JSON {"main", "files": {NAME: text}}; a refused file is
 a 422 problem document naming file, line and field; wrong media type 415, malformed
 JSON 400, bad query 400, body over --max-body 413, unknown format 404, GET 405;
 --auth-reads makes the token necessary, as for /v1/validate; nothing is stored (the
@@ -118,6 +119,31 @@ def scenario(exe, ref, tmp):
         r = d.request("POST", "/v1/import/elastodyn?tip_radius=abc", body=ed,
                       headers={"Content-Type": "text/plain"})
         check(r.status == 400, "bad ?tip_radius: 400 (got %s)" % r.status)
+
+        # a main ElastoDyn file with the files it names (TwrFile, BldFile) in "files"
+        edd = os.path.join(ref, "elastodyn")
+        edmain = read(os.path.join(edd, "NRELOffshrBsline5MW_Onshore_ElastoDyn.dat"))
+        twr = "NRELOffshrBsline5MW_Onshore_ElastoDyn_Tower.dat"
+        bld = "NRELOffshrBsline5MW_Blade.dat"
+        files = {twr: read(os.path.join(edd, twr)), bld: read(os.path.join(edd, bld))}
+        r = d.post("/v1/import/elastodyn", {"main": edmain, "files": files, "name": "5MW.dat"})
+        tw = (r.json() or {}).get("request", {}).get("tower", {})
+        check(r.status == 200 and tw.get("height") == 87.6 and len(tw.get("stations", [])) == 11
+              and 3.49e5 < tw.get("top_mass", {}).get("mass", 0) < 3.50e5,
+              "elastodyn main file with its files: 200, the tower form (87.6 m, 11 stations, "
+              "top mass %s kg) (got %s)" % (tw.get("top_mass", {}).get("mass"), r.status))
+        r = d.post("/v1/import/elastodyn", {"main": edmain, "files": {twr: files[twr]},
+                                            "name": "5MW.dat"})
+        p = r.json() or {}
+        check(r.status == 422 and p.get("field") == "BldFile(1)" and bld in p.get("detail", "")
+              and p.get("errors", [{}])[0].get("pointer") == "/main",
+              "elastodyn main file without its blade file: 422 at /main, BldFile(1) (%s)"
+              % p.get("detail"))
+        r = d.post("/v1/import/elastodyn", {"main": edmain, "files": [files[twr]]})
+        check(r.status == 400 and ((r.json() or {}).get("errors") or [{}])[0].get("pointer")
+              == "/files", "elastodyn \"files\" not an object: 400 at /files (got %s)" % r.status)
+        r = d.post("/v1/import/bmodes", {"main": main, "sec_props": sec, "files": {}})
+        check(r.status == 400, "bmodes takes no \"files\": 400 (got %s)" % r.status)
 
         # CSV
         text = b"s,mass_per_length,EI_flap,EI_edge,GJ,EA\n0,10,1e6,2e6,1e5,1e8\n1,5,1e5,2e5,1e4,5e7\n"
