@@ -62,12 +62,14 @@ typedef struct edt_input {
     int tower;            /* 1: the tower form's member (fore-aft, side-side; want {2, 2}) */
     double ax[9], length;
     double *x, *twist; /* n each */
+    json_t *own;       /* a wired tower's members joined into one layout (layout), or NULL */
 } edt_input;
 
 static void edt_input_clear(edt_input *in)
 {
     free(in->x);
     free(in->twist);
+    json_decref(in->own);
     memset(in, 0, sizeof *in);
 }
 
@@ -78,9 +80,55 @@ static int edt_err(char *err, size_t errcap, const char *msg)
     return SM_INVALID_INPUT;
 }
 
+/* A wired tower's members (tower_1 ... tower_k in the request, each "tower" in the result's
+ * model; base to top, cut at the wires: DESIGN.md 8.6)
+ * as one layout "tower" (new): their nodes in order (each shared joint once), s over the whole
+ * flexible length, the axes of the first (they are collinear, flap_direction fa); NULL when
+ * mems are not such members. */
+static json_t *edt_join_tower(const json_t *mems)
+{
+    const json_t *lay;
+    json_t *nodes = json_array(), *s = json_array(), *tw = json_array(), *out = NULL;
+    double total = 0, acc = 0;
+    size_t i, j;
+
+    json_array_foreach(mems, i, lay) { /* each "tower" (result.c), joined end to start */
+        const char *id = json_string_value(json_object_get(lay, "id"));
+        const json_t *nd = json_object_get(lay, "nodes");
+        const json_t *prev = i ? json_object_get(json_array_get(mems, i - 1), "nodes") : NULL;
+        if (!id || strcmp(id, "tower") ||
+            (prev &&
+             !json_equal(json_array_get(prev, json_array_size(prev) - 1), json_array_get(nd, 0))))
+            goto done;
+        total += json_number_value(json_object_get(lay, "length"));
+    }
+    if (!nodes || !s || !tw || json_array_size(mems) < 2 || !(total > 0))
+        goto done;
+    json_array_foreach(mems, i, lay) {
+        const json_t *nd = json_object_get(lay, "nodes"), *ss = json_object_get(lay, "s");
+        double L = json_number_value(json_object_get(lay, "length"));
+        for (j = i ? 1 : 0; j < json_array_size(nd); j++)
+            if (json_array_append(nodes, json_array_get(nd, j)) ||
+                json_array_append_new(
+                    s, json_real((acc + json_number_value(json_array_get(ss, j)) * L) / total)) ||
+                json_array_append_new(tw, json_real(0.0)))
+                goto done;
+        acc += L;
+    }
+    out = json_pack("{s:s, s:O, s:O, s:O, s:O, s:f}", "id", "tower", "nodes", nodes, "s", s,
+                    "twist_deg", tw, "axes", json_object_get(json_array_get(mems, 0), "axes"),
+                    "length", total);
+done:
+    json_decref(nodes);
+    json_decref(s);
+    json_decref(tw);
+    return out;
+}
+
 /* The blade member's layout: id "blade", else the only member (*tower = 1 when its id is
- * "tower": the tower form's member, which takes TwFAM1Sh..., not the blade's names). */
-static const json_t *edt_member(const json_t *result, int *tower)
+ * "tower": the tower form's member, which takes TwFAM1Sh..., not the blade's names), else a
+ * wired tower's members joined (*own, new: edt_join_tower). */
+static const json_t *edt_member(const json_t *result, int *tower, json_t **own)
 {
     const json_t *mems = json_object_get(json_object_get(result, "model"), "members"), *lay;
     const char *id;
@@ -94,7 +142,9 @@ static const json_t *edt_member(const json_t *result, int *tower)
     lay = json_array_get(mems, 0);
     id = json_string_value(json_object_get(lay, "id"));
     *tower = id && !strcmp(id, "tower");
-    return json_array_size(mems) == 1 ? lay : NULL;
+    if (json_array_size(mems) > 1 && (*own = edt_join_tower(mems)))
+        *tower = 1;
+    return json_array_size(mems) == 1 ? lay : *own;
 }
 
 /* The member's nodes, span fractions, twists (rad), axes and length into *in. */
@@ -108,7 +158,7 @@ static int edt_layout(const json_t *result, edt_input *in, char *err, size_t err
         return edt_err(err, errcap,
                        "ElastoDyn coefficients need a spatial result with mode "
                        "shapes (\"mode_shapes\": true)");
-    lay = edt_member(result, &in->tower);
+    lay = edt_member(result, &in->tower, &in->own);
     if (!lay)
         return edt_err(err, errcap,
                        "ElastoDyn coefficients need a blade or a tower: the blade or tower "
