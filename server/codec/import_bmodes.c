@@ -803,6 +803,26 @@ static int bm_tower_own_offset(json_t *doc, const bm_main *m)
 }
 
 /*
+ * A tower's station model (no bmodes_mesh): the sections' mass moments in torsion only
+ * (analysis.rotary_inertia "torsion"), as BModes has them (no bending rotary inertia,
+ * Struct.f90:1222-1223 vs 1302), like bm_own_mesh's; with bending rotary inertia Test04's 3rd
+ * fore-aft/side-side and 4th fore-aft were 1.5 % below BModes refined (DESIGN.md 8.5).
+ * 0 or -1 (memory).
+ */
+static int bm_tower_rotary(json_t *doc)
+{
+    json_t *an = json_object_get(json_object_get(doc, "request"), "analysis");
+
+    if (!an || json_object_set_new(an, "rotary_inertia", json_string("torsion")))
+        return -1;
+    return imp_warn(json_object_get(doc, "input_warnings"), "/analysis/rotary_inertia",
+                    "analysis.rotary_inertia = \"torsion\": BModes has no bending rotary "
+                    "inertia (the sections' mass moments enter torsion only), so the import "
+                    "leaves it out to reproduce BModes; \"full\" includes it (Test04's 3rd and "
+                    "4th bending modes 1.5 %% lower)");
+}
+
+/*
  * The tension wires (tow_support 1) into doc's request: without own (bmodes_mesh 0) the tower
  * form's "wires", each at height hub_rad + el_loc[node_attach - 1] (radius - hub_rad) (BModes'
  * node_attach counts el_loc's boundaries from the base, BldVib.f90:668); with own, BModes' own
@@ -954,6 +974,8 @@ int import_bmodes(json_t **out, const import_file *bmi, import_loader load, void
     if (!st && m.tower && (bm_tower_doc(*out, &m) || bm_tower_platform(*out, &m)))
         st = SM_NOMEM;
     if (!st && m.tower && o->bmodes_mesh > 0 && bm_tower_own_offset(*out, &m))
+        st = SM_NOMEM;
+    if (!st && m.tower && o->bmodes_mesh <= 0 && bm_tower_rotary(*out))
         st = SM_NOMEM;
     if (!st && o->bmodes_mesh > 0) {
         st = bm_own_mesh(*out, el_loc, o->bmodes_mesh, bmi->name, d,

@@ -9,6 +9,8 @@ Usage: supports_test.py SPINMODAL REFERENCE_BLADES_DIR
   0.5 % of BModes' published frequencies (certtest_frequencies.csv, from BModes'
   CertTest/TestFiles/Test04_wires_supported_tower.out).
 - The same file without the option: the tower form's "wires" at hub_rad + el_loc[node - 1] L.
+  Its station model (48 elements) within 1 % of BModes refined (bmodes_refined_towers.csv, 200
+  elements) on modes 1-10, with the file's top-mass offset and with the one BModes computes with.
 - A foundation against an analytic result: a uniform lateral foundation k (N/m per m) over a
   whole cantilever with lumped mass mu and no bending rotary inertia adds exactly k/mu to omega^2
   of every bending mode in that direction and leaves the other direction unchanged.
@@ -87,6 +89,15 @@ def test04(exe, ref, tmp):
               "Test04 tower form (station model, cut at the wires): solved")
 
 
+def test04_station(exe, ref, tmp):
+    """Test04's station model (the tower form cut at the wires) against BModes refined: the check
+    of tower_test.py's Test03 (issue 25: within 1 %)."""
+    import tower_test
+    tower_test.station_model(exe, ref, tmp, "Test04_wires_supported_tower",
+                             "Test04_wires_supported_tower.bmi")
+    FAILURES.extend(tower_test.FAILURES)
+
+
 def cantilever(found=None, spring=None):
     sec = {"EA": 1e9, "EI_flap": 1e6, "EI_edge": 3e6, "GJ": 1e6, "mass_per_length": 10.0,
            "flap_inertia": 1e-9, "edge_inertia": 1e-9}
@@ -143,6 +154,7 @@ def main():
     tmp = tempfile.mkdtemp(prefix="spinmodal-supports-")
     try:
         test04(exe, ref, tmp)
+        test04_station(exe, ref, tmp)
         foundation(exe, tmp)
         bad_files(exe, ref, tmp)
     finally:

@@ -14,6 +14,10 @@ Usage: tower_test.py SPINMODAL REFERENCE_BLADES_DIR
   every mode, torsion included, and doubling ixx_tip
   (BModes' "tower s-s" moment, about the fore-aft x axis) lowers the mode BModes prints in
   its "s-s" column and ours labels "edge" (side-side), not the fore-aft one.
+- The station model (import without --bmodes-mesh, 48 elements) within 1 % of BModes refined
+  (bmodes_refined_towers.csv: 200 elements) on modes 1-10, both with the file's top-mass offset
+  (against BModes reading cm_axial where it belongs) and with the offset BModes v3.00 computes
+  with (against stock BModes); the import gives the mass moments to torsion only, as BModes.
 - Bad files: a tower file given as a blade and the reverse, two guy wires a set (BModes wants 3), a
   rotor speed for a tower: each refused with FILE:LINE: FIELD.
 """
@@ -159,6 +163,40 @@ def bad_files(exe, ref, tmp):
     check(rc == 2 and "rpm: a tower does not spin" in err, "--rpm on a tower: refused")
 
 
+def refined(ref, test, variant):
+    """BModes refined (200 elements, our runs; bmodes_refined_towers.csv says how), modes 1-10."""
+    import csv
+    with open(os.path.join(ref, "bmodes_refined_towers.csv")) as f:
+        rows = csv.DictReader(line for line in f if not line.startswith("#"))
+        return [float(r["freq_Hz"]) for r in rows if r["test"] == test and
+                r["variant"] == variant]
+
+
+def station_model(exe, ref, tmp, test, name):
+    """The station model (import without --bmodes-mesh, its 48 elements) against BModes refined
+    (issue 25: within 1 %): as imported (top-mass offset [cm_loc, 0, cm_axial] as the file says)
+    against BModes reading cm_axial into cm_axial, and with the offset BModes v3.00 computes with
+    ([cm_axial, 0, 0], BModes.f90:448-449) against stock BModes."""
+    rc, out, err = run(exe, ["import", "bmodes", os.path.join(ref, "bmodes_certtest", name)])
+    if not check(rc == 0, "%s station model imported (%s)" % (test, err.strip()[-200:])):
+        return
+    req = json.loads(out)
+    check(req["analysis"].get("rotary_inertia") == "torsion" and
+          "/analysis/rotary_inertia" in err,
+          "%s station model: rotary_inertia \"torsion\" as BModes, with a warning" % test)
+    top = req["tower"]["top_mass"]
+    as_bmodes = json.loads(json.dumps(req))
+    as_bmodes["tower"]["top_mass"]["offset"] = [top["offset"][2], 0, 0]
+    for r, variant in ((req, "cm_axial_read"), (as_bmodes, "stock")):
+        modes = solve(exe, r, tmp, "%s_station_%s" % (test, variant))
+        bm = refined(ref, test, variant)
+        e = [100 * (m["frequency_hz"] / b - 1) for m, b in zip(modes, bm)]
+        check(len(bm) == 10 and len(e) == 10 and max(abs(x) for x in e) <= 1.0,
+              "%s station model, offset %s, vs BModes refined (%s): modes 1-10 within 1 %% (%s)"
+              % (test, r["tower"]["top_mass"]["offset"], variant,
+                 " ".join("%+.3f" % x for x in e)))
+
+
 def main():
     exe, ref = os.path.abspath(sys.argv[1]), sys.argv[2]
     tmp = tempfile.mkdtemp(prefix="spinmodal-tower-")
@@ -166,6 +204,7 @@ def main():
         own = test03(exe, ref, tmp)
         if own:
             conventions(exe, own, tmp)
+        station_model(exe, ref, tmp, "Test03_tower", "Test03_tower.bmi")
         bad_files(exe, ref, tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
