@@ -8,6 +8,7 @@
 //   SPINMODAL_SCREENSHOTS   where screenshots are written
 //   SPINMODAL_EXAMPLES      the repository's examples/ (the spatial examples the page loads)
 //   CHROMIUM                browser executable (default /usr/bin/chromium)
+//   SPINMODAL_WEB_ONLY      "towers": run only the tower checks (a quick local run)
 //   SPINMODAL_TEST_CLI, SPINMODAL_TEST_TIME_FACTOR, SPINMODAL_TEST_TIMEOUT
 //                           time budgets, as in tests/e2e/timescale.py: every wait
 //                           polls for its condition and gives up after a base budget
@@ -568,6 +569,101 @@ async function exportsAndCompare(page, result) {
   ok(!(await page.evaluate(() => window.__spinmodal.campbell())).series.some((s) => s.kind === 'ref'),
     'Stop comparing: no reference series left');
   await page.fill('#json', text.replace('"mass_per_length": 2.4', '"mass_per_length": 1.2'));
+}
+
+/**
+ * Towers (issue 25 item 4, DESIGN.md 8.5 and 9.3): BModes' Test03 tower
+ * imports into the tower form (not mangled into a "structure" by an edit),
+ * the tower panel edits height, top mass and gravity, and the solved tower's
+ * modes are named "1st fore-aft"/"1st side-side"; the ElastoDyn coefficients
+ * are the daemon's ?format=elastodyn numbers, five per shape summing to 1,
+ * and the plotted fit follows the computed shape.
+ */
+async function towers(page, base) {
+  await page.click('#open-blade');
+  await page.selectOption('#import-format', 'bmodes');
+  if (await page.isChecked('#import-bmodes-mesh')) await page.uncheck('#import-bmodes-mesh');
+  await page.setInputFiles('#import-main', {name: 'Test03_tower.bmi', mimeType: 'text/plain',
+    buffer: fs.readFileSync(path.join(BLADES, 'Test03_tower.bmi'))});
+  await page.setInputFiles('#import-sec', {name: 'tower_sec_props.dat', mimeType: 'text/plain',
+    buffer: fs.readFileSync(path.join(BLADES, 'tower_sec_props.dat'))});
+  await page.click('#import-go');
+  ok(await waitFor(page, () => !document.getElementById('import-dialog').open && window.__spinmodal.doc.tower, null,
+    'the imported tower'), 'BModes Test03 (a tower) imports into the editor', await page.textContent('#import-error'));
+  let doc = await page.evaluate(() => window.__spinmodal.doc);
+  ok(doc.tower && doc.tower.height === 82.39 && !('structure' in doc) && !('blade' in doc) &&
+    await page.isVisible('#tower-panel') && !await page.isVisible('#structure-tables') &&
+    await page.inputValue('#tower-height') === '82.39' && await page.locator('#tower-stations tbody tr').count() > 0,
+  'the tower form: the tower panel with its height and stations, no structure tables',
+  JSON.stringify({...doc.tower, stations: undefined}));
+  ok(/a tower of 82\.39 m/.test(await page.textContent('#file-msg')), 'the message says a tower was imported',
+    await page.textContent('#file-msg'));
+  ok(await page.locator('#structure-svg .member, #structure-svg line.member, #structure-svg path.member').count() > 0,
+    'the tower is drawn', await page.textContent('#structure-desc'));
+
+  // an edit of the analysis options must keep the tower form (it used to add an empty "structure")
+  await page.fill('#modes', '10');
+  doc = await page.evaluate(() => window.__spinmodal.doc);
+  ok(doc.analysis.modes === 10 && !('structure' in doc) && doc.tower.height === 82.39,
+    'an options edit keeps the tower form', JSON.stringify(Object.keys(doc)));
+  // the tower fields edit the request
+  const tm0 = JSON.stringify(doc.tower.top_mass);
+  await page.fill('#tower-height', '90');
+  await page.check('#tower-gravity');
+  doc = await page.evaluate(() => window.__spinmodal.doc);
+  ok(doc.tower.height === 90 && doc.tower.gravity === true && JSON.stringify(doc.tower.top_mass) === tm0 &&
+    /"gravity": true/.test(await page.inputValue('#json')), 'the tower fields edit height and gravity',
+  JSON.stringify({...doc.tower, stations: undefined}));
+  await page.uncheck('#tower-gravity');
+  await page.fill('#tower-height', '82.39');
+  await page.fill('#tower-top-inertia', '1e6, 2e6, 3e6');
+  ok((await page.evaluate(() => window.__spinmodal.doc.tower.top_mass.inertia)).join() === '1000000,2000000,3000000',
+    'the top mass inertia field writes [fa, ss, up]');
+  await page.fill('#tower-top-inertia', JSON.parse(tm0).inertia ? JSON.parse(tm0).inertia.join(', ') : '');
+  doc = await page.evaluate(() => window.__spinmodal.doc);
+  ok(!('gravity' in doc.tower) && JSON.stringify(doc.tower.top_mass) === tm0, 'and back', JSON.stringify(doc.tower.top_mass));
+
+  const r = await solveHere(page, base, 'the Test03 tower');
+  if (!r) return;
+  const labels = await page.$$eval('#freq-table td.mlabel', (ts) => ts.map((t) => t.textContent));
+  ok(labels.includes('1st fore-aft') && labels.includes('1st side-side') && labels.includes('2nd fore-aft'),
+    'the frequency table names the tower\'s modes fore-aft and side-side', labels.join(' | '));
+  ok(await waitFor(page, () => window.__spinmodal.coeffs() && window.__spinmodal.coeffs().points.length > 0, null,
+    'the coefficients'), 'the coefficients of the solved tower are shown');
+  const cf = await page.evaluate(() => window.__spinmodal.coeffs());
+  const rows = await page.$$eval('#coeffs-table tbody tr', (trs) => trs.map((tr) => [...tr.cells].map((c) => c.textContent)));
+  const names = ['TwFAM1Sh', 'TwFAM2Sh', 'TwSSM1Sh', 'TwSSM2Sh'];
+  ok(rows.length === 4 && rows.every((row, i) => row[0] === names[i] && row.length === 8),
+    'the table: TwFAM1Sh, TwFAM2Sh, TwSSM1Sh, TwSSM2Sh, mode, five coefficients and their sum', JSON.stringify(rows));
+  const sums = rows.map((row) => row.slice(2, 7).map(Number).reduce((a, b) => a + b, 0));
+  ok(rows.every((row) => row.slice(2, 7).every((t) => Number.isFinite(Number(t)))) &&
+    sums.every((x) => Math.abs(x - 1) < 1e-9) && rows.every((row) => Math.abs(Number(row[7]) - 1) < 1e-9),
+  'five numbers per shape, summing to 1', JSON.stringify(sums));
+  // the daemon's text, parsed here on its own: the same numbers
+  const text = await (await fetch(`${base}/v1/analyses/${r.id}/result?format=elastodyn`)).text();
+  const api = {};
+  for (const m of text.matchAll(/^\s*(\S+)\s+(TwFAM[12]Sh|TwSSM[12]Sh)\((\d)\)/gm)) (api[m[2]] ||= []).push(Number(m[1]));
+  ok(names.every((n, i) => JSON.stringify(api[n]) === JSON.stringify(rows[i].slice(2, 7).map(Number))),
+    'they are the daemon\'s ?format=elastodyn coefficients', JSON.stringify(api));
+  const fa1 = cf.fits.find((f) => f.name === 'TwFAM1Sh');
+  const m1 = r.result.cases[0].modes[fa1.mode - 1];
+  ok(fa1 && m1 && /fore-aft/.test(m1.label) && cf.plotted === 'TwFAM1Sh',
+    'TwFAM1Sh is a fore-aft mode of the result, plotted first', JSON.stringify({fa1, label: m1 && m1.label}));
+  const pts = cf.points;
+  ok(pts.length === 49 && pts[0].x === 0 && Math.abs(pts[pts.length - 1].x - 1) < 1e-12 &&
+    Math.abs(pts[pts.length - 1].y - 1) < 1e-12 && cf.maxDiff < 0.01,
+  'the computed shape (49 nodes, 0 at the base, 1 at the top) and the fit agree within 1 % of the top',
+  `${pts.length} points, max difference ${cf.maxDiff}`);
+  const drawn = await page.$$eval('#coeffs-svg polyline', (ls) => ls.map((l) => l.dataset.series));
+  ok(drawn.includes('fit') && drawn.includes('computed'), 'the plot draws the fit and the computed shape', drawn.join());
+  await page.selectOption('#coeffs-fit', 'TwSSM2Sh');
+  ok(await waitFor(page, () => window.__spinmodal.coeffs() && window.__spinmodal.coeffs().plotted === 'TwSSM2Sh', null,
+    'the second side-side shape'), 'choosing TwSSM2Sh plots it');
+  const ss2 = await page.evaluate(() => window.__spinmodal.coeffs());
+  ok(ss2.points.length === 49 && ss2.maxDiff < 0.05, 'TwSSM2Sh: fit and computed shape within 5 % of the top',
+    String(ss2.maxDiff));
+  await shotEl(page, '#coeffs-box', '27-tower-coefficients.png');
+  await shot(page, '28-tower.png');
 }
 
 /** Solve what the editor holds; the API result of the job, or null. */
@@ -1422,6 +1518,12 @@ async function run() {
     ok(await waitFor(page, () => window.__spinmodal && document.querySelectorAll('#joints tbody tr').length > 0,
       null, 'the app to start'), 'page loads and the editor fills in');
     ok((await page.title()).includes('spinmodal'), 'page title');
+    if (process.env.SPINMODAL_WEB_ONLY === 'towers') { // a quick local run of the tower part alone
+      await towers(page, base);
+      ok(badResponses.length === 0, 'no unexpected HTTP error answers', badResponses.join(' | '));
+      ok(consoleErrors.length === 0, 'no errors in the browser console', consoleErrors.join(' | '));
+      return;
+    }
 
     // accessibility: every control has an accessible name
     const unnamed = await page.evaluate(() => Array.from(document.querySelectorAll('input, select, textarea, button'))
@@ -1640,6 +1742,7 @@ async function run() {
 
     await spatial(page, base);
     await blades(page, base);
+    await towers(page, base);
     await firstHour(page, base);
     await keepTheDesign(page, base);
     try {

@@ -5,7 +5,9 @@
 // validated.  Also the examples and loadDoc, which puts a request from a
 // file, an import or a past job into the editor.
 
-import {prettyJSON, structureToRows, rowsToStructure, cellValue, fmtNum, sig, ptr} from './request.js';
+import {prettyJSON, structureToRows, rowsToStructure, cellValue, fmtNum} from './request.js';
+import {renderStations} from './stations.js';
+import {renderTower, initTower} from './tower.js';
 import {homeCamera} from './view3d.js';
 import {StructureEditor} from './editor.js';
 import {EXAMPLES} from './examples.js';
@@ -24,10 +26,12 @@ function setDoc(doc, from) {
   S.doc = doc && typeof doc === 'object' && !Array.isArray(doc) ? doc : {};
   if (from !== 'options') S.sweepError = null;
   S.blade = 'blade' in S.doc && !('structure' in S.doc);
+  S.tower = 'tower' in S.doc && !('structure' in S.doc) && !S.blade;
   S.rows = structureToRows(S.doc.structure);
   if (from !== 'name') $('design-name').value = typeof S.doc.name === 'string' ? S.doc.name : '';
   if (from !== 'table') editor.render();
   if (from !== 'blade') renderBlade();
+  if (from !== 'tower') renderTower();
   if (from !== 'options') renderOptions();
   if (from !== 'json') setText(prettyJSON(S.doc));
   afterChange();
@@ -43,7 +47,7 @@ export function setText(t) {
 
 /** Rows or options changed: rebuild the doc and the JSON text. */
 function docChanged(from) {
-  if (!S.blade) S.doc.structure = rowsToStructure(S.rows);
+  if (!S.blade && !S.tower) S.doc.structure = rowsToStructure(S.rows);
   setText(prettyJSON(S.doc));
   if (from === 'rows') editor.render();
   afterChange();
@@ -61,45 +65,19 @@ function afterChange() {
 
 // ------------------------------------------------------------- blade form
 
-const STATION_COLS = [
-  ['s', 's'], ['mass_per_length', 'μ (kg/m)'], ['EA', 'EA (N)'], ['EI_flap', 'EI<sub>flap</sub> (N·m²)'],
-  ['EI_edge', 'EI<sub>edge</sub> (N·m²)'], ['GJ', 'GJ (N·m²)'], ['flap_inertia', 'i<sub>flap</sub> (kg·m)'],
-  ['edge_inertia', 'i<sub>edge</sub> (kg·m)'], ['twist_deg', 'twist (°)'], ['inertia_twist_deg', 'inertia twist (°)'],
-  ['cg_offset', 'cg offset (m)'], ['shear_center_offset', 'shear centre offset (m)'],
-  ['tension_center_offset', 'tension centre offset (m)'],
-];
-
 /** Show the blade panel (fields, stations) instead of the structure tables for a request in the blade form. */
 function renderBlade() {
   $('blade-panel').hidden = !S.blade;
-  $('structure-tables').hidden = S.blade;
-  document.querySelector('.spatial-switch').hidden = S.blade;
+  $('structure-tables').hidden = S.blade || S.tower;
+  document.querySelector('.spatial-switch').hidden = S.blade || S.tower;
   if (!S.blade) return;
   const b = S.doc.blade && typeof S.doc.blade === 'object' ? S.doc.blade : {};
   for (const e of document.querySelectorAll('#blade-panel .blade-fields input[data-key]')) {
     e.value = fmtNum(b[e.dataset.key]);
   }
   $('blade-tip-mass').value = b.tip_mass && typeof b.tip_mass === 'object' ? fmtNum(b.tip_mass.mass) : '';
-  const st = Array.isArray(b.stations) ? b.stations : [];
-  const keys = STATION_COLS.filter(([k]) => st.some((r) => r && typeof r === 'object' && k in r));
-  const thead = $('stations').tHead, tbody = $('stations').tBodies[0];
-  thead.innerHTML = '<tr>' + keys.map(([, l]) => `<th scope="col">${l}</th>`).join('') + '</tr>';
-  tbody.textContent = '';
-  st.forEach((r, j) => {
-    const tr = tbody.insertRow();
-    tr.dataset.pointer = ptr('blade', 'stations', j);
-    for (const [k] of keys) {
-      const td = tr.insertCell();
-      td.dataset.pointer = ptr('blade', 'stations', j, k);
-      const v = r && typeof r === 'object' ? r[k] : undefined;
-      const t = document.createElement('span');
-      t.textContent = Array.isArray(v) ? v.map((x) => sig(x, 5)).join(', ') : typeof v === 'number' ? sig(v, 6) : v === undefined ? '' : String(v);
-      const m = document.createElement('div');
-      m.className = 'msg';
-      td.append(t, m);
-    }
-  });
-  $('stations-count').textContent = st.length ? `(${st.length}, from the root s = 0 to the tip s = 1)`
+  const n = renderStations($('stations'), 'blade', b.stations);
+  $('stations-count').textContent = n ? `(${n}, from the root s = 0 to the tip s = 1)`
     : '(none: the section holds along the span)';
 }
 
@@ -177,6 +155,10 @@ export function initDesign() {
     const t = $('blade-tip-mass').value.trim();
     if (t === '') delete b.tip_mass;
     else b.tip_mass = Object.assign(b.tip_mass && typeof b.tip_mass === 'object' ? b.tip_mass : {}, {mass: cellValue(t)});
+    setText(prettyJSON(S.doc));
+    afterChange();
+  });
+  initTower(() => {
     setText(prettyJSON(S.doc));
     afterChange();
   });

@@ -1,4 +1,4 @@
-// files.js — requests as files and blade files: "Open request…" (a request,
+// files.js — requests as files and blade or tower files: "Open request…" (a request,
 // or a "JSON + request" download with its result), "Save request", and the
 // "Open blade file…" dialog, which sends POST /v1/import/{format} and puts
 // the answer's request into the editor with the importer's warnings.
@@ -30,7 +30,7 @@ function readFile(f) {
 
 // ------------------------------------------------------------ blade import
 
-const IMPORT_MAIN = {bmodes: 'BModes main file (.bmi)', elastodyn: 'ElastoDyn blade file (.dat)',
+const IMPORT_MAIN = {bmodes: 'BModes main file (.bmi: a blade, or a tower with beam_type 2)', elastodyn: 'ElastoDyn blade file (.dat)',
   csv: 'CSV file (a header row naming the columns: s or r, mass_per_length, EI_flap …)'};
 
 function importFormat() {
@@ -98,10 +98,12 @@ async function importBlade() {
   // a name for the past jobs and the file names: the file's, unless the request has one
   if (typeof req.name !== 'string' && fileSafe(main.name.replace(/\.[^.]*$/, ''))) req.name = main.name.replace(/\.[^.]*$/, '');
   const b = req.blade && typeof req.blade === 'object' ? req.blade : null;
+  const tw = req.tower && typeof req.tower === 'object' ? req.tower : null;
   const an = req.analysis && typeof req.analysis === 'object' ? req.analysis : {};
   const sp = 'rpm' in an ? speedList(an.rpm) : [];
   loadDoc(req, `Imported from ${main.name}${format === 'bmodes' ? ` + ${sec.name}` : ''}` + (src.title ? ` (“${src.title}”)` : '') +
     (b ? `: a blade of ${fmtNum(b.length)} m${Array.isArray(b.stations) ? `, ${plural(b.stations.length, 'station')}` : ''}`
+      : tw ? `: a tower of ${fmtNum(tw.height)} m${Array.isArray(tw.stations) ? `, ${plural(tw.stations.length, 'station')}` : ''}`
       : req.structure && Array.isArray(req.structure.members) ? `: ${plural(req.structure.members.length, 'member')}` : '') +
     (sp.length === 1 ? `, ${fmtNum(sp[0])} rpm` : '') + '.');
   $('import-notes').hidden = false;
@@ -138,7 +140,7 @@ async function importBlade() {
   const st = S.doc.structure;
   fileMsg(ownMesh && st && Array.isArray(st.members)
     ? `imported ${main.name} (BModes' own mesh): ${st.members.length} members of ${q.bmodes_mesh} elements — press Solve`
-    : `imported ${main.name} (${format}): a blade of ${S.doc.blade && S.doc.blade.length} m — press Solve`, 'ok');
+    : `imported ${main.name} (${format}): ${S.doc.tower ? `a tower of ${S.doc.tower.height}` : `a blade of ${S.doc.blade && S.doc.blade.length}`} m — press Solve`, 'ok');
 }
 
 /** Wire the open and save buttons and the import dialog. */

@@ -11,6 +11,8 @@
 // its controls; this file calls them in order and starts the page:
 //   state.js (S, kept design, file names)   dom.js ($, plural)
 //   design.js (the request <-> tables, JSON, blade panel, examples)
+//   tower.js, tower-model.js, stations.js (the tower form; stations tables)
+//   coeffs.js (ElastoDyn coefficients of a blade or tower, fit vs computed)
 //   options.js (Analysis panel)   errors.js (errors, warnings, /v1/validate)
 //   views.js (structure drawing, 3D camera, mode animation, span-wise plot)
 //   jobs.js (Solve, progress, Cancel, past jobs)   files.js (open, save, import)
@@ -29,6 +31,7 @@ import {initJobs} from './jobs.js';
 import {chart, initCampbell} from './campbell-panel.js';
 import {initResults} from './results.js';
 import {fileMsg, initFiles} from './files.js';
+import {initCoefficients} from './coeffs.js';
 import {campbellExportSvg, modeExportSvg, initDownloads} from './downloads.js';
 
 initDesign();
@@ -38,6 +41,7 @@ initCampbell();
 initResults();
 initFiles();
 initDownloads();
+initCoefficients();
 
 // ------------------------------------------------------------------ start
 
@@ -77,6 +81,8 @@ window.__spinmodal = {
   spanwise: () => ({available: $('spanwise-dl').dataset.available === 'yes', why: $('spanwise-dl').title,
     buttons: ['dl-spanwise', 'dl-bmodes'].map((id) => ({id, disabled: $(id).disabled, title: $(id).title})),
     plot: S.spanPlot || null}),
+  // the ElastoDyn coefficients shown ({case, fits: [{name, mode, label, coeffs}], plotted, points, maxDiff} or null)
+  coeffs: () => S.coeffs || null,
   loadExample,
   loadDoc,
 };

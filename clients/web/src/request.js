@@ -8,6 +8,8 @@
 // value typed in a numeric cell that is not a number is kept as a string so
 // the daemon reports it with its own message and pointer.
 
+import {expandTower} from './tower-model.js';
+
 export const DEFAULTS = {
   frames: 'per_element',
   analysis: {
@@ -480,9 +482,11 @@ export function expandBlade(b) {
   return st;
 }
 
-/** The structure of a request: its "structure", or its expanded "blade". */
+/** The structure of a request: its "structure", or its expanded "blade" or "tower". */
 export function structureOf(doc) {
   if (!isObj(doc)) return null;
-  if ('structure' in doc || !('blade' in doc)) return doc.structure;
-  return expandBlade(doc.blade);
+  if ('structure' in doc) return doc.structure;
+  if ('blade' in doc) return expandBlade(doc.blade);
+  if ('tower' in doc) return expandTower(doc.tower);
+  return doc.structure;
 }

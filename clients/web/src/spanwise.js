@@ -202,9 +202,10 @@ export const SPAN_SERIES = [
 
 /**
  * Draw flap and edge (left axis, m: the mode scaled to 1 m at its largest)
- * and twist (right axis, rad) against the span fraction.
+ * and twist (right axis, rad) against the span fraction; labels renames
+ * the legend's series ({flap: 'fore-aft (m)', …} for a tower).
  */
-export function drawSpanwise(svg, pts) {
+export function drawSpanwise(svg, pts, labels = {}) {
   svg.textContent = '';
   const W = 600, H = 200, L = 52, R = 56, T = 26, B = 34;
   const X = (x) => L + x * (W - L - R);
@@ -231,8 +232,9 @@ export function drawSpanwise(svg, pts) {
     el('polyline', {class: 'sw-line ' + s.cls, 'data-series': s.key,
       points: pts.map((p) => `${X(p.x).toFixed(2)},${Y(p[s.key], r).toFixed(2)}`).join(' ')}, svg);
     el('line', {x1: lx, x2: lx + 22, y1: 12, y2: 12, class: 'sw-line ' + s.cls}, svg);
-    const t = text(svg, lx + 27, 16, s.label, 'sw-legend', 'start');
-    lx += 40 + s.label.length * 6.2;
+    const label = labels[s.key] || s.label;
+    const t = text(svg, lx + 27, 16, label, 'sw-legend', 'start');
+    lx += 40 + label.length * 6.2;
     t.dataset.series = s.key;
   }
   return {displacement: dr, twist: tr};

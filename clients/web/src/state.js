@@ -18,6 +18,7 @@ export const S = {
   serverErrorsFrom: '', // 'validate' | 'submit'
   warnings: [],        // input_warnings of the last validation or result: [{pointer, message}]
   blade: false,        // the request is in the blade form (DESIGN.md 8.1)
+  tower: false,        // the request is in the tower form (DESIGN.md 8.5)
   speedKey: 'omega',   // the request gives analysis.omega or analysis.rpm
   speedRange: false,   // the speeds are a range {from, to, steps}
   ref: null,           // a result kept for comparison: {id, result, label}

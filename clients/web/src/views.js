@@ -9,6 +9,7 @@ import {drawStructure, modeView} from './drawing.js';
 import {drawStructure3d, modeView3d, attachOrbit, homeCamera, PRESETS} from './view3d.js';
 import {errIn, campbellData} from './campbell.js';
 import {spanwiseAvailability, parseSpanwise, bladeChain, spanPoints, drawSpanwise} from './spanwise.js';
+import {showCoefficients} from './coeffs.js';
 import * as api from './api.js';
 import {$, plural} from './dom.js';
 import {S, selectedCase} from './state.js';
@@ -57,7 +58,7 @@ export function draw() {
 
 /** Is the structure drawn in 3D?  The switch, else whether the structure is spatial. */
 function structureIn3d() {
-  return S.view3d ?? (S.blade || !!(S.rows && S.rows.spatial));
+  return S.view3d ?? (S.blade || S.tower || !!(S.rows && S.rows.spatial));
 }
 
 /** Is the mode shape drawn in 3D?  The switch, else whether the solved request or its result is spatial. */
@@ -241,6 +242,7 @@ let spanSeq = 0;
  * daemon's span-wise CSV (fetched once per result).
  */
 async function showSpanwisePlot() {
+  showCoefficients();
   const seq = ++spanSeq;
   const R = S.result;
   const box = $('spanwise-box');
@@ -273,9 +275,11 @@ async function showSpanwisePlot() {
     box.hidden = true;
     return;
   }
-  const ranges = drawSpanwise($('spanwise-svg'), pts);
+  const tower = !!(R.request && R.request.tower);
+  const ranges = drawSpanwise($('spanwise-svg'), pts, tower ? {flap: 'fore-aft (m)', edge: 'side-side (m)'} : {});
   S.spanPlot = {omega: c.omega, mode: k + 1, points: pts, ranges};
-  cap.textContent = `Span-wise shape of mode ${k + 1} at Ω = ${speedText(c)}: flap (out of the rotor plane) and ` +
-    'edge (in it) in m, the mode scaled to 1 m at its largest; twist in rad on the right axis ' +
+  cap.textContent = (tower ? `Shape of mode ${k + 1} along the tower (base 0 → top 1): fore-aft and side-side `
+    : `Span-wise shape of mode ${k + 1} at Ω = ${speedText(c)}: flap (out of the rotor plane) and edge (in it) `) +
+    'in m, the mode scaled to 1 m at its largest; twist in rad on the right axis ' +
     `(the span-wise CSV, ${chain.parts.length === 1 ? 'one member' : `${chain.parts.length} members`} root → tip).`;
 }
