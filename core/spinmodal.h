@@ -508,12 +508,13 @@ typedef struct sm_case {
 
 /** Kind of a mode (sm_case.label_kind, DESIGN.md 9.1). */
 typedef enum sm_mode_kind {
-    SM_MODE_AXIAL = 0,        /* axial (stretching) */
-    SM_MODE_EDGE,             /* edgewise: bending in the p2 direction (in-plane for a blade) */
-    SM_MODE_FLAP,             /* flapwise: bending in the p3 direction (out of plane) */
-    SM_MODE_TORSION,          /* torsion about the member axis */
-    SM_MODE_COUPLED,          /* no part above 60 % of the strain energy */
-    SM_MODE_BENDING           /* planar models: in-plane bending */
+    SM_MODE_AXIAL = 0, /* axial (stretching) */
+    SM_MODE_EDGE,      /* edgewise: bending in the p2 direction (in-plane for a blade) */
+    SM_MODE_FLAP,      /* flapwise: bending in the p3 direction (out of plane) */
+    SM_MODE_TORSION,   /* torsion about the member axis */
+    SM_MODE_COUPLED,   /* no part above 60 % of the strain energy */
+    SM_MODE_BENDING,   /* planar models: in-plane bending */
+    SM_MODE_RIGID      /* a rigid-body mode (frequency 0) of a free base (DESIGN.md 8.7) */
 } sm_mode_kind;
 
 /** Flags of sm_case.track_flag (DESIGN.md 9.1). */

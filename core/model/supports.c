@@ -89,20 +89,6 @@ static int sup_check_foundation(const sm_support *s, int i, double L, sm_diag *d
     return SM_OK;
 }
 
-/* K (6x6) restricted to the directions not in held: the held rows and columns become those of
- * the identity scaled to K's largest entry (they have no coordinate; this keeps the definiteness
- * test of the free block). */
-static void sup_free_block(double K[36], unsigned held)
-{
-    double mx = 0;
-    for (int i = 0; i < 36; i++)
-        mx = fmax(mx, fabs(K[i]));
-    for (int i = 0; i < 6; i++)
-        if (held & (1u << i))
-            for (int j = 0; j < 6; j++)
-                K[i + 6 * j] = K[j + 6 * i] = i == j ? (mx > 0 ? mx : 1.0) : 0.0;
-}
-
 int supports_check(const sm_structure *st, const sm_options *o, sm_diag *d)
 {
     for (int i = 0; i < st->n_supports; i++) {
@@ -140,13 +126,8 @@ int supports_check(const sm_structure *st, const sm_options *o, sm_diag *d)
             return smi_input_fail(d, SM_ITEM_CLAMP, -1, "",
                                   "a free base (elastic clamp, floating platform) needs spatial "
                                   "sections");
-        double Kb[36] = {0};
         for (int i = 0; i < st->n_supports; i++)
-            if (st->supports[i].joint == st->clamp) {
-                held = 1;
-                for (int c = 0; c < 36; c++)
-                    Kb[c] += st->supports[i].K[c];
-            }
+            held |= st->supports[i].joint == st->clamp;
         if (st->base_held & ~0x3fu)
             return smi_input_fail(
                 d, SM_ITEM_CLAMP, -1, "",
@@ -155,17 +136,11 @@ int supports_check(const sm_structure *st, const sm_options *o, sm_diag *d)
             return smi_input_fail(d, SM_ITEM_CLAMP, -1, "",
                                   "a base held in all six directions is a clamp: give the clamp "
                                   "joint without base_free");
-        sup_free_block(Kb, st->base_held);
-        if (held && sup_symmetric(Kb) && !(sup_lowest(Kb) > 1e-12))
-            return smi_input_fail(
-                d, SM_ITEM_CLAMP, -1, "",
-                "a free base needs stiffness in every direction it is free in at the "
-                "clamp joint (hydrostatic and mooring for a platform): rigid-body modes "
-                "at zero frequency are not supported yet");
         if (!held)
             return smi_input_fail(d, SM_ITEM_CLAMP, -1, "",
                                   "a free base needs a point support at the clamp joint (its "
-                                  "stiffness and mass)");
+                                  "mass, and stiffness where it is held: none for a free-floating "
+                                  "structure)");
         for (int i = 0; i < st->n_point_masses; i++) {
             const sm_point_mass *p = &st->point_masses[i];
             if (p->joint == st->clamp &&

@@ -38,11 +38,12 @@
 /* Share of the strain energy above which a mode is of one kind (DESIGN.md 9). */
 #define LAB_DOMINANT 0.6
 
-static const char *const lab_names[] = {"axial", "edge", "flap", "torsion", "coupled", "bending"};
+static const char *const lab_names[] = {"axial",   "edge",    "flap",      "torsion",
+                                        "coupled", "bending", "rigid-body"};
 
 const char *sm_mode_kind_name(int kind)
 {
-    return kind >= 0 && kind <= SM_MODE_BENDING ? lab_names[kind] : "unknown";
+    return kind >= 0 && kind <= SM_MODE_RIGID ? lab_names[kind] : "unknown";
 }
 
 char *sm_mode_label(int kind, int ordinal, char *buf, size_t size)
@@ -162,7 +163,7 @@ int lab_case(const sm_model *m, sm_case *c)
 {
     int k = c->n_modes, dof = m->kind->node_dof;
     size_t stride = (size_t)dof * (size_t)m->n_nodes;
-    int count[SM_MODE_BENDING + 1] = {0};
+    int count[SM_MODE_RIGID + 1] = {0};
 
     if (k <= 0 || !c->shape_re || !c->nodes)
         return SM_OK;
@@ -179,6 +180,10 @@ int lab_case(const sm_model *m, sm_case *c)
         lab_energy(m, c, c->shape_re + j * stride, c->shape_im ? c->shape_im + j * stride : NULL, f,
                    c->support_share ? c->support_share + j : NULL);
         c->label_kind[j] = lab_kind(m, f, &c->label_confidence[j]);
+        if (m->base && c->frequency[j] == 0) { /* a free base's rigid-body mode (linsys.c) */
+            c->label_kind[j] = SM_MODE_RIGID;
+            c->label_confidence[j] = 1;
+        }
         c->label_ordinal[j] = c->label_kind[j] == SM_MODE_COUPLED ? 0 : ++count[c->label_kind[j]];
     }
     return SM_OK;

@@ -158,9 +158,52 @@ int smi_lin_finite(const smi_lin *L)
     return L->tree || (dm_finite(&L->D.K) && dm_finite(&L->D.M) && dm_finite(&L->D.C));
 }
 
+/*
+ * A free base at rest (DESIGN.md 8.7): C* = 0, and K* may be singular — a floating structure
+ * free in a direction has rigid-body modes at zero frequency.  The undamped problem is solved
+ * as (K* + sigma M*) x = w_s^2 M* x (definite: a rigid-body direction's zero is exact, the
+ * elastic terms have no base rows), sigma = 1e-8 s with s = tr K* over tr M*, and w^2 = w_s^2 -
+ * sigma; |w^2| within 1e-6 sigma (the inverse form's round-off near sigma is ~eps sigma) is 0, a
+ * rigid-body mode; below that a negative w^2 is a divergence (Re lambda = sqrt(-w^2), counted
+ * negative).
+ */
+static int smi_lin_eigen_base(const sm_model *m, smi_lin *L, sm_eig_out *e)
+{
+    int n = m->n, rc;
+    double tk = 0, tm = 0;
+
+    for (int i = 0; i < n; i++) {
+        tk += fabs(DM(&L->D.K, i, i));
+        tm += fabs(DM(&L->D.M, i, i));
+    }
+    double scale = tm > 0 && tk > 0 ? tk / tm : 1.0, sigma = 1e-8 * scale;
+    for (size_t i = 0; i < (size_t)n * (size_t)n; i++)
+        L->D.K.a[i] += sigma * L->D.M.a[i];
+    rc = eig_solve(n, &L->D.M, &L->D.C, &L->D.K, 0, m->opt.modes, e);
+    if (rc < 0)
+        return rc;
+    e->max_re = 0;
+    for (int j = 0; j < e->n_modes; j++) {
+        double w2 = e->wim[j] * e->wim[j] - e->wre[j] * e->wre[j] - sigma;
+        e->wre[j] = e->wim[j] = 0;
+        if (w2 > 1e-6 * sigma) {
+            e->wim[j] = sqrt(w2);
+        } else if (w2 < -1e-6 * sigma) {
+            e->wre[j] = sqrt(-w2);
+            e->negative++;
+        }
+        e->max_re = fmax(e->max_re, e->wre[j]);
+    }
+    return SM_OK;
+}
+
 int smi_lin_eigen(const sm_model *m, smi_lin *L, const sm_progress *pr, sm_eig_out *e,
                   int *fallback)
 {
+    if (m->base && !L->tree) {
+        *fallback = 0;
+        return smi_lin_eigen_base(m, L, e);
+    }
     if (L->tree)
         return eig_solve_tree(m, &L->t, m->opt.coriolis, m->opt.modes, pr, e, fallback);
     *fallback = 0;

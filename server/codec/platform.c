@@ -26,11 +26,6 @@
 #define PLAT_K_UNIT " (N/m, N/rad, N m/rad)"
 #define PLAT_M_UNIT " (kg, kg m, kg m^2)"
 
-/* A platform without stiffness (the solver needs it in all six directions). */
-#define PLAT_NO_K                                                                         \
-    "a platform needs stiffness: give \"hydrostatic\" and/or \"mooring\" (6x6; together " \
-    "stiff in all six directions: rigid-body modes at zero frequency are not supported yet)"
-
 /* The elastic clamp object cl at /structure/clamp into canonical c. */
 static void plat_elastic(val_ctx *v, const json_t *cl, const json_t *joints, json_t *c)
 {
@@ -118,8 +113,6 @@ static void plat_floating(val_ctx *v, const json_t *pf, const json_t *joints, js
 
     field_check_keys(v, pf, p, keys, "platform");
     field_ref(v, pf, "joint", p, c, joints, "joint");
-    if (!json_object_get(pf, "hydrostatic") && !json_object_get(pf, "mooring"))
-        field_error(v, p, PLAT_NO_K);
     for (k = 0; k < 4; k++)
         if (json_object_get(pf, mats[k]))
             sup_matrix6(v, pf, p, mats[k], k < 2 ? PLAT_M_UNIT : PLAT_K_UNIT, k == 2, c, a);
@@ -352,8 +345,6 @@ void plat_tower(val_ctx *v, const json_t *tw, json_t *ct, json_t *st, const doub
         return;
     }
     field_check_keys(v, pf, p, keys, "platform");
-    if (!json_object_get(pf, "hydrostatic") && !json_object_get(pf, "mooring"))
-        field_error(v, p, PLAT_NO_K);
     c = json_object();
     sp = json_pack("{s:s}", "joint", "base");
     if (!c || !sp) {
