@@ -27,14 +27,14 @@ typedef struct bm_main {
     double rot_rpm, rpm_mult, radius, hub_rad, precone, bl_thp;
     double rpm;         /* rot_rpm x rpm_mult, finite (checked where it is made) */
     int length_line;    /* line of hub_rad, which makes the length radius - hub_rad */
-    double tip[9];  /* tip_mass, cm_loc, cm_axial, ixx, iyy, izz, ixy, izx, iyz */
+    double tip[9];      /* tip_mass, cm_loc, cm_axial, ixx, iyy, izz, ixy, izx, iyz */
     char sec_file[256]; /* as printed (ASCII) */
     char sec_raw[256];  /* as written, for the loader */
     int sec_line;       /* line of sec_props_file in the .bmi */
-    double mult[10]; /* sec_mass .. tc_offst multipliers, file order */
-    int tower;       /* beam_type 2 (DESIGN.md 8.5) */
-    int speed_line;  /* line of rot_rpm */
-    int beam_line;   /* line of beam_type */
+    double mult[10];    /* sec_mass .. tc_offst multipliers, file order */
+    int tower;          /* beam_type 2 (DESIGN.md 8.5) */
+    int speed_line;     /* line of rot_rpm */
+    int beam_line;      /* line of beam_type */
     unsigned tw_zeroed; /* tower: columns (1 << column) the file gives and BModes overwrites */
     int tw_zeroed_line; /* the first line with one of them */
     long n_att;         /* tow_support 1: wire-attachment locations, 0 without */
