@@ -175,8 +175,9 @@ int supports_lump(sm_model *m, const sm_structure *st);
 int supports_build(sm_model *m);
 /** Free what supports_lump and supports_build allocated. */
 void supports_free(sm_model *m);
-/** 1/2 x' K_sup x, the supports' strain energy of the modal vector x (0 without supports). */
-double supports_energy(const sm_model *m, const double *x);
+/** x' K x summed over the support nodes of the nodal shape s (node_dof values per node): the
+ *  supports' strain energy in the labels' convention (no 1/2); 0 without supports. */
+double supports_shape_energy(const sm_model *m, const double *s);
 
 /* ------------------------------------------------------------- mesh.c */
 /**

@@ -346,17 +346,18 @@ void supports_free(sm_model *m)
     dm_free(&m->sup_M);
 }
 
-double supports_energy(const sm_model *m, const double *x)
+double supports_shape_energy(const sm_model *m, const double *s)
 {
+    int nd = m->kind->node_dof;
     double e = 0;
 
-    if (!m->has_supports)
-        return 0;
-    for (int j = 0; j < m->n; j++) {
-        double t = 0;
-        for (int i = 0; i < m->n; i++)
-            t += DM(&m->sup_K, i, j) * x[i];
-        e += 0.5 * t * x[j];
+    for (int i = 0; i < m->n_sup; i++) {
+        const double *K = m->sup_k + 36 * i, *x = s + (size_t)nd * m->sup_node[i];
+        for (int a = 0; a < nd; a++)
+            for (int b = 0; b < nd; b++) {
+                int ra = nd == 6 ? a : sup_planar_dof[a], rb = nd == 6 ? b : sup_planar_dof[b];
+                e += x[a] * K[ra + 6 * rb] * x[b];
+            }
     }
     return e;
 }

@@ -96,24 +96,6 @@ static void lab_element(const sm_model *m, const sm_case *c, int el, const doubl
     K->label_strain(E, v, w, tx, r2, r3, e);
 }
 
-/* The supports' strain energy x' K x (the members' convention: no 1/2) of the nodal shape s. */
-static double lab_support(const sm_model *m, const double *s)
-{
-    static const int planar_dof[3] = {0, 1, 5};
-    int nd = m->kind->node_dof;
-    double e = 0;
-
-    for (int i = 0; i < m->n_sup; i++) {
-        const double *K = m->sup_k + 36 * i, *x = s + (size_t)nd * m->sup_node[i];
-        for (int a = 0; a < nd; a++)
-            for (int b = 0; b < nd; b++) {
-                int ra = nd == 6 ? a : planar_dof[a], rb = nd == 6 ? b : planar_dof[b];
-                e += x[a] * K[ra + 6 * rb] * x[b];
-            }
-    }
-    return e;
-}
-
 /* Energy fractions of one nodal shape (re, and im or NULL) into f[SM_ENERGY_PARTS]; *support
  * (may be NULL) = the supports' share of the strain energy. */
 static void lab_energy(const sm_model *m, const sm_case *c, const double *re, const double *im,
@@ -137,7 +119,7 @@ static void lab_energy(const sm_model *m, const sm_case *c, const double *re, co
             f[4 * h + k] = sum > 0 ? e[4 * h + k] / sum : 0.0;
     }
     if (support) {
-        double es = lab_support(m, re) + (im ? lab_support(m, im) : 0.0);
+        double es = supports_shape_energy(m, re) + (im ? supports_shape_energy(m, im) : 0.0);
         double all = es + e[4] + e[5] + e[6] + e[7];
         *support = all > 0 ? es / all : 0.0;
     }
