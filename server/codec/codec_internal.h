@@ -462,10 +462,11 @@ enum { CODEC_FORM_STRUCTURE = 0, CODEC_FORM_BLADE = 1, CODEC_FORM_TOWER = 2 };
 json_t *tower_validate(val_ctx *v, const json_t *root, json_t *canon);
 
 /**
- * A tower does not spin: an error at /analysis/omega (or rpm) when a speed
- * of the canonical request canon (borrowed, analysis checked) is not 0.
+ * A structure analysed at rest only (a tower, gravity, a free base: validate.c): an error at
+ * /analysis/omega (or rpm), "why: its speed must be 0 (speed i is x unit)tail", when a speed of
+ * the canonical request canon (borrowed, analysis checked) is not 0.
  */
-void tower_check_speeds(val_ctx *v, const json_t *canon);
+void tower_check_speeds(val_ctx *v, const json_t *canon, const char *why, const char *tail);
 
 /** The pointer p of a tower's expanded structure moved into /tower; malloc'd, NULL = NOMEM. */
 char *tower_pointer(const char *p);

@@ -438,7 +438,7 @@ json_t *tower_validate(val_ctx *v, const json_t *root, json_t *canon)
     return cst;
 }
 
-void tower_check_speeds(val_ctx *v, const json_t *canon)
+void tower_check_speeds(val_ctx *v, const json_t *canon, const char *why, const char *tail)
 {
     const json_t *an = json_object_get(canon, "analysis");
     const char *key = json_object_get(an, "rpm") ? "rpm" : "omega";
@@ -457,12 +457,9 @@ void tower_check_speeds(val_ctx *v, const json_t *canon)
     for (i = 0; i < n; i++)
         if (om[i] != 0) {
             char *p = err_ptr_key("/analysis", key);
-            field_error(v, p,
-                        "a tower does not spin: its speed must be 0 (speed %zu is %g "
-                        "%s); the rotor's speed belongs to a rotor-on-tower model, which is "
-                        "not supported yet",
-                        i + 1, !strcmp(key, "rpm") ? rpm[i] : om[i],
-                        !strcmp(key, "rpm") ? "rpm" : "rad/s");
+            field_error(v, p, "%s: its speed must be 0 (speed %zu is %g %s)%s", why, i + 1,
+                        !strcmp(key, "rpm") ? rpm[i] : om[i], !strcmp(key, "rpm") ? "rpm" : "rad/s",
+                        tail);
             free(p);
             break;
         }

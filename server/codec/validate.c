@@ -872,8 +872,17 @@ static json_t *val_document(val_ctx *v, const json_t *root, json_t **structure)
     }
     val_frames(v, root, canon);
     val_analysis(v, root, canon);
-    if (json_object_get(canon, "tower"))
-        tower_check_speeds(v, canon); /* a tower does not spin (tower.c) */
+    if (json_object_get(canon, "tower")) /* a tower does not spin (tower.c) */
+        tower_check_speeds(v, canon, "a tower does not spin",
+                           "; the rotor's speed belongs to a rotor-on-tower model, which is not "
+                           "supported yet");
+    else if (json_object_get(json_object_get(canon, "structure"), "gravity"))
+        tower_check_speeds(v, canon, "gravity is a steady load at rest only (DESIGN.md 8.8)", "");
+    else if (plat_base_free(json_object_get(canon, "structure")))
+        tower_check_speeds(v, canon,
+                           "a structure on a free base (elastic clamp, floating platform) is "
+                           "analysed at rest only (DESIGN.md 8.7)",
+                           "");
     val_name(v, root);
     if (json_object_get(canon, "analysis") && *structure)
         size_check(v, canon, *structure); /* the result's size (size.c) */
