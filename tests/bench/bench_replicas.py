@@ -30,6 +30,7 @@ How jobs are submitted and polled (so that the client is not what is measured):
 usage: python3 tests/bench/bench_replicas.py BUILD_DIR [--workers 1,2,4,8,16]
            [--replicas 1,2,4,8] [--workers-per-replica 2] [--jobs N] [--speeds 11]
            [--sqlite-only | --pg-only] [--pg-bin DIR] [--wrk] [--seconds S] [--clients C]
+           [--daemon-env KEY=VALUE ...]
 BUILD_DIR is a build folder (BUILD_DIR/server/spinmodald) or a folder holding spinmodald and
 spinmodal (tests/bench/pack_device.sh's tree).  PostgreSQL: initdb/pg_ctl/createdb from
 --pg-bin DIR, else $PG_BINDIR, else as tests/e2e/replicas_test.py finds them (pg_config,
@@ -95,6 +96,37 @@ def solve_sum(daemons):
     return s, n
 
 
+TCK = os.sysconf("SC_CLK_TCK")
+
+
+def proc_cpu(pids):
+    """(CPU seconds user+system, minor page faults) summed over the live pids."""
+    cpu = flt = 0
+    for pid in pids:
+        try:
+            with open("/proc/%d/stat" % pid) as f:
+                v = f.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        flt += int(v[7])
+        cpu += int(v[11]) + int(v[12])
+    return cpu / TCK, flt
+
+
+def pg_pids():
+    """The PostgreSQL server's processes (every `postgres` process of this machine)."""
+    out = []
+    for e in os.listdir("/proc"):
+        if e.isdigit():
+            try:
+                with open("/proc/%s/comm" % e) as f:
+                    if f.read().strip() == "postgres":
+                        out.append(int(e))
+            except OSError:
+                pass
+    return out
+
+
 def empty(d, state):
     r = d.get("/v1/analyses?state=%s&limit=1" % state)
     return r.status == 200 and not r.json()["items"]
@@ -104,6 +136,10 @@ def throughput(daemons, n, speeds, clients, workers):
     """Run n distinct jobs over the daemons; a dict of the figures."""
     reqs = [body(i, speeds) for i in range(n)]
     s0, c0 = solve_sum(daemons)
+    dpids = [x.proc.pid for x in daemons]
+    pgp = pg_pids()
+    d0, f0 = proc_cpu(dpids)
+    p0, _ = proc_cpu(pgp)
     t0 = time.monotonic()
 
     def submit(k):
@@ -122,6 +158,8 @@ def throughput(daemons, n, speeds, clients, workers):
         if empty(d, "queued") and empty(d, "running"):
             break
     wall = time.monotonic() - t0
+    d1, f1 = proc_cpu(dpids)
+    p1, _ = proc_cpu(pgp)   # the backends of the replicas' connections live as long as the row
     # the daemon's timestamps of every job of this row (fresh database: the row's jobs only)
     starts, ends, states = [], [], {}
     path = "/v1/analyses?limit=100"
@@ -139,7 +177,8 @@ def throughput(daemons, n, speeds, clients, workers):
     s1, c1 = solve_sum(daemons)
     return {"rate": n / span, "wall_rate": n / wall, "span": span, "submit": t_sub,
             "solve_ms": 1e3 * (s1 - s0) / max(1, c1 - c0), "busy": (s1 - s0) / (workers * span),
-            "job": ids[0], "n": n}
+            "job": ids[0], "n": n, "d_ms": 1e3 * (d1 - d0) / n, "pg_ms": 1e3 * (p1 - p0) / n,
+            "faults": (f1 - f0) / n}
 
 
 def wrk(d, job, seconds):
@@ -174,14 +213,16 @@ def find_exe(build, name):
 
 def table(title, unit, rows, first):
     print("\n" + title)
-    print("%-8s %6s %9s %7s %7s %6s %9s %9s %8s %8s" % (
-        unit, "jobs", "jobs/s", "ratio", "eff", "busy", "solve ms", "wall j/s", "submit s", "span s"))
+    print("%-4s %5s %8s %6s %5s %5s %8s %7s %7s %7s %8s %7s %6s" % (
+        unit, "jobs", "jobs/s", "ratio", "eff", "busy", "solve ms", "cpu ms", "pg ms", "faults",
+        "wall j/s", "submit", "span"))
     base = rows[0][1]["rate"]
     for k, r in rows:
         ratio = r["rate"] / base
-        print("%-8s %6d %9.1f %7.2f %7.2f %6.2f %9.1f %9.1f %8.2f %8.2f" % (
-            k, r["n"], r["rate"], ratio, ratio / (k / first), r["busy"], r["solve_ms"],
-            r["wall_rate"], r["submit"], r["span"]))
+        print("%-4s %5d %8.1f %6.2f %5.2f %5.2f %8.1f %7.1f %7s %7.0f %8.1f %7.2f %6.2f" % (
+            k, r["n"], r["rate"], ratio, ratio / (k / first), r["busy"], r["solve_ms"], r["d_ms"],
+            "%.2f" % r["pg_ms"] if r["pg_ms"] > 0 else "-", r["faults"], r["wall_rate"],
+            r["submit"], r["span"]))
 
 
 def main():
@@ -202,6 +243,8 @@ def main():
     ap.add_argument("--pg-bin", help="PostgreSQL bin folder (initdb, pg_ctl, postgres, createdb)")
     ap.add_argument("--wrk", action="store_true", help="add the cache-hit GET rate (wrk)")
     ap.add_argument("--seconds", type=int, default=5, help="wrk's duration")
+    ap.add_argument("--daemon-env", action="append", default=[], metavar="KEY=VALUE",
+                    help="an environment variable for the daemons only (repeatable)")
     a = ap.parse_args()
     if a.speeds < 1 or a.jobs < 1 or a.workers_per_replica < 1 or a.clients < 1:
         ap.error("--speeds, --jobs, --workers-per-replica and --clients must be >= 1")
@@ -209,6 +252,10 @@ def main():
         os.environ["PG_BINDIR"] = os.path.abspath(a.pg_bin)
     exe = find_exe(a.build, "spinmodald")
     env = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
+    for kv in a.daemon_env:
+        if "=" not in kv:
+            ap.error("--daemon-env takes KEY=VALUE: %r" % kv)
+        env[kv.split("=", 1)[0]] = kv.split("=", 1)[1]
     # the harness scales its waits by a reference solve of the CLI beside the daemon
     os.environ.setdefault("SPINMODAL_TEST_CLI", find_exe(os.path.dirname(exe), "spinmodal"))
     print("spinmodald %s; nproc %d (os.cpu_count %d); load %s; %s"
@@ -219,6 +266,8 @@ def main():
           " round-robin over replicas; completion polled by 2 list requests every 2%% of the elapsed"
           " time; rate = jobs / (last finished_at - first started_at) of the daemon's own timestamps"
           % (a.speeds, a.jobs, a.clients))
+    if a.daemon_env:
+        print("daemon environment: %s" % " ".join(a.daemon_env))
     tmp = tempfile.mkdtemp(prefix="spinmodal-bench-replicas-")
     sq, pgr, gets = [], [], []
     pg = None

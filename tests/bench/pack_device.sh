@@ -91,7 +91,8 @@ fi
 cat > "$OUT/run.sh" <<'EOF'
 #!/bin/bash
 # Throughput scaling benchmark from this tree alone (packed by tests/bench/pack_device.sh).
-# usage: bash run.sh [bench_replicas.py options]   (default: the issue 27 goal 4 run)
+# usage: bash run.sh [bench_replicas.py options]
+#   without options: the issue 27 goal 4 run, twice (default malloc, then GLIBC_TUNABLES)
 set -u
 HERE=$(cd "$(dirname "$0")" && pwd)
 PGBIN=$HERE/pg/lib/postgresql/__PGVER__/bin
@@ -124,8 +125,17 @@ bad=$(ldd bin/spinmodald "$PGBIN/postgres" 2>&1 | grep -E 'not found' || true)
 [ -z "$bad" ] || { echo "missing libraries: $bad"; exit 3; }
 bin/spinmodal --version || { echo "spinmodal does not run"; ldd bin/spinmodal; exit 3; }
 "$PGBIN/postgres" --version || { echo "postgres does not run"; ldd "$PGBIN/postgres"; exit 3; }
-[ $# -gt 0 ] || set -- --workers 1,2,4,8,16 --replicas 1,2,4,8 --workers-per-replica 2 --jobs 40
-exec python3 -u bench/bench_replicas.py bin --pg-bin "$PGBIN" "$@"
+if [ $# -gt 0 ]; then
+    exec python3 -u bench/bench_replicas.py bin --pg-bin "$PGBIN" "$@"
+fi
+# the issue 27 goal 4 run: the tables as built, then again with glibc's heap kept by the
+# workers (no trimming back to the kernel, no mmap for big blocks: the page faults of a job)
+ARGS="--workers 1,2,4,8,16 --replicas 1,2,4,8 --workers-per-replica 2 --jobs 40"
+TUN=glibc.malloc.trim_threshold=268435456:glibc.malloc.mmap_threshold=268435456:glibc.malloc.top_pad=67108864
+echo "### pass 1: default malloc"
+python3 -u bench/bench_replicas.py bin --pg-bin "$PGBIN" $ARGS
+echo "### pass 2: daemons with GLIBC_TUNABLES=$TUN"
+python3 -u bench/bench_replicas.py bin --pg-bin "$PGBIN" $ARGS --daemon-env GLIBC_TUNABLES=$TUN
 EOF
 sed -i "s/__PGVER__/$PGVER/" "$OUT/run.sh"
 chmod 755 "$OUT/run.sh"
