@@ -283,6 +283,11 @@ typedef struct sm_options {
      * time, ~10 n^2 doubles of memory); beyond, the case ends eigen_failed with the number of
      * negative eigenvalues of K*.  0: SM_DENSE_MAX_DEFAULT. */
     int max_dense_coordinates;
+    /* Threads a sweep may use (not part of the JSON request; the results are the same bits on
+     * any number): the continuation stays on the calling thread, and each speed's
+     * linearisation, eigen-analysis and shapes run on up to threads - 1 workers beside it
+     * (DESIGN.md 2.1).  0 or 1 (default): the calling thread only. */
+    int threads;
     /* DESIGN.md 9.1: engine orders n > 0 (finite, at most SM_MAX_ENGINE_ORDERS) whose critical
      * speeds (w(Omega) = n Omega along each tracked mode) sm_solve finds in a sweep; 0: none */
     int n_engine_orders;

@@ -15,9 +15,11 @@
  * error.
  */
 #include <errno.h>
+#include <malloc.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli_import.h"
 #include "codec.h"
@@ -30,6 +32,9 @@ extern void openblas_set_num_threads(int n) __attribute__((weak));
 
 /* Dense models at least this large (coordinates) keep OpenBLAS's default threads. */
 #define CLI_BLAS_THREADED_FROM 1000
+/* The most threads a sweep takes by default (--threads: any number from 1 to CLI_THREADS_MAX). */
+#define CLI_THREADS_DEFAULT_MAX 16
+#define CLI_THREADS_MAX 1024
 
 enum {
     CLI_OK = 0,
@@ -47,10 +52,11 @@ typedef struct cli_args {
     int table;           /* --table: aligned frequency table for a terminal */
     int critical_csv;    /* --critical-csv: the critical speeds as CSV (DESIGN.md 9.1) */
     int pretty;          /* --pretty: indented JSON */
+    int threads;         /* --threads N; 0: chosen by cli_threads */
 } cli_args;
 
 static const char cli_usage_text[] =
-    "usage: spinmodal solve [--csv | --table | --critical-csv] [--pretty] FILE|-\n"
+    "usage: spinmodal solve [--csv | --table | --critical-csv] [--pretty] [--threads N] FILE|-\n"
     "       spinmodal validate [--pretty] FILE|-\n"
     "       spinmodal import bmodes|elastodyn|csv FILE [--tip-radius R] [--hub-radius H]\n"
     "                        [--rpm SPEEDS] [--bmodes-mesh K] [--allow-outside] [--pretty] [--full]\n"
@@ -89,6 +95,8 @@ static void cli_help(void)
            "                   frequency in rad/s, Hz and per revolution, status, label\n"
            "  --critical-csv   print the critical speeds (analysis.engine_orders) as CSV\n"
            "  --pretty         indent the JSON output\n"
+           "  --threads N      threads a sweep may use (default: the online cores, at most\n"
+           "                   16; 1 when OpenBLAS runs threaded); the result is the same\n"
            "  -h, --help       show this help\n"
            "  -V, --version    show the version\n\n"
            "exit status: 0 solved, 2 invalid request (problem JSON on stderr),\n"
@@ -332,25 +340,38 @@ static int cli_output(const cli_args *a, const codec_run_out *out)
  * fighting over small matrices made a 48-element solve 6x slower on a busy
  * machine): one thread unless the model takes the dense path with at least
  * CLI_BLAS_THREADED_FROM coordinates, where threaded factorisations pay.  An
- * explicit OPENBLAS_NUM_THREADS in the environment is left alone.
+ * explicit OPENBLAS_NUM_THREADS in the environment is left alone.  Then the
+ * sweep's threads (issue 27): --threads, else the online cores (at most
+ * CLI_THREADS_DEFAULT_MAX) unless BLAS runs threaded.
  */
-static void cli_blas_threads(const codec_request *req)
+static void cli_threads(const cli_args *a, codec_request *req)
 {
     const sm_model_info *info = codec_request_model_info(req);
+    int blas_threaded = 1, threads = a->threads;
 
-    if (!openblas_set_num_threads || getenv("OPENBLAS_NUM_THREADS"))
-        return;
-    if (info->structured || info->coordinates < CLI_BLAS_THREADED_FROM)
+    if (openblas_set_num_threads && !getenv("OPENBLAS_NUM_THREADS") &&
+        (info->structured || info->coordinates < CLI_BLAS_THREADED_FROM)) {
         openblas_set_num_threads(1);
+        blas_threaded = 0;
+    } else if (getenv("OPENBLAS_NUM_THREADS")) {
+        blas_threaded = atoi(getenv("OPENBLAS_NUM_THREADS")) != 1;
+    }
+    if (threads == 0) {
+        long cores = sysconf(_SC_NPROCESSORS_ONLN);
+        threads = blas_threaded || cores < 1        ? 1
+                  : cores > CLI_THREADS_DEFAULT_MAX ? CLI_THREADS_DEFAULT_MAX
+                                                    : (int)cores;
+    }
+    codec_request_set_threads(req, threads);
 }
 
 /* Solve a validated request through the codec's pipeline and print; returns an exit code. */
-static int cli_solve(const cli_args *a, const codec_request *req, codec_errors *errs)
+static int cli_solve(const cli_args *a, codec_request *req, codec_errors *errs)
 {
     codec_run_out out;
     int rc;
 
-    cli_blas_threads(req);
+    cli_threads(a, req);
     switch (codec_run(req, a->csv ? CODEC_RUN_CSV : CODEC_RUN_JSON, NULL, NULL, errs, &out)) {
     case CODEC_RUN_DONE:
     case CODEC_RUN_PARTIAL:
@@ -676,8 +697,14 @@ done:
 
 int main(int argc, char **argv)
 {
-    cli_args a = {NULL, NULL, 0, 0, 0, 0};
+    cli_args a = {NULL, NULL, 0, 0, 0, 0, 0};
     int i, opts_done = 0;
+
+    /* The solver allocates and frees matrices of 0.1-4 MB at every Newton step and speed:
+     * glibc's defaults hand such blocks back to the kernel and fault them in again (42 000
+     * page faults in a 101-speed sweep of the angled beam, 3 000 with these; DESIGN.md 2.1). */
+    mallopt(M_MMAP_THRESHOLD, 4 << 20);
+    mallopt(M_TRIM_THRESHOLD, 16 << 20);
 
     if (argc < 2)
         return cli_usage("a command is required");
@@ -707,6 +734,13 @@ int main(int argc, char **argv)
             a.critical_csv = 1;
         } else if (!opts_done && !strcmp(s, "--pretty")) {
             a.pretty = 1;
+        } else if (!opts_done && !strcmp(s, "--threads")) {
+            char *end = NULL;
+            long t = i + 1 < argc ? strtol(argv[i + 1], &end, 10) : 0;
+            if (!end || *end || t < 1 || t > CLI_THREADS_MAX)
+                return cli_usage("--threads takes a number of threads from 1 to 1024");
+            a.threads = (int)t;
+            i++;
         } else if (!opts_done && s[0] == '-' && s[1] != '\0') {
             fprintf(stderr, "spinmodal: unknown option '%s'\n%s", s, cli_usage_text);
             return CLI_USAGE;

@@ -150,6 +150,11 @@ const sm_model_info *codec_request_model_info(const codec_request *r);
 /** The options for sm_model_new; borrowed from r. */
 const sm_options *codec_request_options(const codec_request *r);
 
+/** Let r's sweep use up to threads threads (sm_options.threads; < 2: the calling thread only).
+ *  A setting of the program that runs it, not of the request: the canonical text, the job id
+ *  and every number of the result stay the same. */
+void codec_request_set_threads(codec_request *r, int threads);
+
 /** The speeds (rad/s) in request order; borrowed from r.  *n receives their count. */
 const double *codec_request_speeds(const codec_request *r, int *n);
 

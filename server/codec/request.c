@@ -769,6 +769,11 @@ const sm_options *codec_request_options(const codec_request *r)
     return &r->opt;
 }
 
+void codec_request_set_threads(codec_request *r, int threads)
+{
+    r->opt.threads = threads > 1 ? threads : 1;
+}
+
 const double *codec_request_speeds(const codec_request *r, int *n)
 {
     *n = r->n_speeds;

@@ -39,6 +39,7 @@ enum {
     F_LISTEN,
     F_DB,
     F_WORKERS,
+    F_SOLVE_THREADS,
     F_QUEUE_MAX,
     F_MAX_BODY,
     F_MAX_ELEMENTS,
@@ -78,6 +79,9 @@ static const config_flag config_flags[F_N] = {
     {"db", "SPINMODAL_DB", "PATH|URI", "./spinmodal.db",
      "SQLite database file, or postgresql://user@host/db to share one queue between replicas"},
     {"workers", "SPINMODAL_WORKERS", "N", "online cores", "solver threads (1-1024)"},
+    {"solve-threads", "SPINMODAL_SOLVE_THREADS", "N", "1",
+     "threads one sweep job may use (1-64; up to workers x N in all): its speeds' "
+     "eigen-analyses run beside the continuation, same results"},
     {"queue-max", "SPINMODAL_QUEUE_MAX", "N", "1000", "queued jobs before POST answers 429"},
     {"max-body", "SPINMODAL_MAX_BODY", "BYTES", "1048576", "largest request body (413 above)"},
     {"max-elements", "SPINMODAL_MAX_ELEMENTS", "N", "2000", "most finite elements of a request"},
@@ -253,6 +257,9 @@ static int config_set(config_opts *o, int f, const char *v, const char **want)
     case F_WORKERS:
         *want = "an integer from 1 to 1024";
         return config_long(v, 1, 1024, &o->workers);
+    case F_SOLVE_THREADS:
+        *want = "an integer from 1 to 64";
+        return config_long(v, 1, 64, &o->solve_threads);
     case F_QUEUE_MAX:
         *want = "an integer from 1 to 10000000";
         return config_long(v, 1, 10000000, &o->queue_max);
@@ -351,6 +358,7 @@ static void config_defaults(config_opts *o)
     o->port = 8080;
     o->db = "./spinmodal.db";
     o->workers = cores < 1 ? 1 : cores > 1024 ? 1024 : cores;
+    o->solve_threads = 1;
     o->queue_max = 1000;
     o->max_body = 1048576;
     o->max_elements = 2000;

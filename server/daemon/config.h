@@ -19,7 +19,8 @@ typedef struct config_opts {
     int port;       /* 0..65535 */
     int ipv6;       /* host was given in [brackets] */
     const char *db;
-    long workers, queue_max, max_body, max_elements, max_speeds, max_coordinates, max_frame_dofs;
+    long workers, solve_threads, queue_max, max_body, max_elements, max_speeds, max_coordinates,
+        max_frame_dofs;
     double job_timeout;         /* s, > 0 */
     double shutdown_grace;      /* s, >= 0 */
     double retain_age;          /* s, 0 = no age bound */

@@ -212,6 +212,7 @@ static void jobs_run(jobs *j, jobs_slot *slot, const store_job *job, jobs_outcom
             codec_errors_to_json(errs), NULL);
         goto done;
     }
+    codec_request_set_threads(req, j->cfg.solve_threads);
     codec_run(req, CODEC_RUN_TEXT | CODEC_RUN_CSV, jobs_progress_cb, &ctx, errs, &out);
     rec->solve_seconds = out.seconds;
     rec->speeds_done = out.speeds_done;

@@ -41,6 +41,7 @@ typedef enum jobs_outcome {
 
 typedef struct jobs_config {
     int workers;            /* worker threads, >= 1 */
+    int solve_threads;      /* threads one sweep job may use (codec_request_set_threads), >= 1 */
     int queue_max;          /* most queued jobs before JOBS_FULL, >= 1 */
     double job_timeout;     /* s of solve time before a job fails with "timeout", > 0 */
     codec_limits limits;    /* limits applied when a worker re-reads a stored request */

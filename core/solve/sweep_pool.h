@@ -1,0 +1,45 @@
+/*
+ * sweep_pool.h — the speeds of a sweep finished on several threads (not installed; issue 27,
+ * DESIGN.md 2.1).
+ *
+ * The continuation (sweep.c) stays on the thread that called sm_solve: each equilibrium starts
+ * from the one before.  Once a speed's equilibrium is found, the rest of its case (steady-state
+ * outputs, linearisation, eigen-analysis, shapes: sweep_case_finish) depends on that equilibrium
+ * and the model alone, so a worker with its own smi_lin finishes it while the calling thread goes
+ * on to the next speed.  Each case's numbers are the same bits on any number of threads.  The
+ * progress callback is only ever called from the calling thread (spinmodal.h); workers stop
+ * when the pool is told to.
+ */
+#ifndef SM_SWEEP_POOL_H
+#define SM_SWEEP_POOL_H
+
+#include "linsys.h"
+
+/** Steady-state outputs of case c at its equilibrium q (c->converged set by the caller), and with
+ *  c->converged its modes and shapes, on L (SMI_USE_MODES, this thread's own).  pr: the stop
+ *  callback the tree path asks.  Returns SM_OK (an eigen-analysis failure is reported on the
+ *  case), SM_NOMEM or SM_CANCELED. */
+int sweep_case_finish(const sm_model *m, const double *q, smi_lin *L, const sm_progress *pr,
+                      sm_case *c);
+
+typedef struct sweep_pool sweep_pool;
+
+/** A pool for at most n_cases cases of m on threads - 1 workers (threads >= 2) besides the
+ *  calling thread.  SM_OK or SM_NOMEM (*out NULL: finish the cases on the calling thread). */
+int sweep_pool_new(const sm_model *m, int threads, int n_cases, sweep_pool **out);
+/** Queue case c at its equilibrium q (n values, copied).  SM_OK or SM_NOMEM (nothing queued). */
+int sweep_pool_add(sweep_pool *p, sm_case *c, const double *q);
+/** Cases finished so far (any thread). */
+int sweep_pool_finished(sweep_pool *p);
+/** Ask the workers to stop: the cases not started are left, a running eigen-analysis on the tree
+ *  path stops at its next check. */
+void sweep_pool_stop(sweep_pool *p);
+/** Finish the queued cases, the calling thread taking its share on L with pr (its callback asked
+ *  with the cases finished between them and while it waits; a nonzero answer before the last
+ *  stops the pool), wait for the workers and end them.  Returns SM_OK, or the first SM_NOMEM or
+ *  SM_CANCELED of any thread. */
+int sweep_pool_finish(sweep_pool *p, smi_lin *L, sm_progress *pr);
+/** End the workers (after sweep_pool_stop when cases are left) and free p; NULL is fine. */
+void sweep_pool_free(sweep_pool *p);
+
+#endif
