@@ -69,11 +69,12 @@ static int sweep_equilibrium_out(const sm_model *m, const double *q, smi_lin *L,
     c->max_frame_rotation = rot;
     c->warning[0] = '\0';
     if (c->converged && rot > SM_FRAME_ROTATION_LIMIT)
-        snprintf(c->warning, sizeof c->warning,
-                 "FE node %d turns %.2f rad relative to its frame (limit %.1f rad for the linear kinematics "
-                 "inside a frame): the steady state and frequencies are those of the model, not of the "
-                 "structure; use more frames",
-                 at, rot, SM_FRAME_ROTATION_LIMIT);
+        snprintf(
+            c->warning, sizeof c->warning,
+            "FE node %d turns %.2f rad relative to its frame (limit %.1f rad for the linear kinematics "
+            "inside a frame): the steady state and frequencies are those of the model, not of the "
+            "structure; use more frames",
+            at, rot, SM_FRAME_ROTATION_LIMIT);
     return SM_OK;
 }
 
@@ -90,9 +91,11 @@ static int sweep_eigen_failed(sm_case *c, int rc, int finite)
     c->status = SM_CASE_EIGEN_FAILED;
     if (rc == SM_LIMIT) /* sweep_eigen wrote the reason */
         return SM_OK;
-    snprintf(c->message, sizeof c->message, "eigen-analysis failed at the converged equilibrium: %s%s",
-             sm_strerror(rc),
-             finite ? "" : " (K*, M* or C* has non-finite entries: the numbers overflow double precision)");
+    snprintf(c->message, sizeof c->message,
+             "eigen-analysis failed at the converged equilibrium: %s%s", sm_strerror(rc),
+             finite
+                 ? ""
+                 : " (K*, M* or C* has non-finite entries: the numbers overflow double precision)");
     return SM_OK;
 }
 
@@ -119,7 +122,8 @@ static int sweep_eigen(const sm_model *m, const double *q, smi_lin *L, smi_lin *
         c->t_eigen = sweep_ms() - t1;
         if (!fallback)
             return SM_OK;
-        int dmax = m->opt.max_dense_coordinates > 0 ? m->opt.max_dense_coordinates : SM_DENSE_MAX_DEFAULT;
+        int dmax =
+            m->opt.max_dense_coordinates > 0 ? m->opt.max_dense_coordinates : SM_DENSE_MAX_DEFAULT;
         if (m->n > dmax) { /* the dense path would take minutes and gigabytes */
             if (smi_lin_negative(L) > 0)
                 snprintf(c->message, sizeof c->message,
@@ -128,12 +132,13 @@ static int sweep_eigen(const sm_model *m, const double *q, smi_lin *L, smi_lin *
                          "eigen-analysis, which is limited to %d coordinates (this model has %d)",
                          smi_lin_negative(L), dmax, m->n);
             else
-                snprintf(c->message, sizeof c->message,
-                         "the structured eigen-analysis cannot give these modes (K* singular, too few "
-                         "coordinates for the modes asked, or no convergence: many equal frequencies), "
-                         "and the dense one is "
-                         "limited to %d coordinates (this model has %d)",
-                         dmax, m->n);
+                snprintf(
+                    c->message, sizeof c->message,
+                    "the structured eigen-analysis cannot give these modes (K* singular, too few "
+                    "coordinates for the modes asked, or no convergence: many equal frequencies), "
+                    "and the dense one is "
+                    "limited to %d coordinates (this model has %d)",
+                    dmax, m->n);
             return SM_LIMIT;
         }
         if ((rc = smi_lin_new(m, SMI_USE_MODES, 0, D)) < 0) /* the dense path decides */
@@ -155,7 +160,8 @@ static int sweep_eigen(const sm_model *m, const double *q, smi_lin *L, smi_lin *
 /* Modes of case c at the equilibrium q; pr: the stop callback the tree path asks every few
  * Krylov vectors.  An eigen-analysis failure is reported on the case (sweep_eigen_failed); returns
  * SM_OK, SM_NOMEM or SM_CANCELED. */
-static int sweep_modes(const sm_model *m, const double *q, smi_lin *L, const sm_progress *pr, sm_case *c)
+static int sweep_modes(const sm_model *m, const double *q, smi_lin *L, const sm_progress *pr,
+                       sm_case *c)
 {
     sm_eig_out e;
     smi_lin *D = NULL, *use = L;
@@ -192,14 +198,16 @@ static int sweep_modes(const sm_model *m, const double *q, smi_lin *L, const sm_
     c->stable = e.negative == 0 && !(e.max_re > 1e-8 * fmax(scale, 1e-3));
     c->status = c->stable ? SM_CASE_SOLVED : SM_CASE_UNSTABLE;
     if (!c->stable && e.negative > 0)
-        snprintf(c->message, sizeof c->message,
-                 "equilibrium found, unstable: K* has %d negative eigenvalue%s (a static divergence: "
-                 "the steady state exists but a disturbance grows away from it)",
-                 e.negative, e.negative == 1 ? "" : "s");
+        snprintf(
+            c->message, sizeof c->message,
+            "equilibrium found, unstable: K* has %d negative eigenvalue%s (a static divergence: "
+            "the steady state exists but a disturbance grows away from it)",
+            e.negative, e.negative == 1 ? "" : "s");
     else if (!c->stable)
         snprintf(c->message, sizeof c->message,
                  "equilibrium found, unstable: a root has a positive real part %.3g (a dynamic "
-                 "instability)", e.max_re);
+                 "instability)",
+                 e.max_re);
     eig_out_free(&e);
     smi_lin_free(D);
     return SM_OK;
