@@ -33,10 +33,15 @@ case "$OUT" in "$ROOT"|/|"$HOME") echo "refusing to empty $OUT" >&2; exit 2 ;; e
 SRC=$ROOT
 if [ $WORKTREE = 0 ]; then
     # HEAD as committed, unpacked beside the build folder (only files that changed are rebuilt)
+    # (a file whose bytes did not change keeps its time, so ninja rebuilds only what changed)
     SRC=$BUILD-src
+    new=$(mktemp -d)
+    git -C "$ROOT" archive --format=tar HEAD | tar -C "$new" -xf -
     mkdir -p "$SRC"
-    git -C "$ROOT" archive --format=tar HEAD | tar -C "$SRC" -xf - --keep-newer-files 2>/dev/null ||
-        git -C "$ROOT" archive --format=tar HEAD | tar -C "$SRC" -xf -
+    (cd "$new" && find . -type f) | while read -r f; do
+        cmp -s "$new/$f" "$SRC/$f" || { mkdir -p "$(dirname "$SRC/$f")"; cp -p "$new/$f" "$SRC/$f"; }
+    done
+    rm -rf "$new"
     BUILD=$BUILD-head
 fi
 if [ ! -f "$BUILD/build.ninja" ]; then
@@ -93,6 +98,7 @@ cat > "$OUT/run.sh" <<'EOF'
 # Throughput scaling benchmark from this tree alone (packed by tests/bench/pack_device.sh).
 # usage: bash run.sh [bench_replicas.py options]
 #   without options: the issue 27 goal 4 run, twice (default malloc, then GLIBC_TUNABLES)
+#   bash run.sh procs: the same solves by 1..16 separate CLI processes (the machine's ceiling)
 set -u
 HERE=$(cd "$(dirname "$0")" && pwd)
 PGBIN=$HERE/pg/lib/postgresql/__PGVER__/bin
@@ -125,13 +131,28 @@ bad=$(ldd bin/spinmodald "$PGBIN/postgres" 2>&1 | grep -E 'not found' || true)
 [ -z "$bad" ] || { echo "missing libraries: $bad"; exit 3; }
 bin/spinmodal --version || { echo "spinmodal does not run"; ldd bin/spinmodal; exit 3; }
 "$PGBIN/postgres" --version || { echo "postgres does not run"; ldd "$PGBIN/postgres"; exit 3; }
+TUN=glibc.malloc.trim_threshold=268435456:glibc.malloc.mmap_threshold=268435456:glibc.malloc.top_pad=67108864
+if [ "${1:-}" = procs ]; then
+    # the machine's own ceiling: the same 11-speed solves by P separate `spinmodal solve`
+    # processes (no daemon, no store, no shared process), default malloc and TUN
+    lscpu 2>/dev/null | grep -E "^(CPU\(s\)|Thread|Core|Socket|Model name|L3)"
+    python3 -c 'import json; r = json.load(open("bench/angled-beam-90.json")); r["analysis"]["omega"] = {"from": 1.0, "to": 11.0, "steps": 10}; r["analysis"]["mode_shapes"] = False; json.dump(r, open("/tmp/spinmodal-req11.json", "w"))'
+    one() { for _ in $(seq "$1"); do bin/spinmodal solve /tmp/spinmodal-req11.json >/dev/null; done; }
+    N=20
+    for P in 1 2 4 8 12 16; do for t in "" "$TUN"; do
+        s=$(date +%s%N)
+        for _ in $(seq $P); do GLIBC_TUNABLES=$t one $N & done; wait
+        e=$(date +%s%N)
+        echo "procs $P${t:+ tunables}: $(( (e - s) / 1000000 / N )) ms a solve, $(python3 -c "print(round($P * $N / (($e - $s) / 1e9), 1))") solves/s"
+    done; done
+    exit 0
+fi
 if [ $# -gt 0 ]; then
     exec python3 -u bench/bench_replicas.py bin --pg-bin "$PGBIN" "$@"
 fi
 # the issue 27 goal 4 run: the tables as built, then again with glibc's heap kept by the
 # workers (no trimming back to the kernel, no mmap for big blocks: the page faults of a job)
 ARGS="--workers 1,2,4,8,16 --replicas 1,2,4,8 --workers-per-replica 2 --jobs 40"
-TUN=glibc.malloc.trim_threshold=268435456:glibc.malloc.mmap_threshold=268435456:glibc.malloc.top_pad=67108864
 echo "### pass 1: default malloc"
 python3 -u bench/bench_replicas.py bin --pg-bin "$PGBIN" $ARGS
 echo "### pass 2: daemons with GLIBC_TUNABLES=$TUN"
