@@ -23,7 +23,9 @@ How jobs are submitted and polled (so that the client is not what is measured):
     nor the client's start-up counts; the wall rate (first POST -> done seen) is printed too.
   - `busy` is the daemon's own solve time (spinmodal_solve_duration_seconds_sum, all replicas)
     over workers x span: near 1.0 the workers never wait for work; `solve ms` is the mean solve
-    time of a job (codec_run: model, sweep, encoding) — rising with W means the cores interfere
+    time of a job (codec_run's own clock: model build and sweep; the result's JSON and CSV
+    encoding, the store's write and the claim are the rest, 1 - busy) — rising with W means the
+    cores interfere
     (memory bandwidth, frequency), a low `busy` with a flat `solve ms` means time outside the
     solve (store, claim, queue wait).
 
