@@ -174,7 +174,8 @@ static int cli_print_json(FILE *f, const json_t *doc, int pretty)
 {
     size_t flags = JSON_REAL_PRECISION(17) | (pretty ? JSON_INDENT(2) : JSON_COMPACT);
 
-    if (json_dumpf(doc, f, flags) || fputc('\n', f) == EOF || fflush(f))
+    if ((pretty ? json_dumpf(doc, f, flags) : codec_json_dumpf(doc, f)) || fputc('\n', f) == EOF ||
+        fflush(f))
         return -1;
     return 0;
 }

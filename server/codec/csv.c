@@ -42,8 +42,10 @@ int codec_memstream_done(FILE *f, char **buf, size_t *n, char **out, size_t *len
 /* A CSV number: full precision, empty when not finite. */
 static void csv_num(FILE *f, double x)
 {
+    char text[CODEC_NUMTEXT_MAX];
+
     if (isfinite(x))
-        fprintf(f, "%.17g", x);
+        fwrite(text, 1, (size_t)codec_numtext(text, x, 0), f);
 }
 
 /* The columns after status: per_rev (frequency / omega, empty at rest) and rpm. */

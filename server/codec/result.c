@@ -551,7 +551,7 @@ static int res_put(const char *buffer, size_t size, void *data)
 /* Append x (stolen; NULL is out of memory) to t as CODEC_RESULT_DUMP text; 0 or -1. */
 static int res_dump(codec_text *t, json_t *x)
 {
-    int rc = x ? json_dump_callback(x, res_put, t, CODEC_RESULT_DUMP) : -1;
+    int rc = x ? codec_json_dump(x, res_put, t) : -1;
 
     json_decref(x);
     return rc || t->nomem ? -1 : 0;

@@ -1,0 +1,149 @@
+/*
+ * jsontext.c — a result document as text: the bytes of jansson's json_dump_callback with
+ * CODEC_RESULT_DUMP (compact, reals at 17 digits, keys in insertion order), written faster
+ * (issue 27, DESIGN.md 2.1).
+ *
+ * How it fits: result.c's documents are mostly reals; jansson formats each through snprintf
+ * (glibc's multi-precision path, ~4 000 instructions a number: 15 % of a 101-speed sweep's
+ * process) and hands every piece to its callback.  Here reals take codec_numtext (the same
+ * bytes), pieces gather in a buffer, and whatever is not plain — a string with a byte outside
+ * printable ASCII, a quote or a backslash — is still written by jansson itself, so escapes and
+ * UTF-8 checks stay jansson's.  numtext_test checks the numbers; the CLI and daemon tests
+ * compare whole results.
+ */
+#include "codec_internal.h"
+
+#include <stdio.h>
+#include <string.h>
+
+typedef struct jt_out {
+    char b[8192];
+    size_t n;
+    json_dump_callback_t cb;
+    void *data;
+    int err;
+} jt_out;
+
+static void jt_flush(jt_out *o)
+{
+    if (o->n && !o->err && o->cb(o->b, o->n, o->data))
+        o->err = 1;
+    o->n = 0;
+}
+
+static void jt_put(jt_out *o, const char *s, size_t n)
+{
+    if (n > sizeof o->b - o->n) {
+        jt_flush(o);
+        if (n > sizeof o->b) {
+            if (!o->err && o->cb(s, n, o->data))
+                o->err = 1;
+            return;
+        }
+    }
+    memcpy(o->b + o->n, s, n);
+    o->n += n;
+}
+
+/* 1 when s (n bytes) is written between quotes as it is: printable ASCII, no '"' nor '\'. */
+static int jt_plain(const char *s, size_t n)
+{
+    for (size_t i = 0; i < n; i++) {
+        unsigned char c = (unsigned char)s[i];
+        if (c < 0x20 || c > 0x7e || c == '"' || c == '\\')
+            return 0;
+    }
+    return 1;
+}
+
+/* The string s (n bytes): plain here, else by jansson (its escapes and UTF-8 check). */
+static void jt_string(jt_out *o, const char *s, size_t n)
+{
+    if (jt_plain(s, n)) {
+        jt_put(o, "\"", 1);
+        jt_put(o, s, n);
+        jt_put(o, "\"", 1);
+        return;
+    }
+    jt_flush(o);
+    json_t *t = json_stringn(s, n);
+    if (!t || o->err || json_dump_callback(t, o->cb, o->data, JSON_ENCODE_ANY))
+        o->err = 1;
+    json_decref(t);
+}
+
+static void jt_value(jt_out *o, const json_t *x)
+{
+    char num[CODEC_NUMTEXT_MAX];
+    switch (json_typeof(x)) {
+    case JSON_OBJECT: {
+        const char *key;
+        json_t *v;
+        int first = 1;
+        jt_put(o, "{", 1);
+        json_object_foreach((json_t *)x, key, v) {
+            if (!first)
+                jt_put(o, ",", 1);
+            first = 0;
+            jt_string(o, key, strlen(key));
+            jt_put(o, ":", 1);
+            jt_value(o, v);
+        }
+        jt_put(o, "}", 1);
+        break;
+    }
+    case JSON_ARRAY:
+        jt_put(o, "[", 1);
+        for (size_t i = 0; i < json_array_size(x); i++) {
+            if (i > 0)
+                jt_put(o, ",", 1);
+            jt_value(o, json_array_get(x, i));
+        }
+        jt_put(o, "]", 1);
+        break;
+    case JSON_STRING:
+        jt_string(o, json_string_value(x), json_string_length(x));
+        break;
+    case JSON_INTEGER: {
+        int n = snprintf(num, sizeof num, "%" JSON_INTEGER_FORMAT, json_integer_value(x));
+        jt_put(o, num, (size_t)n);
+        break;
+    }
+    case JSON_REAL:
+        jt_put(o, num, (size_t)codec_numtext(num, json_real_value(x), 1));
+        break;
+    case JSON_TRUE:
+        jt_put(o, "true", 4);
+        break;
+    case JSON_FALSE:
+        jt_put(o, "false", 5);
+        break;
+    case JSON_NULL:
+        jt_put(o, "null", 4);
+        break;
+    }
+}
+
+int codec_json_dump(const json_t *x, json_dump_callback_t cb, void *data)
+{
+    jt_out o;
+    if (!json_is_object(x) && !json_is_array(x))
+        return -1; /* as json_dump_callback without JSON_ENCODE_ANY */
+    o.n = 0;
+    o.cb = cb;
+    o.data = data;
+    o.err = 0;
+    jt_value(&o, x);
+    jt_flush(&o);
+    return o.err ? -1 : 0;
+}
+
+static int jt_file(const char *buffer, size_t size, void *data)
+{
+    return fwrite(buffer, 1, size, (FILE *)data) == size ? 0 : -1;
+}
+
+int codec_json_dumpf(const json_t *x, FILE *f)
+{
+    return codec_json_dump(x, jt_file, f);
+}
