@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# tests/bench/bench_sweeps.sh — issue 27 goals 2 and 3: whole-process time of speed sweeps
+# (`spinmodal solve FILE`, stdout to /dev/null, OPENBLAS_NUM_THREADS=1), the median of N runs of
+# BASE (as it is: a CLI without --threads solves on one thread) and of NEW with --threads
+# 1, 2, 4, 8, 16, alternating run by run in one run.  Then whether BASE and NEW --threads 16
+# give the same result document (timings and version removed): the threads must not change a
+# bit.  A benchmark, never a test: it prints, it checks nothing.
+#   bash tests/bench/bench_sweeps.sh BASE NEW [N]      (N default 5)
+# Cases: the angled beam (examples/angled-beam-90.json, planar, 48 elements, 143 coordinates)
+# at 101 speeds 0..20 rad/s; the R3-style precone blade of bench_spatial.c (spatial, hub radius
+# 1 m, 10 m at 10 deg, 48 elements, 288 coordinates, the tree path) at 21 speeds 0..20 and 101
+# speeds 0..20 rad/s; 3 modes, shapes on, default options.  Measured on the 16-core device (see
+# DESIGN.md 2.1) and on 2 shared cores.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/../.."
+base=${1:?usage: bench_sweeps.sh BASE NEW [N]}
+new=${2:?usage: bench_sweeps.sh BASE NEW [N]}
+n=${3:-5}
+export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+python3 - "$tmp" <<'PY'
+import json, math, sys
+d = sys.argv[1]
+r = json.load(open("examples/angled-beam-90.json"))
+r["analysis"]["omega"] = [20 * i / 100 for i in range(101)]
+json.dump(r, open(d + "/planar101.json", "w"))
+b = math.radians(10)
+blade = {"structure": {"joints": {"H": [1, 0, 0], "T": [1 + 10 * math.cos(b), 0, 10 * math.sin(b)]},
+         "sections": {"s": {"EA": 8.4e7, "EI_flap": 2800, "EI_edge": 25200, "GJ": 3883,
+                            "mass_per_length": 3.0, "flap_inertia": 1e-4, "edge_inertia": 9e-4}},
+         "members": [{"id": "b", "from": "H", "to": "T", "section": "s", "elements": 48}],
+         "clamp": "H"},
+         "frames": "per_element", "analysis": {"omega": [float(i) for i in range(21)], "modes": 3}}
+json.dump(blade, open(d + "/blade21.json", "w"))
+blade["analysis"]["omega"] = [20 * i / 100 for i in range(101)]
+json.dump(blade, open(d + "/blade101.json", "w"))
+PY
+ms() {
+  local s e
+  s=$(date +%s%N)
+  "$@" >/dev/null
+  e=$(date +%s%N)
+  echo $(((e - s) / 1000000))
+}
+med() { sort -n | awk '{a[NR]=$1} END{print a[int((NR+1)/2)]}'; }
+strip() {
+  python3 -c "import json,sys; r=json.load(sys.stdin); r.pop('timing_ms'); r['solver'].pop('version'); print(json.dumps(r, sort_keys=True))"
+}
+echo "$(nproc --all) cores, load $(cut -d' ' -f1-3 /proc/loadavg); median ms of $n runs, alternating"
+printf "%-10s %8s" case base
+for t in 1 2 4 8 16; do printf " %8s" "new t$t"; done
+printf " %10s\n" "base/best"
+for f in planar101 blade21 blade101; do
+  : >"$tmp/t_base"
+  for t in 1 2 4 8 16; do : >"$tmp/t_$t"; done
+  for _ in $(seq "$n"); do
+    ms "$base" solve "$tmp/$f.json" >>"$tmp/t_base"
+    for t in 1 2 4 8 16; do ms "$new" solve --threads "$t" "$tmp/$f.json" >>"$tmp/t_$t"; done
+  done
+  b=$(med <"$tmp/t_base")
+  best=$b
+  printf "%-10s %8s" "$f" "$b"
+  for t in 1 2 4 8 16; do
+    v=$(med <"$tmp/t_$t")
+    [ "$v" -lt "$best" ] && best=$v
+    printf " %8s" "$v"
+  done
+  printf " %10s\n" "$(awk -v a="$b" -v c="$best" 'BEGIN{printf "%.2f", a / (c > 0 ? c : 1)}')"
+  "$base" solve "$tmp/$f.json" | strip >"$tmp/a"
+  "$new" solve --threads 16 "$tmp/$f.json" | strip >"$tmp/b"
+  cmp -s "$tmp/a" "$tmp/b" && echo "  $f: base and new --threads 16 give the same document" ||
+    echo "  $f: the documents DIFFER"
+done
