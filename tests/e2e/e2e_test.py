@@ -565,6 +565,55 @@ def t_cancel(sc):
     stop_clean(d, "cancel")
 
 
+def t_solve_threads(sc):
+    """--solve-threads (issue 27): a sweep whose speeds' eigen-analyses run on 4 threads gives the
+    bytes of one thread (JSON without its timings, and CSV) and the CLI's document; a running sweep
+    on 4 threads stops on DELETE; 0 or 65 threads are refused at start (exit 64)."""
+    req = angled(12, 12, [20.0 * i / 30 for i in range(31)])
+    texts = {}
+    for t in (1, 4):
+        d = sc.daemon(["--workers", "1", "--solve-threads", str(t)], name="threads%d" % t)
+        jid, r = submit_id(d, req, "solve_threads: %d thread(s)" % t)
+        g = poll(d, jid) if jid else None
+        if check(g and g.get("state") == "done", "solve_threads: %d thread(s): sweep done (%s)"
+                 % (t, g and g.get("state"))):
+            body = d.get(job_path(jid) + "/result").body
+            texts[t] = (re.sub(rb',?"timing_ms":\{[^}]*\}', b"", body),
+                        d.get(job_path(jid) + "/result?format=csv").body)
+        if t == 4:
+            lid = run_until_running(d, long_sweep(), "solve_threads: long sweep")
+            if lid:
+                t0 = time.monotonic()
+                r = d.delete(job_path(lid))
+                check(r.status == 202, "solve_threads: DELETE running sweep -> 202 (%s)" % r.status)
+                g = poll(d, lid, timeout=60, interval=0.02)
+                el = time.monotonic() - t0
+                check(g and g.get("state") == "canceled" and g["progress"]["done"] < g["progress"]["total"],
+                      "solve_threads: the sweep on 4 threads is canceled early (%s)" % (g and g.get("progress")))
+                check(el < ts.scaled(5), "solve_threads: canceled within %.1f s (%.2f s)" % (ts.scaled(5), el))
+        stop_clean(d, "solve_threads %d" % t)
+    if check(len(texts) == 2, "solve_threads: both results"):
+        check(texts[1][0] == texts[4][0], "solve_threads: result JSON on 4 threads = on 1, byte for byte")
+        check(texts[1][1] == texts[4][1], "solve_threads: result CSV on 4 threads = on 1, byte for byte")
+        cli = os.environ.get("SPINMODAL_TEST_CLI")
+        if cli:
+            path = os.path.join(sc.tmp, "threads.json")
+            with open(path, "w") as f:
+                json.dump(req, f)
+            p = subprocess.run([cli, "solve", "--threads", "3", path], capture_output=True,
+                               timeout=ts.budget(60), env=dm._env())
+            mine = json.loads(texts[4][0])
+            theirs = json.loads(p.stdout or b"null") or {}
+            theirs.pop("timing_ms", None)
+            check(p.returncode == 0 and mine == theirs,
+                  "solve_threads: the daemon's document = the CLI's with --threads 3 (exit %d)" % p.returncode)
+    for bad in ("0", "65", "x"):
+        p = subprocess.run([EXE, "--solve-threads", bad, "--db", os.path.join(sc.tmp, "flags.sqlite")],
+                           capture_output=True, timeout=ts.budget(20), env=dm._env(), cwd=sc.tmp)
+        check(p.returncode == 64 and b"solve-threads" in p.stderr + p.stdout,
+              "solve_threads: --solve-threads %s -> exit 64 naming the flag (got %d)" % (bad, p.returncode))
+
+
 def t_csv(sc):
     """/result?format=csv agrees with the JSON result."""
     d = sc.daemon(["--workers", "2"])
@@ -1685,6 +1734,7 @@ SCENARIOS = {
     "resubmit": t_resubmit,
     "wait": t_wait,
     "cancel": t_cancel,
+    "solve_threads": t_solve_threads,
     "csv": t_csv,
     "auth": t_auth,
     "errors": t_errors,
