@@ -131,20 +131,17 @@ void field_check_keys(val_ctx *v, const json_t *obj, const char *base,
         const char *best = NULL;
         int i, found = 0, bestd = strlen(key) >= 5 ? 4 : 3; /* suggest below this distance */
         (void)val;
-        for (i = 0; allowed[i]; i++) {
-            int d;
-            if (!strcmp(key, allowed[i])) {
-                found = 1;
-                break;
-            }
-            d = field_edit_distance(key, allowed[i]);
+        for (i = 0; allowed[i] && !found; i++)
+            found = !strcmp(key, allowed[i]);
+        if (found)
+            continue;
+        for (i = 0; allowed[i]; i++) { /* an unknown key: the closest allowed one, if close */
+            int d = field_edit_distance(key, allowed[i]);
             if (d < bestd) {
                 bestd = d;
                 best = allowed[i];
             }
         }
-        if (found)
-            continue;
         if (best)
             field_error_key(v, base, key, "unknown %s key '%s' (did you mean '%s'?)", what,
                             field_short_name(key).s, best);
