@@ -616,4 +616,9 @@ int codec_memstream_done(FILE *f, char **buf, size_t *n, char **out, size_t *len
  *  chars.  Returns the length. */
 int codec_numtext(char *buf, double x, int json);
 
+/** json_dumps(x, JSON_SORT_KEYS | JSON_COMPACT | JSON_REAL_PRECISION(17)): the same bytes,
+ *  written by jsontext.c (keys sorted by strcmp as jansson does).  x: an object or an array.
+ *  Returns the malloc'd text, or NULL (out of memory, a string not valid UTF-8). */
+char *codec_json_dumps_sorted(const json_t *x);
+
 #endif /* SPINMODAL_CODEC_INTERNAL_H */

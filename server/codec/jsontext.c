@@ -14,6 +14,7 @@
 #include "codec_internal.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 typedef struct jt_out {
@@ -22,6 +23,7 @@ typedef struct jt_out {
     json_dump_callback_t cb;
     void *data;
     int err;
+    int sort; /* JSON_SORT_KEYS: an object's keys in strcmp order (jansson's compare_keys) */
 } jt_out;
 
 static void jt_flush(jt_out *o)
@@ -72,11 +74,48 @@ static void jt_string(jt_out *o, const char *s, size_t n)
     json_decref(t);
 }
 
+static void jt_value(jt_out *o, const json_t *x);
+
+static int jt_key_cmp(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+/* An object with its keys sorted (jansson: the keys gathered, qsort by strcmp). */
+static void jt_sorted(jt_out *o, const json_t *x)
+{
+    size_t n = json_object_size(x), i = 0;
+    const char **keys = malloc((n ? n : 1) * sizeof *keys);
+    const char *key;
+    json_t *v;
+    if (!keys) {
+        o->err = 1;
+        return;
+    }
+    json_object_foreach((json_t *)x, key, v)
+        keys[i++] = key;
+    qsort(keys, n, sizeof *keys, jt_key_cmp);
+    jt_put(o, "{", 1);
+    for (i = 0; i < n; i++) {
+        if (i > 0)
+            jt_put(o, ",", 1);
+        jt_string(o, keys[i], strlen(keys[i]));
+        jt_put(o, ":", 1);
+        jt_value(o, json_object_get(x, keys[i]));
+    }
+    jt_put(o, "}", 1);
+    free(keys);
+}
+
 static void jt_value(jt_out *o, const json_t *x)
 {
     char num[CODEC_NUMTEXT_MAX];
     switch (json_typeof(x)) {
     case JSON_OBJECT: {
+        if (o->sort) {
+            jt_sorted(o, x);
+            break;
+        }
         const char *key;
         json_t *v;
         int first = 1;
@@ -124,7 +163,8 @@ static void jt_value(jt_out *o, const json_t *x)
     }
 }
 
-int codec_json_dump(const json_t *x, json_dump_callback_t cb, void *data)
+/* The dump of x (object or array) with keys sorted or not. */
+static int jt_dump(const json_t *x, int sort, json_dump_callback_t cb, void *data)
 {
     jt_out o;
     if (!json_is_object(x) && !json_is_array(x))
@@ -133,9 +173,33 @@ int codec_json_dump(const json_t *x, json_dump_callback_t cb, void *data)
     o.cb = cb;
     o.data = data;
     o.err = 0;
+    o.sort = sort;
     jt_value(&o, x);
     jt_flush(&o);
     return o.err ? -1 : 0;
+}
+
+int codec_json_dump(const json_t *x, json_dump_callback_t cb, void *data)
+{
+    return jt_dump(x, 0, cb, data);
+}
+
+/* json_dump_callback into a codec_text; -1 when out of memory. */
+static int jt_text(const char *buffer, size_t size, void *data)
+{
+    codec_text *t = data;
+    codec_text_put(t, buffer, size);
+    return t->nomem ? -1 : 0;
+}
+
+char *codec_json_dumps_sorted(const json_t *x)
+{
+    codec_text t = {NULL, 0, 0, 0};
+    if (jt_dump(x, 1, jt_text, &t) || t.nomem || !t.p) {
+        free(t.p);
+        return NULL;
+    }
+    return t.p;
 }
 
 static int jt_file(const char *buffer, size_t size, void *data)

@@ -21,7 +21,6 @@
 #include <string.h>
 
 /* Flags for dumping canonical text. */
-#define CODEC_DUMP_CANON (JSON_SORT_KEYS | JSON_COMPACT | JSON_REAL_PRECISION(17))
 
 struct codec_request {
     json_t *canon;              /* canonical request, defaults applied */
@@ -615,7 +614,7 @@ static int req_keep_name(codec_request *r, const json_t *root)
         json_decref(copy);
         return SM_NOMEM;
     }
-    r->stored_text = json_dumps(copy, CODEC_DUMP_CANON);
+    r->stored_text = codec_json_dumps_sorted(copy);
     json_decref(copy);
     return r->stored_text ? SM_OK : SM_NOMEM;
 }
@@ -651,7 +650,7 @@ static int req_from_json(codec_request **out, const json_t *root, const codec_li
     r->structure = structure;
     r->blade = tower_form(r->canon);
     canon = structure = NULL;
-    r->canon_text = json_dumps(r->canon, CODEC_DUMP_CANON);
+    r->canon_text = codec_json_dumps_sorted(r->canon);
     if (!r->canon_text || req_keep_name(r, root))
         goto fail;
     if ((rc = codec_sha256_hex(r->canon_text, strlen(r->canon_text), r->sha)) ||

@@ -8,8 +8,10 @@
  *     fractions: their exact decimals end in 5), 10^k and its neighbours, integers around
  *     10^16 and 10^17, numbers whose 17-digit rounding carries into a new decade
  *     (9.99999999999999999e k), 0, -0, the largest and smallest doubles;
- *  4. the numbers of a solved result: frequencies, shape components, eigenvalues.
- * Prints how many values took the fast path.
+ *  4. the numbers of a solved result: frequencies, shape components, eigenvalues;
+ * and codec_json_dump / codec_json_dumps_sorted (jsontext.c) against jansson's own compact
+ * dump, with and without JSON_SORT_KEYS, on 3 000 random documents (nested objects and arrays,
+ * keys and strings with quotes, backslashes, control characters and UTF-8, reals, integers).
  */
 #include <float.h>
 #include <jansson.h>
@@ -56,6 +58,89 @@ static void check(double x, int with_jansson)
     }
     free(j);
     json_decref(r);
+}
+
+/* A random JSON value of depth up to d: objects with keys in random order (some not plain
+ * ASCII, some needing escapes), arrays, reals, integers, strings, true, false, null. */
+static json_t *random_doc(int d)
+{
+    static const char *strs[] = {"plain",     "1st edge", "quote\"d",    "back\\slash",
+                                 "tab\there", "ctl\x01",  "caf\xc3\xa9", "\xe2\x86\x92 arrow",
+                                 "",          "/slash"};
+    int kind = d > 0 ? (int)(next_u64() % 9) : 2 + (int)(next_u64() % 7);
+    uint64_t b;
+    double x;
+    switch (kind) {
+    case 0: {
+        json_t *o = json_object();
+        int n = (int)(next_u64() % 6);
+        for (int i = 0; i < n; i++) {
+            char key[32];
+            snprintf(key, sizeof key, "%s%d", strs[next_u64() % 10], (int)(next_u64() % 50));
+            json_object_set_new(o, key, random_doc(d - 1));
+        }
+        return o;
+    }
+    case 1: {
+        json_t *a = json_array();
+        int n = (int)(next_u64() % 6);
+        for (int i = 0; i < n; i++)
+            json_array_append_new(a, random_doc(d - 1));
+        return a;
+    }
+    case 2:
+        b = next_u64();
+        memcpy(&x, &b, sizeof x);
+        return json_real(isfinite(x) ? x : 0.5);
+    case 3:
+        return json_real((double)(next_u64() % 1000) / 8.0);
+    case 4:
+        return json_integer((json_int_t)(next_u64() >> 1) * (next_u64() & 1 ? -1 : 1));
+    case 5:
+        return json_string(strs[next_u64() % 10]);
+    case 6:
+        return json_true();
+    case 7:
+        return json_false();
+    default:
+        return json_null();
+    }
+}
+
+static int put_text(const char *buffer, size_t size, void *data)
+{
+    FILE *f = data;
+    return fwrite(buffer, 1, size, f) == size ? 0 : -1;
+}
+
+/* codec_json_dump = json_dump_callback(CODEC_RESULT_DUMP) and codec_json_dumps_sorted =
+ * json_dumps(JSON_SORT_KEYS | compact | precision 17) on random documents. */
+static void check_documents(int count)
+{
+    for (int i = 0; i < count; i++) {
+        json_t *doc = json_object();
+        json_object_set_new(doc, "a", random_doc(4));
+        json_object_set_new(doc, "z\xc3\xa9", random_doc(3));
+        char *want = json_dumps(doc, CODEC_RESULT_DUMP), *got = NULL, *ws = NULL, *gs = NULL;
+        size_t len = 0;
+        FILE *f = open_memstream(&got, &len);
+        int rc = codec_json_dump(doc, put_text, f);
+        fclose(f);
+        ws = json_dumps(doc, JSON_SORT_KEYS | JSON_COMPACT | JSON_REAL_PRECISION(17));
+        gs = codec_json_dumps_sorted(doc);
+        checked++;
+        if (rc || !want || strcmp(want, got) || !ws || !gs || strcmp(ws, gs)) {
+            if (failures++ < 20)
+                printf(
+                    "FAIL document %d:\n want %.300s\n got  %.300s\n sorted want %.300s\n sorted got  %.300s\n",
+                    i, want, got, ws, gs ? gs : "(null)");
+        }
+        free(want);
+        free(got);
+        free(ws);
+        free(gs);
+        json_decref(doc);
+    }
 }
 
 int main(void)
@@ -124,6 +209,7 @@ int main(void)
         check((2 * v - 1) * pow(10.0, -18 * u), i % 4 == 0); /* shape components */
         check(-1e-3 * u * v, i % 4 == 0);                    /* small real parts */
     }
-    printf("numtext: %ld values, %ld failures\n", checked, failures);
+    check_documents(3000);
+    printf("numtext: %ld values and documents, %ld failures\n", checked, failures);
     return failures ? 1 : 0;
 }
