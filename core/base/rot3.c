@@ -70,53 +70,6 @@ void rot3_exp(const sp_cx psi[3], sp_cx L[9], sp_cx T[9])
     }
 }
 
-void rot3_mul(const sp_cx a[9], const sp_cx b[9], sp_cx c[9])
-{
-    for (int j = 0; j < 3; j++)
-        for (int i = 0; i < 3; i++)
-            c[i + 3 * j] = a[i] * b[3 * j] + a[i + 3] * b[3 * j + 1] + a[i + 6] * b[3 * j + 2];
-}
-
-void rot3_tmul(const sp_cx a[9], const sp_cx b[9], sp_cx c[9])
-{
-    for (int j = 0; j < 3; j++)
-        for (int i = 0; i < 3; i++)
-            c[i + 3 * j] = a[3 * i] * b[3 * j] + a[3 * i + 1] * b[3 * j + 1] + a[3 * i + 2] * b[3 * j + 2];
-}
-
-void rot3_mv(const sp_cx a[9], const sp_cx x[3], sp_cx y[3])
-{
-    for (int i = 0; i < 3; i++)
-        y[i] = a[i] * x[0] + a[i + 3] * x[1] + a[i + 6] * x[2];
-}
-
-void rot3_tmv(const sp_cx a[9], const sp_cx x[3], sp_cx y[3])
-{
-    for (int i = 0; i < 3; i++)
-        y[i] = a[3 * i] * x[0] + a[3 * i + 1] * x[1] + a[3 * i + 2] * x[2];
-}
-
-void rot3_cross(const sp_cx a[3], const sp_cx b[3], sp_cx c[3])
-{
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-void rot3_mul_r(const double a[9], const double b[9], double c[9])
-{
-    for (int j = 0; j < 3; j++)
-        for (int i = 0; i < 3; i++)
-            c[i + 3 * j] = a[i] * b[3 * j] + a[i + 3] * b[3 * j + 1] + a[i + 6] * b[3 * j + 2];
-}
-
-void rot3_tmul_r(const double a[9], const double b[9], double c[9])
-{
-    for (int j = 0; j < 3; j++)
-        for (int i = 0; i < 3; i++)
-            c[i + 3 * j] = a[3 * i] * b[3 * j] + a[3 * i + 1] * b[3 * j + 1] + a[3 * i + 2] * b[3 * j + 2];
-}
-
 void rot3_log(const double R[9], double v[3])
 {
     /* skew part: (R - R')/2 = sin t/t skew(v); cos t = (tr R - 1)/2 */
