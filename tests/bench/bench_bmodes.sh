@@ -9,6 +9,8 @@
 # without BModes' source.
 #   bash tests/bench/bench_bmodes.sh SPINMODAL [N]          (N default 5; cases where one BModes
 #                                                            run takes > 5 s get 1 run)
+# BMODES_BIN=PATH: use that BModes binary (built by this script with BMODES_KEEP=PATH) instead of
+# building one, e.g. on a machine without gfortran.
 # BModes' source: $BMODES_SRC, a checkout of github.com/old-NWTC/BModes (a work tree with src/,
 # or a bare git directory; default: the tool library's mirror /work/.mirror/old-NWTC+BModes/repo).
 # Built with gfortran -O2 (-O3 with BMODES_FFLAGS=-O3); one patch, stated: eigsolver.f's
@@ -19,17 +21,20 @@ spin=$(realpath "${1:?usage: bench_bmodes.sh SPINMODAL [N]}")
 n=${2:-5}
 src=${BMODES_SRC:-/work/.mirror/old-NWTC+BModes/repo}
 fflags=${BMODES_FFLAGS:--O2}
-if ! command -v gfortran >/dev/null; then
-  echo "bench_bmodes: skipped (no gfortran: apt-get install gfortran)"; exit 0
-fi
-if [ ! -d "$src/src/bmodes" ] && ! git --git-dir="$src" rev-parse HEAD >/dev/null 2>&1; then
-  echo "bench_bmodes: skipped (no BModes source at $src: set BMODES_SRC)"; exit 0
-fi
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
+if [ -n "${BMODES_BIN:-}" ]; then # a BModes built earlier by this script (a machine without gfortran)
+  bmodes=$(realpath "$BMODES_BIN")
+  rev="prebuilt $BMODES_BIN"
+elif ! command -v gfortran >/dev/null; then
+  echo "bench_bmodes: skipped (no gfortran: apt-get install gfortran)"; exit 0
+elif [ ! -d "$src/src/bmodes" ] && ! git --git-dir="$src" rev-parse HEAD >/dev/null 2>&1; then
+  echo "bench_bmodes: skipped (no BModes source at $src: set BMODES_SRC)"; exit 0
+fi
 
-# ---- build BModes
+# ---- build BModes (BMODES_KEEP=PATH: copy the binary there, for BMODES_BIN on another machine)
+if [ -z "${BMODES_BIN:-}" ]; then
 mkdir -p "$tmp/bm"
 if [ -d "$src/src/bmodes" ]; then
   cp -r "$src/src" "$tmp/bm/"
@@ -51,6 +56,8 @@ sed -i 's/parameter (NMAX=1000)/parameter (NMAX=4000)/' "$tmp/bm/src/bmodes/eigs
   gfortran -o bmodes ./*.o
 ) >"$tmp/build.log" 2>&1 || { echo "bench_bmodes: BModes build failed:"; tail -20 "$tmp/build.log"; exit 1; }
 bmodes="$tmp/bm/build/bmodes"
+[ -n "${BMODES_KEEP:-}" ] && cp "$bmodes" "$BMODES_KEEP"
+fi
 
 # ---- cases: BModes inputs (refined el_loc; rot_rpm) and spinmodal requests (--bmodes-mesh k)
 ref=tests/reference/blades/bmodes_certtest
