@@ -315,6 +315,17 @@ json_t *val_request(const json_t *root, const codec_limits *lim, codec_errors *e
  */
 void val_structure(val_ctx *v, const json_t *root, json_t *canon);
 
+/* What to add for spatial sections, in messages (validate.c, validate_analysis.c). */
+#define VAL_SPATIAL_SECTIONS                                                                \
+    "give every section EA, EI_flap, EI_edge, GJ and mass_per_length (or E, G, A, I_flap, " \
+    "I_edge, J and mass_per_length)"
+
+/** root's "frames" (the scheme, default "per_element") into canon (validate_analysis.c). */
+void val_frames(val_ctx *v, const json_t *root, json_t *canon);
+
+/** root's "analysis" (speeds, modes, options and their defaults) into canon (validate_analysis.c). */
+void val_analysis(val_ctx *v, const json_t *root, json_t *canon);
+
 /* ===================================================== supports.c: sup_ */
 
 /**
