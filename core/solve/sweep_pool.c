@@ -30,7 +30,7 @@ struct sweep_pool {
     pthread_cond_t more;  /* a case was queued, or the pool closes */
     pthread_cond_t ended; /* a case was finished */
     pool_job *jobs;       /* queue: jobs[head .. tail) wait, [0 .. head) taken */
-    int cap, head, tail;
+    int head, tail;
     int running, finished, closing;
     int rc; /* first SM_NOMEM / SM_CANCELED of a thread */
     atomic_int stop;
@@ -105,7 +105,6 @@ int sweep_pool_new(const sm_model *m, int threads, int n_cases, sweep_pool **out
         return SM_NOMEM;
     p->m = m;
     p->n_workers = threads - 1 < n_cases ? threads - 1 : n_cases;
-    p->cap = n_cases;
     p->jobs = calloc((size_t)(n_cases > 0 ? n_cases : 1), sizeof *p->jobs);
     p->th = calloc((size_t)(p->n_workers > 0 ? p->n_workers : 1), sizeof *p->th);
     atomic_init(&p->stop, 0);

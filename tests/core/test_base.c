@@ -42,14 +42,7 @@ static void base_init(base_mast *b, double H, int elements, double EI, double mu
     b->sec.ip_over_a = 2e-12 / mu;
     b->mem.to = 1;
     b->mem.elements = elements;
-    b->st.n_joints = 2;
-    b->st.joint_xy = b->xy;
-    b->st.joint_z = b->z;
-    b->st.n_sections = 1;
-    b->st.sections = &b->sec;
-    b->st.n_members = 1;
-    b->st.members = &b->mem;
-    b->st.spatial = 1;
+    tu_one_member3(&b->st, b->xy, b->z, &b->sec, &b->mem);
     b->sup.joint = 0;
     b->sup.member = -1;
     b->st.n_supports = 1;

@@ -35,14 +35,7 @@ static void blade_init(blade *b, int elements, double twist_deg)
     b->sec.mu = 100;
     b->mem = (sm_member){0, 1, 0, elements};
     b->mem.twist = twist_deg * PI / 180;
-    b->st.n_joints = 2;
-    b->st.joint_xy = b->xy;
-    b->st.joint_z = b->z;
-    b->st.n_sections = 1;
-    b->st.sections = &b->sec;
-    b->st.n_members = 1;
-    b->st.members = &b->mem;
-    b->st.spatial = 1;
+    tu_one_member3(&b->st, b->xy, b->z, &b->sec, &b->mem);
 }
 
 /* 1. A polynomial of ElastoDyn's form is fitted exactly. */

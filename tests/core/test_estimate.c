@@ -40,14 +40,7 @@ static void est_bar_init(est_bar *b, double L, int n, double EA, double EIf, dou
     b->sec.i_edge = i_edge;
     b->sec.ip_over_a = (i_flap + i_edge) / mu;
     b->mem = (sm_member){0, 1, 0, n};
-    b->st.n_joints = 2;
-    b->st.joint_xy = b->xy;
-    b->st.joint_z = b->z;
-    b->st.n_sections = 1;
-    b->st.sections = &b->sec;
-    b->st.n_members = 1;
-    b->st.members = &b->mem;
-    b->st.spatial = 1;
+    tu_one_member3(&b->st, b->xy, b->z, &b->sec, &b->mem);
 }
 
 /* Share of nodal value `kind` (1 dy, 2 dz, 3 rx) in |shape|^2 of spatial mode j. */

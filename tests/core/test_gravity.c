@@ -44,16 +44,9 @@ static void gr_init(gr_beam *b, double mu, double M, double g)
     b->mem.elements = 60;
     b->pm.joint = 1;
     b->pm.mass = M;
-    b->st.n_joints = 2;
-    b->st.joint_xy = b->xy;
-    b->st.joint_z = b->z;
-    b->st.n_sections = 1;
-    b->st.sections = &b->sec;
-    b->st.n_members = 1;
-    b->st.members = &b->mem;
+    tu_one_member3(&b->st, b->xy, b->z, &b->sec, &b->mem);
     b->st.n_point_masses = M > 0;
     b->st.point_masses = &b->pm;
-    b->st.spatial = 1;
     b->st.gravity[1] = g;
 }
 

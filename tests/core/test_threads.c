@@ -184,14 +184,7 @@ static void arm3_init(arm3 *b)
     b->sec.mu = 20, b->sec.EA = 2e8, b->sec.EI_flap = 4e4, b->sec.EI_edge = 9e4, b->sec.GJ = 3e4;
     b->sec.i_flap = 0.02, b->sec.i_edge = 0.05, b->sec.ip_over_a = 0.07 / 20;
     b->mem.from = 0, b->mem.to = 1, b->mem.elements = 10;
-    b->st.n_joints = 2;
-    b->st.joint_xy = b->xy;
-    b->st.joint_z = b->z;
-    b->st.n_sections = 1;
-    b->st.sections = &b->sec;
-    b->st.n_members = 1;
-    b->st.members = &b->mem;
-    b->st.spatial = 1;
+    tu_one_member3(&b->st, b->xy, b->z, &b->sec, &b->mem);
 }
 
 int main(void)

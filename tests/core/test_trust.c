@@ -38,14 +38,7 @@ static void blade_init(blade *b, int elements, double EIe, double GJ, double i_e
     b->sec.ip_over_a = i_edge / 100;
     b->mem = (sm_member){0, 1, 0, elements};
     b->mem.twist = pitch_deg * PI / 180;
-    b->st.n_joints = 2;
-    b->st.joint_xy = b->xy;
-    b->st.joint_z = b->z;
-    b->st.n_sections = 1;
-    b->st.sections = &b->sec;
-    b->st.n_members = 1;
-    b->st.members = &b->mem;
-    b->st.spatial = 1;
+    tu_one_member3(&b->st, b->xy, b->z, &b->sec, &b->mem);
 }
 
 static sm_result *solve(const sm_structure *st, const sm_options *o, const double *om, int n)

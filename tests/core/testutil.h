@@ -46,6 +46,21 @@ static inline int tu_finish(const char *name)
     return tu_failures ? 1 : 0;
 }
 
+/* st: one spatial member (mem, of section sec) between joints 0 and 1 at xy (x0, y0, x1, y1)
+ * and z (z0, z1); the other fields of st are left as they are. */
+static inline void tu_one_member3(sm_structure *st, double *xy, double *z, sm_section *sec,
+                                  sm_member *mem)
+{
+    st->n_joints = 2;
+    st->joint_xy = xy;
+    st->joint_z = z;
+    st->n_sections = 1;
+    st->sections = sec;
+    st->n_members = 1;
+    st->members = mem;
+    st->spatial = 1;
+}
+
 /* Paper Table 1 section and the angled beam of Fig. 5: O(0,0)-C(5,0)-P. */
 typedef struct tu_angled {
     double xy[6];
