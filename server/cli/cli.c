@@ -30,6 +30,25 @@
 /* OpenBLAS: the program chooses its BLAS threads (weak: a reference BLAS links too). */
 extern void openblas_set_num_threads(int n) __attribute__((weak));
 
+/*
+ * OpenBLAS starts its thread pool (a thread per core) in its own constructor, before main, unless
+ * the environment names a count: 5 ms of a 10 ms small solve on 2 cores, more on 16 (issue 27).
+ * With OpenBLAS linked from its archive (meson.build) this constructor runs first (a prioritised
+ * one) and, when the user set none of the variables OpenBLAS reads, asks it for one thread;
+ * cli_threads then sets the count it always set (1, or the cores for a large dense model:
+ * OpenBLAS adds the threads then).  Linked as a shared library, OpenBLAS has started already and
+ * this changes nothing.
+ */
+static int cli_blas_env_ours;
+__attribute__((constructor(101))) static void cli_blas_env(void)
+{
+    if (!getenv("OPENBLAS_NUM_THREADS") && !getenv("GOTO_NUM_THREADS") &&
+        !getenv("OMP_NUM_THREADS")) {
+        setenv("OPENBLAS_NUM_THREADS", "1", 1);
+        cli_blas_env_ours = 1;
+    }
+}
+
 /* Dense models at least this large (coordinates) keep OpenBLAS's default threads. */
 #define CLI_BLAS_THREADED_FROM 1000
 /* The most threads a sweep takes by default (--threads: any number from 1 to CLI_THREADS_MAX). */
@@ -350,15 +369,19 @@ static void cli_threads(const cli_args *a, codec_request *req)
     const sm_model_info *info = codec_request_model_info(req);
     int blas_threaded = 1, threads = a->threads;
 
-    if (openblas_set_num_threads && !getenv("OPENBLAS_NUM_THREADS") &&
+    const char *env = cli_blas_env_ours ? NULL : getenv("OPENBLAS_NUM_THREADS");
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+
+    if (openblas_set_num_threads && !env &&
         (info->structured || info->coordinates < CLI_BLAS_THREADED_FROM)) {
         openblas_set_num_threads(1);
         blas_threaded = 0;
-    } else if (getenv("OPENBLAS_NUM_THREADS")) {
-        blas_threaded = atoi(getenv("OPENBLAS_NUM_THREADS")) != 1;
+    } else if (env) {
+        blas_threaded = atoi(env) != 1;
+    } else if (openblas_set_num_threads && cli_blas_env_ours && cores > 1) {
+        openblas_set_num_threads((int)cores); /* OpenBLAS's own default: a thread per core */
     }
     if (threads == 0) {
-        long cores = sysconf(_SC_NPROCESSORS_ONLN);
         threads = blas_threaded || cores < 1        ? 1
                   : cores > CLI_THREADS_DEFAULT_MAX ? CLI_THREADS_DEFAULT_MAX
                                                     : (int)cores;

@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
 # tests/bench/bench_bmodes.sh — issue 27 goal 5: spinmodal against BModes v3.00, side by side, in
-# one run on the same machine: whole-process wall time (median of N alternating runs) and peak
-# memory (the child's max RSS) on the BModes CertTest blade Test01 at 12, 48, 96 and 192
-# elements (BModes' own mesh refined: each of its 12 elements cut in k; spinmodal reads the same
-# model with `import bmodes --bmodes-mesh k`), and a 16-speed sweep at 48 elements (BModes: 16
-# runs, one per rot_rpm; spinmodal: one request with 16 speeds).  A benchmark, never a test: it
+# one run on the same machine: whole-process wall and CPU time (medians of N alternating runs)
+# and peak memory (RSS, under /usr/bin/time) on the BModes CertTest blade Test01 at 12, 48, 96
+# and 192 elements (BModes' own mesh refined: each of its 12 elements cut in k; spinmodal reads
+# the same model with `import bmodes --bmodes-mesh k`), and a 16-speed sweep at 48 elements
+# (BModes: 16 runs, one per rot_rpm; spinmodal: one request with 16 speeds).  A benchmark, never a test: it
 # prints a table and checks nothing.  It skips (exit 0, a line saying why) without gfortran or
 # without BModes' source.
 #   bash tests/bench/bench_bmodes.sh SPINMODAL [N]          (N default 5; cases where one BModes
 #                                                            run takes > 5 s get 1 run)
+# BMODES_ELEMENTS="12 48": only those sizes (default 12 48 96 192); BMODES_SWEEP=0: no sweep row.
 # BMODES_BIN=PATH: use that BModes binary (built by this script with BMODES_KEEP=PATH) instead of
 # building one, e.g. on a machine without gfortran.
 # BModes' source: $BMODES_SRC, a checkout of github.com/old-NWTC/BModes (a work tree with src/,
@@ -95,13 +96,14 @@ an["omega"] = [r * 2 * math.pi / 60 for r in speeds]
 json.dump(req, open("%s/sweep.json" % tmp, "w"))
 PY
 
-python3 - "$n" "$spin" "$bmodes" "$tmp" "$rev" "$fflags" <<'PY'
+python3 - "$n" "$spin" "$bmodes" "$tmp" "$rev" "$fflags" "${BMODES_ELEMENTS:-12 48 96 192}" \
+  "${BMODES_SWEEP:-1}" <<'PY'
 import os, statistics, sys, time
-n, spin, bmodes, tmp, rev, fflags = int(sys.argv[1]), *sys.argv[2:]
+n, spin, bmodes, tmp, rev, fflags, sizes, sweep = int(sys.argv[1]), *sys.argv[2:]
 null = os.open(os.devnull, os.O_WRONLY)
 
 def once(argv):
-    """Wall ms and peak RSS MiB of one whole process (posix_spawn, cwd = tmp)."""
+    """Wall ms and CPU ms (user + system) of one whole process (posix_spawn, cwd = tmp)."""
     fa = [(os.POSIX_SPAWN_DUP2, null, 1), (os.POSIX_SPAWN_DUP2, null, 2)]
     t0 = time.perf_counter_ns()
     pid = os.posix_spawn(argv[0], argv, os.environ, file_actions=fa)
@@ -109,29 +111,50 @@ def once(argv):
     wall = (time.perf_counter_ns() - t0) / 1e6
     if os.waitstatus_to_exitcode(status) != 0:
         sys.exit("failed: %s" % " ".join(argv))
-    return wall, ru.ru_maxrss / 1024.0
+    return wall, (ru.ru_utime + ru.ru_stime) * 1e3
+
+def peak_mib(argv):
+    """Peak RSS in MiB, measured under /usr/bin/time: a process spawned from this one starts on
+    Python's pages (posix_spawn shares them until exec) and its ru_maxrss never reads below
+    Python's own ~14 MiB.  None without /usr/bin/time."""
+    if not os.access("/usr/bin/time", os.X_OK):
+        return None
+    out = os.path.join(tmp, "rss.txt")
+    pid = os.posix_spawn("/usr/bin/time", ["/usr/bin/time", "-f", "%M", "-o", out] + argv,
+                         os.environ, file_actions=[(os.POSIX_SPAWN_DUP2, null, 1),
+                                                   (os.POSIX_SPAWN_DUP2, null, 2)])
+    os.waitpid(pid, 0)
+    return int(open(out).read().split()[-1]) / 1024.0
 
 os.chdir(tmp)
 cases = [("Test01, %d el., 1 speed" % e, [[bmodes, "t01_%d.bmi" % e]],
-          [spin, "solve", "t01_%d.json" % e]) for e in (12, 48, 96, 192)]
-cases.append(("16-speed sweep, 48 el.", [[bmodes, "sweep_%02d.bmi" % j] for j in range(16)],
-              [spin, "solve", "sweep.json"]))
+          [spin, "solve", "t01_%d.json" % e]) for e in map(int, sizes.split())]
+if sweep != "0":
+  cases.append(("16-speed sweep, 48 el.", [[bmodes, "sweep_%02d.bmi" % j] for j in range(16)],
+                [spin, "solve", "sweep.json"]))
 print("BModes v3.00 (old-NWTC/BModes %s, gfortran %s, NMAX 4000) vs %s; OPENBLAS_NUM_THREADS=1;"
-      " median of alternating runs" % (rev, fflags, spin))
-print("%-26s %5s %11s %11s %9s %10s %10s" % ("case", "runs", "BModes ms", "spinmodal", "ratio",
-                                            "BModes MiB", "spin. MiB"))
+      " medians of alternating runs; CPU = user + system" % (rev, fflags, spin))
+print("%-24s %4s %10s %10s %6s %9s %9s %6s %7s %7s" % (
+    "case", "runs", "BModes ms", "spinmodal", "ratio", "BM CPU", "spin CPU", "ratio",
+    "BM MiB", "sp MiB"))
+fmt_mib = lambda x: "%7s" % "n/a" if x is None else "%7.1f" % x
 for name, bm_runs, sp in cases:
     first = [once(a) for a in bm_runs]  # also warms the page cache
     once(sp)
     k = 1 if sum(w for w, _ in first) > 5000 else n
-    bt, st, bm_mem, sp_mem = [], [], 0.0, 0.0
+    bt, bc, st, sc = [], [], [], []
     for _ in range(k):
         r = [once(a) for a in bm_runs]
         bt.append(sum(w for w, _ in r))
-        bm_mem = max([bm_mem] + [m for _, m in r])
-        w, m = once(sp)
+        bc.append(sum(c for _, c in r))
+        w, c = once(sp)
         st.append(w)
-        sp_mem = max(sp_mem, m)
-    b, s = statistics.median(bt), statistics.median(st)
-    print("%-26s %5d %11.1f %11.1f %9.1f %10.1f %10.1f" % (name, k, b, s, b / s, bm_mem, sp_mem))
+        sc.append(c)
+    mem = [peak_mib(a) for a in bm_runs]
+    bm_mem = None if None in mem else max(mem)
+    sp_mem = peak_mib(sp)
+    med = statistics.median
+    print("%-24s %4d %10.1f %10.1f %6.1f %9.1f %9.1f %6.1f %s %s" % (
+        name, k, med(bt), med(st), med(bt) / med(st), med(bc), med(sc),
+        med(bc) / max(med(sc), 1e-9), fmt_mib(bm_mem), fmt_mib(sp_mem)))
 PY
