@@ -200,10 +200,12 @@ void sp_hessian_own(const sm_model *m, sp_kin *k, int s, int j, double *col)
     const sm_sub *b = &m->subs[s];
     double qj = creal(k->cq[j]), h = SP_STEP * fmax(1.0, fabs(qj));
     k->cq[j] = qj + _Complex_I * h;
+    k->pert_j = j;
     sp_step_own(m, k, s, h);
     for (int i = 0; i < b->m; i++)
         col[i] = cimag(k->cg[b->q0 + i]) / h;
     k->cq[j] = qj;
+    k->pert_j = -1;
     memcpy(k->cF + 6 * s, k->bF + 6 * s, 6 * sizeof(sp_cx));
     for (int t = k->ch_ptr[s]; t < k->ch_ptr[s + 1]; t++)
         memcpy(k->cF + 6 * k->ch_idx[t], k->bF + 6 * k->ch_idx[t], 6 * sizeof(sp_cx));
@@ -227,8 +229,10 @@ void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat
         for (int j = b->q0; j < b->q0 + b->m; j++) {
             double h = SP_STEP * fmax(1.0, fabs(q[j]));
             k->cq[j] = q[j] + _Complex_I * h;
+            k->pert_j = j;
             sp_step(m, k, s, h, &DM(H, 0, j));
             k->cq[j] = q[j];
+            k->pert_j = -1;
         }
     }
     memcpy(k->cF, k->bF, 6 * (size_t)m->n_subs * sizeof(sp_cx));

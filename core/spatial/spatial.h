@@ -113,6 +113,7 @@ typedef struct sp_kin {
     double *v;          /* 6S: pose change of each frame below a stepped coordinate */
     int cached;         /* 1 while lw.. hold the base state */
     int pert;           /* the substructure stepped (-1: none) */
+    int pert_j;         /* the coordinate stepped, of substructure pert (-1: none) */
 } sp_kin;
 
 /** Allocate k for m; jac: also the dense Jacobians JRT, JW (O(n (S + P))).  SM_OK or SM_NOMEM. */

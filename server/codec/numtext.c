@@ -8,7 +8,7 @@
  * significand): N = x 10^p with 10^16 <= N < 10^17 and the powers of ten up to 10^27 exact, so
  * N is within 2 ulp (2^-6 at most, the ulp being <= 2^-7 there) of x 10^p.  Only the distance
  * of N's fraction to one half decides the rounding: when it is within the error bound, and for
- * everything outside 1e-38..1e70, subnormals, zero's sign cases and non-finite values, the text
+ * everything outside 1e-38..1e70, subnormals and non-finite values, the text
  * is glibc's own (snprintf).  The bytes are therefore those of "%.17g" (numtext_units checks
  * millions of values against snprintf).  Without a 64-bit long double every value takes the
  * snprintf path.
@@ -168,6 +168,18 @@ static int numtext_printf(char *buf, double x, int json)
 
 int codec_numtext(char *buf, double x, int json)
 {
+    if (x == 0) { /* "0" or "-0" ("0.0", "-0.0" in JSON): a tenth of a mode shape's values */
+        int n = 0;
+        if (signbit(x))
+            buf[n++] = '-';
+        buf[n++] = '0';
+        if (json) {
+            buf[n++] = '.';
+            buf[n++] = '0';
+        }
+        buf[n] = '\0';
+        return n;
+    }
 #if LDBL_MANT_DIG == 64
     char dig[17];
     int X;
