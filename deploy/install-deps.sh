@@ -16,6 +16,7 @@ required=(
   build-essential pkg-config meson ninja-build
   libjansson-dev libssl-dev                # codec, request SHA-256
   liblapacke-dev libopenblas-dev           # LAPACK(E) + BLAS for core/
+  libgfortran-12-dev                       # the CLI links OpenBLAS's archive, which needs -lgfortran
   libmicrohttpd-dev libsqlite3-dev         # daemon (spinmodald)
   libpq-dev                                # daemon: the store's PostgreSQL backend (DESIGN.md §6)
   postgresql                               # tests: server binaries for the throwaway cluster (15 on Debian 12)

@@ -15,7 +15,13 @@ cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 new=${1:?usage: bench_small.sh NEW [OTHER] [N]}
 other=${2:-}
 n=${3:-40}
-export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
+# SMALL_USER_ENV=1: without OPENBLAS_NUM_THREADS and OMP_NUM_THREADS, as a user runs the CLI
+# (a shared OpenBLAS then starts a thread per core before main).
+if [ "${SMALL_USER_ENV:-0}" = 1 ]; then
+  unset OPENBLAS_NUM_THREADS OMP_NUM_THREADS GOTO_NUM_THREADS
+else
+  export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
+fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 bmi=tests/reference/blades/bmodes_certtest/Test01_nonunif_blade.bmi
