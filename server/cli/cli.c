@@ -32,7 +32,7 @@ extern void openblas_set_num_threads(int n) __attribute__((weak));
 
 /*
  * OpenBLAS starts its thread pool (a thread per core) in its own constructor, before main, unless
- * the environment names a count: 5 ms of a 10 ms small solve on 2 cores, more on 16 (issue 27).
+ * the environment names a count: 4-5 ms of a 15-19 ms small solve on 2 cores (issue 27).
  * With OpenBLAS linked from its archive (meson.build) this constructor runs first (a prioritised
  * one) and, when the user set none of the variables OpenBLAS reads, asks it for one thread;
  * cli_threads then sets the count it always set (1, or the cores for a large dense model:
