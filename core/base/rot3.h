@@ -13,6 +13,19 @@
 
 typedef double complex sp_cx;
 
+/* re + i im, exactly (both parts as given, a zero's sign included): C11's CMPLX, which glibc's
+ * complex.h leaves undefined under clang. */
+static inline sp_cx rot3_cx(double re, double im)
+{
+    union {
+        sp_cx z;
+        double d[2]; /* C11 6.2.5: a complex has the representation of double[2] */
+    } u;
+    u.d[0] = re;
+    u.d[1] = im;
+    return u.z;
+}
+
 /* ------------------------------------------------------------- rot3.c */
 /** L = Lambda(psi) = exp(skew psi) and T = its left tangent (d Lambda = skew(T d psi) Lambda);
  *  T may be NULL.  Analytic in psi (series near zero), so complex steps go through. */

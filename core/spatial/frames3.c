@@ -182,8 +182,8 @@ void sp_point_state(const sm_model *m, sp_kin *k, int pi, const sp_cx *q, int wa
         const double *Nj = p->N + (size_t)p->ldn * (k->pert_j - m->subs[p->sub].q0);
         double h = cimag(q[k->pert_j]);
         for (int i = 0; i < 3; i++) { /* + 0.0: a product -0 summed onto +0 is +0 */
-            w[i] = CMPLX(creal(k->lw[3 * pi + i]), Nj[i] * h + 0.0);
-            psi[i] = CMPLX(creal(k->lpsi[3 * pi + i]), Nj[3 + i] * h + 0.0);
+            w[i] = rot3_cx(creal(k->lw[3 * pi + i]), Nj[i] * h + 0.0);
+            psi[i] = rot3_cx(creal(k->lpsi[3 * pi + i]), Nj[3 + i] * h + 0.0);
         }
     } else {
         sp_local(m, p, q, w, psi);
