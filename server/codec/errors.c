@@ -31,22 +31,27 @@ struct codec_errors {
     int nomem;          /* an append failed for lack of memory */
 };
 
-/* malloc'd printf; NULL when out of memory. */
+/* malloc'd printf; NULL when out of memory.  Formatted once into a stack buffer when it fits
+ * (validation formats texts for every member and station of a request: issue 27). */
 char *err_vfmt(const char *fmt, va_list ap)
 {
+    char buf[256];
     va_list aq;
     int n;
     char *s;
 
     va_copy(aq, ap);
-    n = vsnprintf(NULL, 0, fmt, aq);
+    n = vsnprintf(buf, sizeof buf, fmt, aq);
     va_end(aq);
     if (n < 0)
         return NULL;
     s = malloc((size_t)n + 1);
     if (!s)
         return NULL;
-    vsnprintf(s, (size_t)n + 1, fmt, ap);
+    if ((size_t)n < sizeof buf)
+        memcpy(s, buf, (size_t)n + 1);
+    else
+        vsnprintf(s, (size_t)n + 1, fmt, ap);
     return s;
 }
 
@@ -235,8 +240,24 @@ char *err_ptr_key(const char *base, const char *key)
     return s;
 }
 
-/* base + "/" + index; NULL = NOMEM. */
+/* base + "/" + index (decimal); NULL = NOMEM.  Written here, not by printf: validation makes one
+ * for every element of every array it checks. */
 char *err_ptr_idx(const char *base, size_t i)
 {
-    return err_fmt("%s/%zu", base, i);
+    char digits[24];
+    int nd = 0;
+    do {
+        digits[nd++] = (char)('0' + i % 10);
+        i /= 10;
+    } while (i);
+    size_t nb = strlen(base);
+    char *s = malloc(nb + 1 + (size_t)nd + 1);
+    if (!s)
+        return NULL;
+    memcpy(s, base, nb);
+    s[nb] = '/';
+    for (int k = 0; k < nd; k++)
+        s[nb + 1 + k] = digits[nd - 1 - k];
+    s[nb + 1 + nd] = '\0';
+    return s;
 }
