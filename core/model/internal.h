@@ -346,6 +346,9 @@ typedef struct tree_ws {
                            spatial: 3 per s, a = R_s - R_parent (T_s = [I -skew(a); 0 I]) */
     double *D;          /* spatial: 6 x m_parent per s (ld 6), the link D_s = [A N^u_e; A T N^psi_e] */
     size_t *d_off;      /* spatial: S+1 offsets of D_s */
+    double *Cc;         /* d x (m_parent + d) per s (ld d): the coupling C_s = [-D_s, -T_s] to the
+                           parent's front, built by tree_factor, read by tree_solve */
+    size_t *c_off;      /* S+1 offsets of C_s in Cc */
     double *z;          /* sum (m_s+2d): solve vector */
     double *u, *v;      /* d S each: forward / adjoint recursion vectors */
     double *work;       /* small scratch */

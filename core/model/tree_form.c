@@ -56,6 +56,8 @@ void tree_free(tree_ws *t)
     free(t->lk);
     free(t->D);
     free(t->d_off);
+    free(t->Cc);
+    free(t->c_off);
     free(t->z);
     free(t->u);
     free(t->v);
@@ -76,7 +78,8 @@ int tree_alloc(const sm_model *m, tree_ws *t)
     t->fr_off = calloc((size_t)S + 1, sizeof(size_t));
     t->v_off = calloc((size_t)S + 1, sizeof(size_t));
     t->d_off = calloc((size_t)S + 1, sizeof(size_t));
-    if (!t->mp_ptr || !t->mp_idx || !t->loc_off || !t->fr_off || !t->v_off || !t->d_off)
+    t->c_off = calloc((size_t)S + 1, sizeof(size_t));
+    if (!t->mp_ptr || !t->mp_idx || !t->loc_off || !t->fr_off || !t->v_off || !t->d_off || !t->c_off)
         goto fail;
     for (int s = 0; s < S; s++) {
         size_t l = (size_t)d + m->subs[s].m, nb = 2 * (size_t)d + m->subs[s].m;
@@ -86,6 +89,7 @@ int tree_alloc(const sm_model *m, tree_ws *t)
         t->fr_off[s + 1] = t->fr_off[s] + nb * nb;
         t->v_off[s + 1] = t->v_off[s] + nb;
         t->d_off[s + 1] = t->d_off[s] + (d == 6 && p >= 0 ? 6 * (size_t)m->subs[p].m : 0);
+        t->c_off[s + 1] = t->c_off[s] + (p >= 0 ? (size_t)d * ((size_t)m->subs[p].m + d) : 0);
     }
     /* mass points of each substructure (CSR, in the order of m->mp) */
     for (int p = 0; p < m->n_mp; p++)
@@ -110,11 +114,12 @@ int tree_alloc(const sm_model *m, tree_ws *t)
     t->ipiv = calloc(V ? V : 1, sizeof(int));
     t->lk = dm_vec(4 * (size_t)S);
     t->D = dm_vec(t->d_off[S] + 1);
+    t->Cc = dm_vec(t->c_off[S] + 1);
     t->z = dm_vec(V);
     t->u = dm_vec((size_t)d * S);
     t->v = dm_vec((size_t)d * S);
     t->work = dm_vec(4 * (size_t)mx + 2 * (size_t)(mx + 2 * d) * (mx + 2 * d) + 64);
-    if (!t->Kl || !t->Ml || !t->Cl || !t->F || !t->X || !t->ipiv || !t->lk || !t->D || !t->z ||
+    if (!t->Kl || !t->Ml || !t->Cl || !t->F || !t->X || !t->ipiv || !t->lk || !t->D || !t->Cc || !t->z ||
         !t->u || !t->v || !t->work)
         goto fail;
     return SM_OK;

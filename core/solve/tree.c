@@ -88,13 +88,13 @@ static void tree_front_init(const sm_model *m, tree_ws *t, int s)
     }
 }
 
-/* Spatial C_s = [-D_s, -T_s, 0] (6 x nb_p, ld 6). */
+/* Spatial C_s = [-D_s, -T_s] (6 x (m_p + 6), ld 6; the zero block of w_p is not stored). */
 static void tree_coupling6(const sm_model *m, const tree_ws *t, int s, double *C)
 {
     const sm_sub *b = &m->subs[s], *p = &m->subs[b->parent];
     const double *a = t->lk + 3 * s, *D = t->D + t->d_off[s];
     int mp = p->m;
-    memset(C, 0, 6 * (size_t)(mp + 12) * sizeof(double));
+    memset(C, 0, 6 * (size_t)(mp + 6) * sizeof(double));
     for (size_t i = 0; i < 6 * (size_t)mp; i++)
         C[i] = -D[i];
     double *Ct = C + 6 * (size_t)mp; /* -T = -[I -skew(a); 0 I] */
@@ -105,7 +105,8 @@ static void tree_coupling6(const sm_model *m, const tree_ws *t, int s, double *C
     Ct[6 * 5 + 0] = a[1], Ct[6 * 5 + 1] = -a[0];
 }
 
-/* C_s = [-D_s, -T_s, 0] (d x nb_p, column-major ld d) coupling child s to its parent's front. */
+/* C_s = [-D_s, -T_s] (d x (m_p + d), column-major ld d) coupling child s to its parent's front
+ * (its zero block on the parent's w_p is not stored: nothing reads it). */
 static void tree_coupling(const sm_model *m, const tree_ws *t, int s, double *C)
 {
     if (t->d == 6) {
@@ -115,7 +116,7 @@ static void tree_coupling(const sm_model *m, const tree_ws *t, int s, double *C)
     const sm_sub *b = &m->subs[s], *p = &m->subs[b->parent];
     const double *lk = t->lk + 4 * s;
     int a = b->attach_local, mp = p->m;
-    memset(C, 0, 3 * (size_t)(mp + 6) * sizeof(double));
+    memset(C, 0, 3 * (size_t)(mp + 3) * sizeof(double));
     for (int j = 0; j < mp; j++) {
         double n0 = DM(&p->N, 3 * a, j), n1 = DM(&p->N, 3 * a + 1, j);
         C[3 * j] = -(lk[0] * n0 - lk[1] * n1);
@@ -128,11 +129,77 @@ static void tree_coupling(const sm_model *m, const tree_ws *t, int s, double *C)
             C[3 * (mp + j) + i] = -T[3 * j + i];
 }
 
+/*
+ * x = A^-1 b in place for the Bunch-Kaufman factors of dsytrf ('L', 1-based ipiv), one column:
+ * LAPACK's dsytrs step for step, written out.  Fronts are 18 x 18 for a spatial frame of 6
+ * modes, where dsytrs's 17 dger and 17 dgemv calls cost 13 400 instructions a solve, mostly
+ * per-call overhead: 32 % of a 288-coordinate spatial sweep (issue 27).  The sums run in another
+ * order than OpenBLAS's kernels, so the last bits differ: planar fronts keep dsytrs (their
+ * results are fixed to the byte), spatial fronts take this one (tree_front_solve).
+ */
+static void tree_sytrs_l(int n, const double *A, const int *ip, double *b)
+{
+    for (int k = 0; k < n;) { /* L D y = P b, leading column first */
+        const double *ak = A + (size_t)k * n;
+        if (ip[k] > 0) {
+            int kp = ip[k] - 1;
+            double t = b[k];
+            b[k] = b[kp], b[kp] = t;
+            double bk = b[k];
+            for (int i = k + 1; i < n; i++)
+                b[i] -= ak[i] * bk;
+            b[k] = bk * (1.0 / ak[k]);
+            k++;
+        } else {
+            const double *ak1 = ak + n;
+            int kp = -ip[k] - 1;
+            double t = b[k + 1];
+            b[k + 1] = b[kp], b[kp] = t;
+            double b0 = b[k], b1 = b[k + 1];
+            for (int i = k + 2; i < n; i++)
+                b[i] = (b[i] - ak[i] * b0) - ak1[i] * b1;
+            double akm1k = ak[k + 1], akm1 = ak[k] / akm1k, akk = ak1[k + 1] / akm1k, den = akm1 * akk - 1.0;
+            double bkm1 = b0 / akm1k, bkk = b1 / akm1k;
+            b[k] = (akk * bkm1 - bkk) / den;
+            b[k + 1] = (akm1 * bkk - bkm1) / den;
+            k += 2;
+        }
+    }
+    for (int k = n - 1; k >= 0;) { /* L' x = y, then P' x, trailing column first */
+        const double *ak = A + (size_t)k * n;
+        double acc = 0;
+        for (int i = k + 1; i < n; i++)
+            acc += ak[i] * b[i];
+        b[k] -= acc;
+        if (ip[k] > 0) {
+            int kp = ip[k] - 1;
+            double t = b[k];
+            b[k] = b[kp], b[kp] = t;
+            k--;
+        } else {
+            const double *ak1 = ak - n;
+            double acc1 = 0;
+            for (int i = k + 1; i < n; i++)
+                acc1 += ak1[i] * b[i];
+            b[k - 1] -= acc1;
+            int kp = -ip[k] - 1;
+            double t = b[k];
+            b[k] = b[kp], b[kp] = t;
+            k -= 2;
+        }
+    }
+}
+
 /* Solve front s in place for nrhs columns (ld nb). */
 static int tree_front_solve(const tree_ws *t, int s, int nb, int nrhs, double *B)
 {
     const double *F = t->F + t->fr_off[s];
     const int *ip = t->ipiv + t->v_off[s];
+    if (t->sym && t->d == 6) {
+        for (int j = 0; j < nrhs; j++)
+            tree_sytrs_l(nb, F, ip, B + (size_t)j * nb);
+        return SM_OK;
+    }
     int info = t->sym ? LAPACKE_dsytrs_work(LAPACK_COL_MAJOR, 'L', nb, nrhs, F, nb, ip, B, nb)
                       : LAPACKE_dgetrs_work(LAPACK_COL_MAJOR, 'N', nb, nrhs, F, nb, ip, B, nb);
     return dm_lapack_status(info, SM_LAPACK_FAILED);
@@ -141,7 +208,7 @@ static int tree_front_solve(const tree_ws *t, int s, int nb, int nrhs, double *B
 int tree_factor(const sm_model *m, tree_ws *t, int sym)
 {
     int S = m->n_subs, d = t->d, neg = 0, sign = (d * S) % 2 ? -1 : 1, rc;
-    double *C = t->work, *W = C + (size_t)d * (t->max_m + 2 * d);
+    double *W = t->work;
     t->sym = sym;
     t->neg = 0;
     for (int s = 0; s < S; s++)
@@ -181,7 +248,7 @@ int tree_factor(const sm_model *m, tree_ws *t, int sym)
             continue;
         /* F_p -= C' Z C,  Z = (F_s^-1)_ww = rows w of X */
         int mp = m->subs[b->parent].m, nbp = mp + 2 * d, nc = mp + d;
-        double *Fp = t->F + t->fr_off[b->parent];
+        double *Fp = t->F + t->fr_off[b->parent], *C = t->Cc + t->c_off[s];
         tree_coupling(m, t, s, C);
         for (int j = 0; j < nc; j++) /* W = Z C (d x nc) */
             for (int i = 0; i < d; i++) {
@@ -206,7 +273,6 @@ int tree_factor(const sm_model *m, tree_ws *t, int sym)
 int tree_solve(const sm_model *m, tree_ws *t, double *x)
 {
     int S = m->n_subs, d = t->d, rc;
-    double *C = t->work;
     for (int s = 0; s < S; s++) { /* right-hand sides [b_s; 0; 0] */
         double *zs = t->z + t->v_off[s];
         int mm = m->subs[s].m;
@@ -223,7 +289,7 @@ int tree_solve(const sm_model *m, tree_ws *t, double *x)
             continue;
         int nc = m->subs[b->parent].m + d;
         double *zp = t->z + t->v_off[b->parent], *yw = zs + mm + d;
-        tree_coupling(m, t, s, C);
+        const double *C = t->Cc + t->c_off[s];
         for (int j = 0; j < nc; j++) {
             double acc = C[d * j] * yw[0];
             for (int r = 1; r < d; r++)
@@ -238,8 +304,8 @@ int tree_solve(const sm_model *m, tree_ws *t, double *x)
         if (b->parent >= 0) {
             int nc = m->subs[b->parent].m + d;
             const double *zp = t->z + t->v_off[b->parent], *X = t->X + (size_t)d * t->v_off[s];
+            const double *C = t->Cc + t->c_off[s];
             double cz[6] = {0, 0, 0, 0, 0, 0};
-            tree_coupling(m, t, s, C);
             for (int j = 0; j < nc; j++)
                 for (int i = 0; i < d; i++)
                     cz[i] += C[d * j + i] * zp[j];
