@@ -41,8 +41,15 @@
 #define EIG_TREE_MAX_BASIS 240
 #define EIG_TREE_STEP 8
 
-/* w (2n) = A v for A = [-K^-1 C, -K^-1 M; I, 0] (tree.c header); tmp: 2n scratch. */
-static int eig_tree_op(const sm_model *m, tree_ws *t, int coriolis, const double *v, double *w, double *tmp)
+/* A spatial model's solves stop being refined once a refinement has corrected the solution by
+ * less than this (relative): 2e-15 typically, at most 9e-14 up to 800 elements (4800
+ * coordinates), where a step costs one more solve and K product: 12 % of a sweep (issue 27). */
+#define EIG_TREE_REFINE_SKIP 1e-13
+
+/* w (2n) = A v for A = [-K^-1 C, -K^-1 M; I, 0] (tree.c header); tmp: 2n scratch.  *refine: 1
+ * while the solves are refined (cleared here for a spatial model, see EIG_TREE_REFINE_SKIP). */
+static int eig_tree_op(const sm_model *m, tree_ws *t, int coriolis, const double *v, double *w, double *tmp,
+                       int *refine)
 {
     int n = m->n;
     tree_apply(m, t, TREE_M, v + n, w); /* w = M y */
@@ -60,13 +67,15 @@ static int eig_tree_op(const sm_model *m, tree_ws *t, int coriolis, const double
     double *b = tmp + n;
     memcpy(b, w, (size_t)n * sizeof(double));
     int rc = tree_solve(m, t, w);
-    if (rc < 0)
+    if (rc < 0 || !*refine)
         return rc;
     tree_apply(m, t, TREE_K, w, tmp);
     for (int i = 0; i < n; i++)
         tmp[i] = b[i] - tmp[i];
     if ((rc = tree_solve(m, t, tmp)) < 0)
         return rc;
+    if (t->d == 6 && dm_norm(tmp, n) <= EIG_TREE_REFINE_SKIP * dm_norm(w, n))
+        *refine = 0; /* planar models keep every refinement: their bytes are fixed (issue 27) */
     for (int i = 0; i < n; i++)
         w[i] += tmp[i];
     return SM_OK;
@@ -80,6 +89,24 @@ static double eig_cgs2(int len, int nq, const double *Q, double *w, double *h)
         cblas_dgemv(CblasColMajor, CblasNoTrans, len, nq, -1.0, Q, len, h, 1, 1.0, w, 1);
     }
     return dm_norm(w, len);
+}
+
+/* Relative residual of mode lambda = lr + i li from the products of its vector x with M, C, K
+ * (s: Mr, Mi, Cr, Ci, Kr, Ki, n each; C zero without Coriolis). */
+static double eig_residual_terms(int n, double lr, double li, const double *s)
+{
+    const double *Mr = s, *Mi = s + n, *Cr = s + 2 * n, *Ci = s + 3 * n, *Kr = s + 4 * n, *Ki = s + 5 * n;
+    double l2r = lr * lr - li * li, l2i = 2 * lr * li, rr = 0, nm = 0, nc = 0, nk = 0;
+    for (int i = 0; i < n; i++) {
+        double re = l2r * Mr[i] - l2i * Mi[i] + lr * Cr[i] - li * Ci[i] + Kr[i];
+        double im = l2r * Mi[i] + l2i * Mr[i] + lr * Ci[i] + li * Cr[i] + Ki[i];
+        rr += re * re + im * im;
+        nm += Mr[i] * Mr[i] + Mi[i] * Mi[i];
+        nc += Cr[i] * Cr[i] + Ci[i] * Ci[i];
+        nk += Kr[i] * Kr[i] + Ki[i] * Ki[i];
+    }
+    double al = hypot(lr, li), den = al * al * sqrt(nm) + al * sqrt(nc) + sqrt(nk);
+    return den > 0 ? sqrt(rr) / den : INFINITY;
 }
 
 /* Relative residual of mode (lambda, x = xr + i xi) of the quadratic problem; s: 6n scratch. */
@@ -98,17 +125,25 @@ static double eig_tree_residual(const sm_model *m, tree_ws *t, int coriolis, dou
     } else {
         memset(Cr, 0, 2 * (size_t)n * sizeof(double));
     }
-    double l2r = lr * lr - li * li, l2i = 2 * lr * li, rr = 0, nm = 0, nc = 0, nk = 0;
-    for (int i = 0; i < n; i++) {
-        double re = l2r * Mr[i] - l2i * Mi[i] + lr * Cr[i] - li * Ci[i] + Kr[i];
-        double im = l2r * Mi[i] + l2i * Mr[i] + lr * Ci[i] + li * Cr[i] + Ki[i];
-        rr += re * re + im * im;
-        nm += Mr[i] * Mr[i] + Mi[i] * Mi[i];
-        nc += Cr[i] * Cr[i] + Ci[i] * Ci[i];
-        nk += Kr[i] * Kr[i] + Ki[i] * Ki[i];
+    return eig_residual_terms(n, lr, li, s);
+}
+
+/* The same for x = V (ar + i ai) from the basis products MV, CV, KV (n x nv): six products of
+ * n x nv instead of six operator applications (spatial models, issue 27). */
+static double eig_basis_residual(int n, int nv, int coriolis, const double *MV, const double *CV,
+                                 const double *KV, double lr, double li, const double *ar, const double *ai,
+                                 double *s)
+{
+    const double *P[3] = {MV, CV, KV};
+    for (int k = 0; k < 3; k++) {
+        if (k == 1 && !coriolis) {
+            memset(s + 2 * (size_t)n, 0, 2 * (size_t)n * sizeof(double));
+            continue;
+        }
+        cblas_dgemv(CblasColMajor, CblasNoTrans, n, nv, 1.0, P[k], n, ar, 1, 0.0, s + 2 * (size_t)k * n, 1);
+        cblas_dgemv(CblasColMajor, CblasNoTrans, n, nv, 1.0, P[k], n, ai, 1, 0.0, s + (2 * (size_t)k + 1) * n, 1);
     }
-    double al = hypot(lr, li), den = al * al * sqrt(nm) + al * sqrt(nc) + sqrt(nk);
-    return den > 0 ? sqrt(rr) / den : INFINITY;
+    return eig_residual_terms(n, lr, li, s);
 }
 
 /*
@@ -206,7 +241,7 @@ static int eig_tree_project(const sm_model *m, tree_ws *t, int coriolis, int mod
         }
     for (int i = 0; i < nv; i++)
         DM(&Cp, i, i) = 0;
-    if (coriolis) {
+    if (coriolis && t->d != 6) {
         rc = eig_alloc_out(&e, nv, modes);
         if (rc == SM_OK)
             rc = eig_gyro_inverse(nv, &Mp, &Cp, &Kp, modes, e.wim, e.xre, e.xim);
@@ -233,8 +268,11 @@ static int eig_tree_project(const sm_model *m, tree_ws *t, int coriolis, int mod
     for (int j = 0; j < modes; j++) {
         out->wre[j] = e.wre[j];
         out->wim[j] = e.wim[j];
-        worst = fmax(worst, eig_tree_residual(m, t, coriolis, e.wre[j], e.wim[j], out->xre + (size_t)j * n,
-                                              out->xim + (size_t)j * n, scratch));
+        double r = t->d == 6 ? eig_basis_residual(n, nv, coriolis, MV, CV, KV, e.wre[j], e.wim[j],
+                                                   e.xre + (size_t)j * nv, e.xim + (size_t)j * nv, scratch)
+                             : eig_tree_residual(m, t, coriolis, e.wre[j], e.wim[j], out->xre + (size_t)j * n,
+                                                 out->xim + (size_t)j * n, scratch);
+        worst = fmax(worst, r);
     }
     *res = worst;
     rc = SM_OK;
@@ -278,7 +316,7 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const
     double nrm = dm_norm(Q, N2);
     for (int i = 0; i < N2; i++)
         Q[i] /= nrm;
-    int p = 0, next = 2 * modes + 10 > 16 ? 2 * modes + 10 : 16, breakdown = 0;
+    int p = 0, next = 2 * modes + 10 > 16 ? 2 * modes + 10 : 16, breakdown = 0, refine = 1;
     for (;;) {
         /* a stop every EIG_TREE_STEP vectors: one operator application is two block solves of K*,
          * so building the first 2 modes + 10 vectors of a 2000-element blade takes seconds */
@@ -287,7 +325,7 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const
             goto done;
         }
         double *w = Q + (size_t)(p + 1) * N2;
-        if ((rc = eig_tree_op(m, t, coriolis, Q + (size_t)p * N2, w, tmp)) < 0)
+        if ((rc = eig_tree_op(m, t, coriolis, Q + (size_t)p * N2, w, tmp, &refine)) < 0)
             goto done;
         double w0 = dm_norm(w, N2), wn = eig_cgs2(N2, p + 1, Q, w, h);
         if (!(wn > 1e-12 * w0)) {
