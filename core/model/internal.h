@@ -311,17 +311,27 @@ typedef struct sm_progress {
     int done, total;    /* speeds finished / requested */
 } sm_progress;
 
+/* The workspace of a sequence of continuations (a sweep's speeds, equilibrium.c), kept from one
+ * eq_solve to the next: allocated once, and for a kind with carry_tangent the factors of the
+ * last Newton tangent, which predict the next speed's first step. */
+typedef struct eq_carry eq_carry;
+
+/** A carry for continuations of m: SM_OK or SM_NOMEM (*out NULL). */
+int eq_carry_new(const sm_model *m, eq_carry **out);
+void eq_carry_free(eq_carry *c);
+
 /**
  * Continuation in s = Omega^2 from the equilibrium q at s_from (q = 0 with
  * from_rest: at least min_increments steps) to s_to, Newton-Raphson at each
  * step (DESIGN.md 1.3).  q (n, in/out): the equilibrium at s_to when
- * out->converged, else the last converged state (at out->last_s).  pr may be
- * NULL.  Returns SM_OK whether or not it converged or was canceled (see
- * *out), SM_NOMEM, or SM_LAPACK_FAILED when a factorisation or solve reports
- * an error (out->message says where).  Allocates only its own workspace.
+ * out->converged, else the last converged state (at out->last_s).  carry:
+ * NULL, or the workspace of the continuation that ended at (q, s_from).  pr
+ * may be NULL.  Returns SM_OK whether or not it converged or was canceled
+ * (see *out), SM_NOMEM, or SM_LAPACK_FAILED when a factorisation or solve
+ * reports an error (out->message says where).
  */
 int eq_solve(const sm_model *m, double *q, double s_from, double s_to,
-             int from_rest, sm_progress *pr, sm_eq_out *out);
+             int from_rest, eq_carry *carry, sm_progress *pr, sm_eq_out *out);
 
 /* --------------------------------------------------------------- tree.c */
 /* The linearised equations in block form along the frame tree (see the header of tree.c):

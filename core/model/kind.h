@@ -41,6 +41,9 @@ typedef struct smi_kind {
     int ubar_dim;        /* undeformed local coordinates per free node: 2 | 3 */
     int stiffened_start; /* 1: the continuation from rest starts with a small increment and a
                             stiffened predictor (equilibrium.c, DESIGN.md 7.3) */
+    int carry_tangent;   /* 1: a sweep's next speed predicts with the last Newton tangent of the
+                            speed before instead of a fresh one at its equilibrium (eq_carry;
+                            the planar kind keeps its Newton path, and its bytes: issue 27) */
 
     /* ---- model build (mesh.c, modes.c, model.c) ---- */
     /** Length of a member from its joints' differences (the kind's own rounding). */

@@ -277,6 +277,7 @@ const smi_kind smi_kind_planar = {
     .pose_dof = 3,
     .ubar_dim = 2,
     .stiffened_start = 0,
+    .carry_tangent = 0,
     .length = planar_length,
     .check = planar_check,
     .elements = NULL,

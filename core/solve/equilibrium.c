@@ -46,6 +46,13 @@ typedef struct eq_ws {
     double residual;
 } eq_ws;
 
+struct eq_carry {
+    eq_ws w;
+    int valid; /* w->L holds the factors of a Newton tangent at s (carry_tangent kinds) */
+    int sign;  /* the continuation's sign of det Kt there */
+    double s;
+};
+
 static void eq_ws_free(eq_ws *w)
 {
     smi_lin_free(w->L);
@@ -200,82 +207,92 @@ static int eq_restart(const sm_model *m, const double *q, double s, eq_ws *w, in
  * Returns SM_OK (whether or not it converged: see out), SM_NOMEM or
  * SM_LAPACK_FAILED (a LAPACK error, not a property of the structure).
  */
-int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_rest,
+int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_rest, eq_carry *carry,
              sm_progress *pr, sm_eq_out *out)
 {
-    eq_ws w;
-    int n = m->n, rc = eq_ws_alloc(m, &w), incr = 0, have_lu = 0;
+    eq_ws own, *w = carry ? &carry->w : &own;
+    int n = m->n, rc = carry ? SM_OK : eq_ws_alloc(m, &own), incr = 0, have_lu = 0;
     memset(out, 0, sizeof *out);
     out->last_s = s_from;
     if (rc < 0)
         return rc;
+    w->iterations = 0;
+    w->residual = 0;
     double range = s_to - s_from;
     double hmax = from_rest ? range / (m->opt.min_increments > 0 ? m->opt.min_increments : 1) : range;
     double h = hmax, hmin = 1e-7 * fmax(s_to, 1e-12), s = s_from;
     if (m->kind->stiffened_start && from_rest)
         h = hmax / EQ_STIFFENED_FIRST;
     const char *why = "";
-    /* tangent at the start for the first predictor */
-    if ((rc = eq_restart(m, q, s, &w, &have_lu)) < 0)
-        goto fail;
-    int sign = have_lu ? smi_lin_det_sign(m, w.L) : 1;
+    /* tangent at the start for the first predictor: at (q, s_from), or the one carried over */
+    int sign = 1;
+    if (carry && carry->valid && !from_rest && m->kind->carry_tangent && carry->s == s_from) {
+        have_lu = 1;
+        sign = carry->sign;
+    } else {
+        if ((rc = eq_restart(m, q, s, w, &have_lu)) < 0)
+            goto fail;
+        sign = have_lu ? smi_lin_det_sign(m, w->L) : 1;
+    }
+    if (carry)
+        carry->valid = 0;
     while (s < s_to) {
-        if (incr++ >= EQ_MAX_INCREMENTS || w.iterations >= EQ_MAX_TOTAL_ITER) {
+        if (incr++ >= EQ_MAX_INCREMENTS || w->iterations >= EQ_MAX_TOTAL_ITER) {
             why = "too many continuation steps";
             break;
         }
         double sn = s + h >= s_to - 1e-12 * s_to ? s_to : s + h;
         /* predictor: Kt dq = g ds */
-        memcpy(w.q0, q, (size_t)n * sizeof(double));
-        smi_lin_centrifugal(m, q, w.L, w.g);
-        memcpy(w.qp, q, (size_t)n * sizeof(double));
+        memcpy(w->q0, q, (size_t)n * sizeof(double));
+        smi_lin_centrifugal(m, q, w->L, w->g);
+        memcpy(w->qp, q, (size_t)n * sizeof(double));
         if (have_lu) {
-            memcpy(w.dq, w.g, (size_t)n * sizeof(double));
-            if ((rc = smi_lin_solve(m, w.L, w.dq)) < 0)
+            memcpy(w->dq, w->g, (size_t)n * sizeof(double));
+            if ((rc = smi_lin_solve(m, w->L, w->dq)) < 0)
                 goto fail;
             for (int i = 0; i < n; i++)
-                w.qp[i] += (sn - s) * w.dq[i];
+                w->qp[i] += (sn - s) * w->dq[i];
             if (m->kind->stiffened_start && from_rest && s == 0.0) { /* the stiffened predictor */
-                int r2 = smi_lin_tangent(m, w.qp, sn, w.L);
+                int r2 = smi_lin_tangent(m, w->qp, sn, w->L);
                 if (r2 < 0 && r2 != SM_SINGULAR) {
                     rc = r2;
                     goto fail;
                 }
                 if (r2 == SM_OK) {
-                    memcpy(w.dq, w.g, (size_t)n * sizeof(double));
-                    if ((rc = smi_lin_solve(m, w.L, w.dq)) < 0)
+                    memcpy(w->dq, w->g, (size_t)n * sizeof(double));
+                    if ((rc = smi_lin_solve(m, w->L, w->dq)) < 0)
                         goto fail;
                     for (int i = 0; i < n; i++)
-                        w.qp[i] = q[i] + (sn - s) * w.dq[i];
+                        w->qp[i] = q[i] + (sn - s) * w->dq[i];
                 }
             }
         }
-        memcpy(q, w.qp, (size_t)n * sizeof(double));
-        int it0 = w.iterations;
-        int ok = eq_newton(m, q, sn, &w, pr);
+        memcpy(q, w->qp, (size_t)n * sizeof(double));
+        int it0 = w->iterations;
+        int ok = eq_newton(m, q, sn, w, pr);
         if (ok == SM_CANCELED) {
-            memcpy(q, w.q0, (size_t)n * sizeof(double));
+            memcpy(q, w->q0, (size_t)n * sizeof(double));
             out->canceled = 1;
             break;
         }
         if (ok < 0) {
             rc = ok;
-            memcpy(q, w.q0, (size_t)n * sizeof(double));
+            memcpy(q, w->q0, (size_t)n * sizeof(double));
             goto fail;
         }
         if (ok) {
             /* branch check: the corrector must stay within the predicted step */
             double step = 0, corr = 0;
             for (int i = 0; i < n; i++) {
-                step += (w.qp[i] - w.q0[i]) * (w.qp[i] - w.q0[i]);
-                corr += (q[i] - w.qp[i]) * (q[i] - w.qp[i]);
+                step += (w->qp[i] - w->q0[i]) * (w->qp[i] - w->q0[i]);
+                corr += (q[i] - w->qp[i]) * (q[i] - w->qp[i]);
             }
             step = sqrt(step);
             corr = sqrt(corr);
             if (have_lu && corr > fmax(0.5 * step, 1e-6 * fmax(1.0, dm_norm(q, n)))) {
                 ok = 0;
                 why = "the solution jumped to another branch";
-            } else if (eq_max_strain(m, q, w.P) > EQ_MAX_STRAIN) {
+            } else if (eq_max_strain(m, q, w->P) > EQ_MAX_STRAIN) {
                 ok = 0;
                 /* With one frame per element the frames cannot be refined: the strain is the
                  * structure's own (the speed is beyond what its EA carries), not an artefact. */
@@ -284,7 +301,7 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
                             "structure's axial stiffness EA carries (frames are per element already)"
                           : "the deformation leaves the small-strain range (axial strain above 1 %): "
                             "the steady state runs away; use more frames";
-            } else if (smi_lin_det_sign(m, w.L) != sign) {
+            } else if (smi_lin_det_sign(m, w->L) != sign) {
                 /* A critical point lies inside the step.  Shrink the step until it is small;
                  * a converged corrector that stays on the predicted branch there has crossed
                  * a bifurcation of a branch that goes on (the symmetric steady state of a
@@ -308,30 +325,61 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
             s = sn;
             out->last_s = s;
             have_lu = 1; /* the LU of the last Newton tangent, at s */
-            if (w.iterations - it0 <= 4)
+            if (w->iterations - it0 <= 4)
                 h = fmin(2.0 * h, hmax);
         } else {
-            memcpy(q, w.q0, (size_t)n * sizeof(double));
-            if ((rc = eq_restart(m, q, s, &w, &have_lu)) < 0)
+            memcpy(q, w->q0, (size_t)n * sizeof(double));
+            if ((rc = eq_restart(m, q, s, w, &have_lu)) < 0)
                 goto fail;
             h *= 0.5;
             if (h < hmin)
                 break;
         }
     }
-    out->iterations = w.iterations;
+    out->iterations = w->iterations;
     out->converged = s >= s_to && !out->canceled;
-    out->residual = eq_residual(m, q, out->converged ? s_to : out->last_s, &w);
+    /* converged: the last Newton step's residual is ||F|| at this q and s_to, the same value */
+    out->residual = out->converged && incr > 0 ? w->residual
+                                               : eq_residual(m, q, out->converged ? s_to : out->last_s, w);
     if (!out->converged && !out->canceled)
         snprintf(out->message, sizeof out->message,
                  "no equilibrium beyond Omega = %.6g rad/s (target %.6g rad/s): %s",
                  sqrt(out->last_s), sqrt(s_to), why);
-    eq_ws_free(&w);
+    if (carry && out->converged && have_lu) { /* the LU of the last Newton tangent, at s_to */
+        carry->valid = 1;
+        carry->s = s_to;
+        carry->sign = sign;
+    }
+    if (!carry)
+        eq_ws_free(w);
     return SM_OK;
 fail:
-    out->iterations = w.iterations;
+    out->iterations = w->iterations;
     snprintf(out->message, sizeof out->message, "equilibrium at Omega = %.6g rad/s: %s", sqrt(s_to),
              sm_strerror(rc));
-    eq_ws_free(&w);
+    if (!carry)
+        eq_ws_free(w);
     return rc;
+}
+
+int eq_carry_new(const sm_model *m, eq_carry **out)
+{
+    eq_carry *c = calloc(1, sizeof *c);
+    *out = NULL;
+    if (!c)
+        return SM_NOMEM;
+    if (eq_ws_alloc(m, &c->w) < 0) {
+        free(c);
+        return SM_NOMEM;
+    }
+    *out = c;
+    return SM_OK;
+}
+
+void eq_carry_free(eq_carry *c)
+{
+    if (!c)
+        return;
+    eq_ws_free(&c->w);
+    free(c);
 }

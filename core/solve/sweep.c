@@ -137,13 +137,14 @@ int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress
     double *q = dm_vec((size_t)n);
     smi_lin *L = NULL;
     sweep_pool *pool = NULL;
+    eq_carry *carry = NULL;
     if (!r || !key || !q)
         goto fail;
     r->cases = calloc((size_t)n_omegas, sizeof(sm_case));
     if (!r->cases)
         goto fail;
     r->n_cases = n_omegas;
-    if ((rc = smi_lin_new(m, SMI_USE_MODES, tree_use(m), &L)) < 0)
+    if ((rc = smi_lin_new(m, SMI_USE_MODES, tree_use(m), &L)) < 0 || (rc = eq_carry_new(m, &carry)) < 0)
         goto fail;
     for (int i = 0; i < n_omegas; i++) {
         key[i].omega = omegas[i];
@@ -165,7 +166,7 @@ int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress
             memset(q, 0, (size_t)n * sizeof(double));
             s_prev = 0;
         }
-        rc = eq_solve(m, q, s_prev, s, from_rest, &pr, &eo);
+        rc = eq_solve(m, q, s_prev, s, from_rest, carry, &pr, &eo);
         if (rc < 0) {
             snprintf(d->message, sizeof d->message, "%s", eo.message);
             goto fail;
@@ -200,6 +201,7 @@ int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress
     if (pool && (rc = sweep_pool_finish(pool, L, &pr)) < 0)
         goto fail;
     sweep_pool_free(pool);
+    eq_carry_free(carry);
     smi_lin_free(L);
     free(key);
     free(q);
@@ -210,6 +212,7 @@ fail:
         sweep_pool_stop(pool);
         sweep_pool_free(pool); /* before the cases its workers write go */
     }
+    eq_carry_free(carry);
     smi_lin_free(L);
     free(key);
     free(q);
@@ -231,7 +234,7 @@ int sweep_lowest(const sm_model *m, double omega, sm_progress_fn cb, void *user,
     rc = SM_NOMEM;
     if (!q)
         goto done;
-    if ((rc = eq_solve(m, q, 0, smi_load(m, omega), 1, &pr, &eo)) < 0)
+    if ((rc = eq_solve(m, q, 0, smi_load(m, omega), 1, NULL, &pr, &eo)) < 0)
         goto done;
     rc = eo.canceled ? SM_CANCELED : SM_NO_EQUILIBRIUM;
     if (!eo.converged)

@@ -221,6 +221,7 @@ const smi_kind smi_kind_spatial = {
     .pose_dof = 6,
     .ubar_dim = 3,
     .stiffened_start = 1,
+    .carry_tangent = 1,
     .length = spatial_length,
     .check = mesh3_check,
     .elements = mesh3_elements,

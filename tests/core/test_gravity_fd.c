@@ -99,7 +99,7 @@ static void run(sm_mass_model mass, int per)
     sm_eq_out eo;
     if (!q0 || !x || !g || !fp || !fm || !f0 || !kin || !work || sp_kin_alloc(m, &kp, 0) ||
         m->kind->dense_alloc(m, SMI_USE_NEWTON, &D) != SM_OK ||
-        eq_solve(m, q0, 0.0, 1.0, 1, NULL, &eo) < 0 || !eo.converged) {
+        eq_solve(m, q0, 0.0, 1.0, 1, NULL, NULL, &eo) < 0 || !eo.converged) {
         printf("FAIL %s, %d el./frame: no steady state under gravity (%s)\n", tag, per, eo.message);
         fails++;
         goto done;

@@ -438,7 +438,7 @@ static void run_case(const spec *sp, sm_frame_scheme fr, int param, sm_mass_mode
 
     /* ---- the steady state */
     sm_eq_out eo;
-    int rc = eq_solve(m, q0, 0.0, s2, 1, NULL, &eo);
+    int rc = eq_solve(m, q0, 0.0, s2, 1, NULL, NULL, &eo);
     char line[512];
     snprintf(line, sizeof line, "equilibrium from rest converged (rc %d, %d iterations, |F| %.2e)%s%s", rc,
              eo.iterations, eo.residual, eo.converged ? "" : ": ", eo.message);
