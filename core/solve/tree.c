@@ -190,14 +190,77 @@ static void tree_sytrs_l(int n, const double *A, const int *ip, double *b)
     }
 }
 
+/*
+ * LU with partial pivoting of A (n x n, column-major) in place, LAPACK's dgetf2 written out
+ * (1-based ipiv, the first largest |pivot|): the Newton tangent's spatial fronts, where OpenBLAS's
+ * dgetrf and dgetrs cost ~30 000 instructions a front, mostly per-call overhead (issue 27; planar
+ * fronts keep LAPACK and their bytes).  SM_OK, or SM_SINGULAR at an exactly zero pivot.
+ */
+static int tree_getrf(int n, double *A, int *ip)
+{
+    for (int k = 0; k < n; k++) {
+        double *ak = A + (size_t)k * n, big = fabs(ak[k]);
+        int p = k;
+        for (int i = k + 1; i < n; i++)
+            if (fabs(ak[i]) > big)
+                big = fabs(ak[i]), p = i;
+        ip[k] = p + 1;
+        if (ak[p] == 0)
+            return SM_SINGULAR;
+        if (p != k)
+            for (int j = 0; j < n; j++) {
+                double t = A[(size_t)j * n + k];
+                A[(size_t)j * n + k] = A[(size_t)j * n + p], A[(size_t)j * n + p] = t;
+            }
+        double r = 1.0 / ak[k];
+        for (int i = k + 1; i < n; i++)
+            ak[i] *= r;
+        for (int j = k + 1; j < n; j++) {
+            double *aj = A + (size_t)j * n, a = aj[k];
+            if (a != 0)
+                for (int i = k + 1; i < n; i++)
+                    aj[i] -= ak[i] * a;
+        }
+    }
+    return SM_OK;
+}
+
+/* x = A^-1 b in place for the factors of tree_getrf, one column. */
+static void tree_getrs(int n, const double *A, const int *ip, double *b)
+{
+    for (int k = 0; k < n; k++) {
+        int p = ip[k] - 1;
+        double t = b[k];
+        b[k] = b[p], b[p] = t;
+    }
+    for (int k = 0; k < n; k++) { /* L y = P b, L unit lower */
+        const double *ak = A + (size_t)k * n;
+        double bk = b[k];
+        if (bk != 0)
+            for (int i = k + 1; i < n; i++)
+                b[i] -= ak[i] * bk;
+    }
+    for (int k = n - 1; k >= 0; k--) { /* U x = y */
+        const double *ak = A + (size_t)k * n;
+        double bk = b[k] / ak[k];
+        b[k] = bk;
+        if (bk != 0)
+            for (int i = 0; i < k; i++)
+                b[i] -= ak[i] * bk;
+    }
+}
+
 /* Solve front s in place for nrhs columns (ld nb). */
 static int tree_front_solve(const tree_ws *t, int s, int nb, int nrhs, double *B)
 {
     const double *F = t->F + t->fr_off[s];
     const int *ip = t->ipiv + t->v_off[s];
-    if (t->sym && t->d == 6) {
+    if (t->d == 6) {
         for (int j = 0; j < nrhs; j++)
-            tree_sytrs_l(nb, F, ip, B + (size_t)j * nb);
+            if (t->sym)
+                tree_sytrs_l(nb, F, ip, B + (size_t)j * nb);
+            else
+                tree_getrs(nb, F, ip, B + (size_t)j * nb);
         return SM_OK;
     }
     int info = t->sym ? LAPACKE_dsytrs_work(LAPACK_COL_MAJOR, 'L', nb, nrhs, F, nb, ip, B, nb)
@@ -228,7 +291,9 @@ int tree_factor(const sm_model *m, tree_ws *t, int sym)
                 return rc;
             neg += dm_sytrf_negative(nb, F, ip);
         } else {
-            if ((rc = dm_lapack_status(LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, nb, nb, F, nb, ip), SM_SINGULAR)) < 0)
+            rc = d == 6 ? tree_getrf(nb, F, ip)
+                        : dm_lapack_status(LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, nb, nb, F, nb, ip), SM_SINGULAR);
+            if (rc < 0)
                 return rc;
             for (int i = 0; i < nb; i++) {
                 if (F[(size_t)i * nb + i] < 0)
