@@ -62,6 +62,7 @@ VERSION_RE = re.compile(r"(?<![\w.])(\d+\.\d+\.\d+)(?![\w.]*\d)")
 # context, why)
 ALLOWED_OTHER_VERSIONS = [
     (r"version=0\.0\.4", "Prometheus text exposition format version"),
+    (r"\b(?:before|since) \d+\.\d+\.\d+", "the earlier release a behaviour changed in"),
 ]
 
 
