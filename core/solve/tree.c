@@ -335,6 +335,18 @@ int tree_factor(const sm_model *m, tree_ws *t, int sym)
     return SM_OK;
 }
 
+/* C_s for a solve.  Spatial: the one tree_factor built.  Planar: rebuilt from the current links,
+ * as before the cache: the planar kind's residual (tree_centrifugal) updates the links between a
+ * Newton tangent's factorisation and its chord solves, which therefore run with the links of the
+ * latest iterate; planar results are fixed to the byte (issue 27), so that stays. */
+static const double *tree_solve_coupling(const sm_model *m, tree_ws *t, int s)
+{
+    if (t->d == 6)
+        return t->Cc + t->c_off[s];
+    tree_coupling(m, t, s, t->work);
+    return t->work;
+}
+
 int tree_solve(const sm_model *m, tree_ws *t, double *x)
 {
     int S = m->n_subs, d = t->d, rc;
@@ -354,7 +366,7 @@ int tree_solve(const sm_model *m, tree_ws *t, double *x)
             continue;
         int nc = m->subs[b->parent].m + d;
         double *zp = t->z + t->v_off[b->parent], *yw = zs + mm + d;
-        const double *C = t->Cc + t->c_off[s];
+        const double *C = tree_solve_coupling(m, t, s);
         for (int j = 0; j < nc; j++) {
             double acc = C[d * j] * yw[0];
             for (int r = 1; r < d; r++)
@@ -369,7 +381,7 @@ int tree_solve(const sm_model *m, tree_ws *t, double *x)
         if (b->parent >= 0) {
             int nc = m->subs[b->parent].m + d;
             const double *zp = t->z + t->v_off[b->parent], *X = t->X + (size_t)d * t->v_off[s];
-            const double *C = t->Cc + t->c_off[s];
+            const double *C = tree_solve_coupling(m, t, s);
             double cz[6] = {0, 0, 0, 0, 0, 0};
             for (int j = 0; j < nc; j++)
                 for (int i = 0; i < d; i++)
@@ -391,7 +403,9 @@ void tree_apply(const sm_model *m, tree_ws *t, int which, const double *x, doubl
     const double *L = which == TREE_K ? t->Kl : which == TREE_M ? t->Ml : t->Cl;
     double scale = which == TREE_C ? 2.0 * t->omega : 1.0;
     int d = t->d;
-    double *in = t->work, *out = t->work + d + t->max_m;
+    /* disjoint halves of the scratch: restrict lets the compiler keep out[] in vector registers
+     * (each out[i] is the same sum in the same order: the same bits) */
+    double *restrict in = t->work, *restrict out = t->work + d + t->max_m;
     tree_forward(m, t, x, t->u);
     for (int s = 0; s < m->n_subs; s++) {
         const sm_sub *b = &m->subs[s];
@@ -401,9 +415,12 @@ void tree_apply(const sm_model *m, tree_ws *t, int which, const double *x, doubl
         memcpy(in + d, x + b->q0, (size_t)b->m * sizeof(double));
         for (int i = 0; i < l; i++)
             out[i] = 0;
-        for (int j = 0; j < l; j++)
+        for (int j = 0; j < l; j++) {
+            const double *restrict Lj = Ls + (size_t)j * l;
+            double xj = in[j];
             for (int i = 0; i < l; i++)
-                out[i] += Ls[(size_t)j * l + i] * in[j];
+                out[i] += Lj[i] * xj;
+        }
         for (int i = 0; i < d; i++)
             t->v[(size_t)d * s + i] = scale * out[i];
         for (int i = 0; i < b->m; i++)
