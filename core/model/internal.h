@@ -330,8 +330,8 @@ void eq_carry_free(eq_carry *c);
  * (see *out), SM_NOMEM, or SM_LAPACK_FAILED when a factorisation or solve
  * reports an error (out->message says where).
  */
-int eq_solve(const sm_model *m, double *q, double s_from, double s_to,
-             int from_rest, eq_carry *carry, sm_progress *pr, sm_eq_out *out);
+int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_rest,
+             eq_carry *carry, sm_progress *pr, sm_eq_out *out);
 
 /* --------------------------------------------------------------- tree.c */
 /* The linearised equations in block form along the frame tree (see the header of tree.c):

@@ -79,7 +79,8 @@ int tree_alloc(const sm_model *m, tree_ws *t)
     t->v_off = calloc((size_t)S + 1, sizeof(size_t));
     t->d_off = calloc((size_t)S + 1, sizeof(size_t));
     t->c_off = calloc((size_t)S + 1, sizeof(size_t));
-    if (!t->mp_ptr || !t->mp_idx || !t->loc_off || !t->fr_off || !t->v_off || !t->d_off || !t->c_off)
+    if (!t->mp_ptr || !t->mp_idx || !t->loc_off || !t->fr_off || !t->v_off || !t->d_off ||
+        !t->c_off)
         goto fail;
     for (int s = 0; s < S; s++) {
         size_t l = (size_t)d + m->subs[s].m, nb = 2 * (size_t)d + m->subs[s].m;
@@ -119,8 +120,8 @@ int tree_alloc(const sm_model *m, tree_ws *t)
     t->u = dm_vec((size_t)d * S);
     t->v = dm_vec((size_t)d * S);
     t->work = dm_vec(4 * (size_t)mx + 2 * (size_t)(mx + 2 * d) * (mx + 2 * d) + 64);
-    if (!t->Kl || !t->Ml || !t->Cl || !t->F || !t->X || !t->ipiv || !t->lk || !t->D || !t->Cc || !t->z ||
-        !t->u || !t->v || !t->work)
+    if (!t->Kl || !t->Ml || !t->Cl || !t->F || !t->X || !t->ipiv || !t->lk || !t->D || !t->Cc ||
+        !t->z || !t->u || !t->v || !t->work)
         goto fail;
     return SM_OK;
 fail:

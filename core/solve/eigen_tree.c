@@ -48,8 +48,8 @@
 
 /* w (2n) = A v for A = [-K^-1 C, -K^-1 M; I, 0] (tree.c header); tmp: 2n scratch.  *refine: 1
  * while the solves are refined (cleared here for a spatial model, see EIG_TREE_REFINE_SKIP). */
-static int eig_tree_op(const sm_model *m, tree_ws *t, int coriolis, const double *v, double *w, double *tmp,
-                       int *refine)
+static int eig_tree_op(const sm_model *m, tree_ws *t, int coriolis, const double *v, double *w,
+                       double *tmp, int *refine)
 {
     int n = m->n;
     tree_apply(m, t, TREE_M, v + n, w); /* w = M y */
@@ -95,7 +95,8 @@ static double eig_cgs2(int len, int nq, const double *Q, double *w, double *h)
  * (s: Mr, Mi, Cr, Ci, Kr, Ki, n each; C zero without Coriolis). */
 static double eig_residual_terms(int n, double lr, double li, const double *s)
 {
-    const double *Mr = s, *Mi = s + n, *Cr = s + 2 * n, *Ci = s + 3 * n, *Kr = s + 4 * n, *Ki = s + 5 * n;
+    const double *Mr = s, *Mi = s + n, *Cr = s + 2 * n, *Ci = s + 3 * n, *Kr = s + 4 * n,
+                 *Ki = s + 5 * n;
     double l2r = lr * lr - li * li, l2i = 2 * lr * li, rr = 0, nm = 0, nc = 0, nk = 0;
     for (int i = 0; i < n; i++) {
         double re = l2r * Mr[i] - l2i * Mi[i] + lr * Cr[i] - li * Ci[i] + Kr[i];
@@ -131,8 +132,8 @@ static double eig_tree_residual(const sm_model *m, tree_ws *t, int coriolis, dou
 /* The same for x = V (ar + i ai) from the basis products MV, CV, KV (n x nv): six products of
  * n x nv instead of six operator applications (spatial models, issue 27). */
 static double eig_basis_residual(int n, int nv, int coriolis, const double *MV, const double *CV,
-                                 const double *KV, double lr, double li, const double *ar, const double *ai,
-                                 double *s)
+                                 const double *KV, double lr, double li, const double *ar,
+                                 const double *ai, double *s)
 {
     const double *P[3] = {MV, CV, KV};
     for (int k = 0; k < 3; k++) {
@@ -140,8 +141,10 @@ static double eig_basis_residual(int n, int nv, int coriolis, const double *MV, 
             memset(s + 2 * (size_t)n, 0, 2 * (size_t)n * sizeof(double));
             continue;
         }
-        cblas_dgemv(CblasColMajor, CblasNoTrans, n, nv, 1.0, P[k], n, ar, 1, 0.0, s + 2 * (size_t)k * n, 1);
-        cblas_dgemv(CblasColMajor, CblasNoTrans, n, nv, 1.0, P[k], n, ai, 1, 0.0, s + (2 * (size_t)k + 1) * n, 1);
+        cblas_dgemv(CblasColMajor, CblasNoTrans, n, nv, 1.0, P[k], n, ar, 1, 0.0,
+                    s + 2 * (size_t)k * n, 1);
+        cblas_dgemv(CblasColMajor, CblasNoTrans, n, nv, 1.0, P[k], n, ai, 1, 0.0,
+                    s + (2 * (size_t)k + 1) * n, 1);
     }
     return eig_residual_terms(n, lr, li, s);
 }
@@ -268,10 +271,12 @@ static int eig_tree_project(const sm_model *m, tree_ws *t, int coriolis, int mod
     for (int j = 0; j < modes; j++) {
         out->wre[j] = e.wre[j];
         out->wim[j] = e.wim[j];
-        double r = t->d == 6 ? eig_basis_residual(n, nv, coriolis, MV, CV, KV, e.wre[j], e.wim[j],
-                                                   e.xre + (size_t)j * nv, e.xim + (size_t)j * nv, scratch)
-                             : eig_tree_residual(m, t, coriolis, e.wre[j], e.wim[j], out->xre + (size_t)j * n,
-                                                 out->xim + (size_t)j * n, scratch);
+        double r =
+            t->d == 6
+                ? eig_basis_residual(n, nv, coriolis, MV, CV, KV, e.wre[j], e.wim[j],
+                                     e.xre + (size_t)j * nv, e.xim + (size_t)j * nv, scratch)
+                : eig_tree_residual(m, t, coriolis, e.wre[j], e.wim[j], out->xre + (size_t)j * n,
+                                    out->xim + (size_t)j * n, scratch);
         worst = fmax(worst, r);
     }
     *res = worst;

@@ -207,8 +207,8 @@ static int eq_restart(const sm_model *m, const double *q, double s, eq_ws *w, in
  * Returns SM_OK (whether or not it converged: see out), SM_NOMEM or
  * SM_LAPACK_FAILED (a LAPACK error, not a property of the structure).
  */
-int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_rest, eq_carry *carry,
-             sm_progress *pr, sm_eq_out *out)
+int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_rest,
+             eq_carry *carry, sm_progress *pr, sm_eq_out *out)
 {
     eq_ws own, *w = carry ? &carry->w : &own;
     int n = m->n, rc = carry ? SM_OK : eq_ws_alloc(m, &own), incr = 0, have_lu = 0;
@@ -339,8 +339,9 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
     out->iterations = w->iterations;
     out->converged = s >= s_to && !out->canceled;
     /* converged: the last Newton step's residual is ||F|| at this q and s_to, the same value */
-    out->residual = out->converged && incr > 0 ? w->residual
-                                               : eq_residual(m, q, out->converged ? s_to : out->last_s, w);
+    out->residual = out->converged && incr > 0
+                        ? w->residual
+                        : eq_residual(m, q, out->converged ? s_to : out->last_s, w);
     if (!out->converged && !out->canceled)
         snprintf(out->message, sizeof out->message,
                  "no equilibrium beyond Omega = %.6g rad/s (target %.6g rad/s): %s",

@@ -144,7 +144,8 @@ int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress
     if (!r->cases)
         goto fail;
     r->n_cases = n_omegas;
-    if ((rc = smi_lin_new(m, SMI_USE_MODES, tree_use(m), &L)) < 0 || (rc = eq_carry_new(m, &carry)) < 0)
+    if ((rc = smi_lin_new(m, SMI_USE_MODES, tree_use(m), &L)) < 0 ||
+        (rc = eq_carry_new(m, &carry)) < 0)
         goto fail;
     for (int i = 0; i < n_omegas; i++) {
         key[i].omega = omegas[i];

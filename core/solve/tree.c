@@ -158,7 +158,8 @@ static void tree_sytrs_l(int n, const double *A, const int *ip, double *b)
             double b0 = b[k], b1 = b[k + 1];
             for (int i = k + 2; i < n; i++)
                 b[i] = (b[i] - ak[i] * b0) - ak1[i] * b1;
-            double akm1k = ak[k + 1], akm1 = ak[k] / akm1k, akk = ak1[k + 1] / akm1k, den = akm1 * akk - 1.0;
+            double akm1k = ak[k + 1], akm1 = ak[k] / akm1k, akk = ak1[k + 1] / akm1k,
+                   den = akm1 * akk - 1.0;
             double bkm1 = b0 / akm1k, bkk = b1 / akm1k;
             b[k] = (akk * bkm1 - bkk) / den;
             b[k + 1] = (akm1 * bkk - bkm1) / den;
@@ -292,7 +293,8 @@ int tree_factor(const sm_model *m, tree_ws *t, int sym)
             neg += dm_sytrf_negative(nb, F, ip);
         } else {
             rc = d == 6 ? tree_getrf(nb, F, ip)
-                        : dm_lapack_status(LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, nb, nb, F, nb, ip), SM_SINGULAR);
+                        : dm_lapack_status(LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, nb, nb, F, nb, ip),
+                                           SM_SINGULAR);
             if (rc < 0)
                 return rc;
             for (int i = 0; i < nb; i++) {
