@@ -242,9 +242,10 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
             break;
         }
         double sn = s + h >= s_to - 1e-12 * s_to ? s_to : s + h;
-        /* predictor: Kt dq = g ds */
+        /* predictor: Kt dq = g ds.  w->g holds g(q) already: q comes from eq_restart, from the
+         * carried continuation or from a converged Newton step, and each ends with a residual
+         * evaluation at q (issue 27: one of a speed's five evaluations of g, same values) */
         memcpy(w->q0, q, (size_t)n * sizeof(double));
-        smi_lin_centrifugal(m, q, w->L, w->g);
         memcpy(w->qp, q, (size_t)n * sizeof(double));
         if (have_lu) {
             memcpy(w->dq, w->g, (size_t)n * sizeof(double));
