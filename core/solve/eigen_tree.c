@@ -153,7 +153,9 @@ static double eig_basis_residual(int n, int nv, int coriolis, const double *MV, 
  * The k lowest modes of the small gyroscopic problem (l^2 M + l C + K) a = 0 (nv x nv, K positive
  * definite) in the inverse companion form mu [a; l a] = [-K^-1 C, -K^-1 M; I, 0] [a; l a],
  * mu = 1/l, by dgeev: the wanted roots are the largest |mu|, resolved relative to themselves
- * (eig_solve resolves them relative to the highest frequency of the projected problem).
+ * (eig_solve resolved them relative to the highest frequency of the projected problem when this
+ * was written; it has its own inverse form since, which spatial projections take: 4x cheaper.
+ * Planar ones keep this one and their bytes, issue 27).
  * w: k frequencies (lambda = i w); a: nv x k complex vectors as ar, ai.  Returns SM_OK,
  * SM_NOMEM, SM_SINGULAR (K not positive definite, or fewer than k roots) or SM_LAPACK_FAILED.
  */
