@@ -2,9 +2,9 @@
 # tests/bench/bench_sweeps.sh — issue 27 goals 2 and 3: whole-process time of speed sweeps
 # (`spinmodal solve FILE`, stdout to /dev/null, OPENBLAS_NUM_THREADS=1), the median of N runs of
 # BASE (as it is: a CLI without --threads solves on one thread) and of NEW with --threads
-# 1, 2, 4, 8, 16, alternating run by run in one run.  Then whether BASE and NEW --threads 16
-# give the same result document (timings and version removed): the threads must not change a
-# bit.  A benchmark, never a test: it prints, it checks nothing.
+# 1, 2, 4, 8, 16, alternating run by run in one run.  Then whether NEW gives the same result
+# document (timings and version removed) on 1 and 16 threads (the threads must not change a
+# bit), and whether BASE's is the same.  A benchmark, never a test: it prints, it checks nothing.
 #   bash tests/bench/bench_sweeps.sh BASE NEW [N]      (N default 5)
 # Cases: the angled beam (examples/angled-beam-90.json, planar, 48 elements, 143 coordinates)
 # at 101 speeds 0..20 rad/s; the R3-style precone blade of bench_spatial.c (spatial, hub radius
@@ -20,21 +20,15 @@ export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 python3 - "$tmp" <<'PY'
-import json, math, sys
+import json, sys
+sys.path.insert(0, "tests/bench")
+from sweep_cases import precone_blade
 d = sys.argv[1]
 r = json.load(open("examples/angled-beam-90.json"))
 r["analysis"]["omega"] = [20 * i / 100 for i in range(101)]
 json.dump(r, open(d + "/planar101.json", "w"))
-b = math.radians(10)
-blade = {"structure": {"joints": {"H": [1, 0, 0], "T": [1 + 10 * math.cos(b), 0, 10 * math.sin(b)]},
-         "sections": {"s": {"EA": 8.4e7, "EI_flap": 2800, "EI_edge": 25200, "GJ": 3883,
-                            "mass_per_length": 3.0, "flap_inertia": 1e-4, "edge_inertia": 9e-4}},
-         "members": [{"id": "b", "from": "H", "to": "T", "section": "s", "elements": 48}],
-         "clamp": "H"},
-         "frames": "per_element", "analysis": {"omega": [float(i) for i in range(21)], "modes": 3}}
-json.dump(blade, open(d + "/blade21.json", "w"))
-blade["analysis"]["omega"] = [20 * i / 100 for i in range(101)]
-json.dump(blade, open(d + "/blade101.json", "w"))
+json.dump(precone_blade(), open(d + "/blade21.json", "w"))
+json.dump(precone_blade(omegas=[20 * i / 100 for i in range(101)]), open(d + "/blade101.json", "w"))
 PY
 ms() {
   local s e
@@ -67,8 +61,11 @@ for f in planar101 blade21 blade101; do
     printf " %8s" "$v"
   done
   printf " %10s\n" "$(awk -v a="$b" -v c="$best" 'BEGIN{printf "%.2f", a / (c > 0 ? c : 1)}')"
-  "$base" solve "$tmp/$f.json" | strip >"$tmp/a"
+  "$new" solve --threads 1 "$tmp/$f.json" | strip >"$tmp/a"
   "$new" solve --threads 16 "$tmp/$f.json" | strip >"$tmp/b"
-  cmp -s "$tmp/a" "$tmp/b" && echo "  $f: base and new --threads 16 give the same document" ||
-    echo "  $f: the documents DIFFER"
+  cmp -s "$tmp/a" "$tmp/b" && echo "  $f: new --threads 1 and --threads 16 give the same document" ||
+    echo "  $f: the documents DIFFER between --threads 1 and 16"
+  "$base" solve "$tmp/$f.json" | strip >"$tmp/a"
+  cmp -s "$tmp/a" "$tmp/b" && echo "  $f: base gives the same document" ||
+    echo "  $f: base gives another document (tests/bench/compare_outputs.py BASE NEW says by how much)"
 done

@@ -17,7 +17,6 @@ differ (must be 0) and the largest relative frequency change of the spatial ones
 """
 import glob
 import json
-import math
 import os
 import re
 import subprocess
@@ -25,6 +24,8 @@ import sys
 import tempfile
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from sweep_cases import precone_blade  # noqa: E402
 
 
 def generated(tmp):
@@ -36,19 +37,8 @@ def generated(tmp):
             mb["elements"] = ne
         r["analysis"].update({"omega": [0, 5, 10, 20], "coriolis": cor, "modes": 4})
         out.append(("planar-tree-%d-%s.json" % (6 * ne - 1, "c" if cor else "n"), r))
-    b = math.radians(10)
-    blade = {"structure": {"joints": {"H": [1, 0, 0], "T": [1 + 10 * math.cos(b), 0, 10 * math.sin(b)]},
-             "sections": {"s": {"EA": 8.4e7, "EI_flap": 2800, "EI_edge": 25200, "GJ": 3883,
-                                "mass_per_length": 3.0, "flap_inertia": 1e-4, "edge_inertia": 9e-4}},
-             "members": [{"id": "b", "from": "H", "to": "T", "section": "s", "elements": 48}],
-             "clamp": "H"},
-             "frames": "per_element",
-             "analysis": {"omega": [float(i) for i in range(21)], "modes": 3, "mode_shapes": True}}
-    out.append(("spatial-tree-288.json", blade))
-    big = json.loads(json.dumps(blade))
-    big["structure"]["members"][0]["elements"] = 200
-    big["analysis"].update({"omega": [0.0, 10.0, 20.0], "modes": 6})
-    out.append(("spatial-tree-1200.json", big))
+    out.append(("spatial-tree-288.json", precone_blade(mode_shapes=True)))
+    out.append(("spatial-tree-1200.json", precone_blade(200, [0.0, 10.0, 20.0], 6, mode_shapes=True)))
     files = []
     for name, r in out:
         path = os.path.join(tmp, name)

@@ -1,0 +1,20 @@
+"""tests/bench/sweep_cases.py — the spatial sweep case of issue 27's benchmarks, written once
+(bench_sweeps.sh, compare_outputs.py): the R3-style precone blade of bench_spatial.c, hub radius
+1 m, 10 m at 10 degrees precone, per-element frames (6 coordinates each), clamped at the hub."""
+import math
+
+
+def precone_blade(elements=48, omegas=None, modes=3, **analysis):
+    """The request (a dict): elements per blade, speeds in rad/s (default 0..20 by 1), modes,
+    and further analysis fields (e.g. mode_shapes=True)."""
+    b = math.radians(10)
+    a = {"omega": [float(i) for i in range(21)] if omegas is None else list(omegas), "modes": modes}
+    a.update(analysis)
+    return {"structure": {"joints": {"H": [1, 0, 0], "T": [1 + 10 * math.cos(b), 0, 10 * math.sin(b)]},
+                          "sections": {"s": {"EA": 8.4e7, "EI_flap": 2800, "EI_edge": 25200, "GJ": 3883,
+                                             "mass_per_length": 3.0, "flap_inertia": 1e-4,
+                                             "edge_inertia": 9e-4}},
+                          "members": [{"id": "b", "from": "H", "to": "T", "section": "s",
+                                       "elements": elements}],
+                          "clamp": "H"},
+            "frames": "per_element", "analysis": a}
