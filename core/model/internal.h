@@ -312,7 +312,7 @@ typedef struct sm_progress {
 } sm_progress;
 
 /* The workspace of a sequence of continuations (a sweep's speeds, equilibrium.c), kept from one
- * eq_solve to the next: allocated once, and for a kind with carry_tangent the factors of the
+ * eq_solve to the next: allocated once, and for a kind without fixed_bits the factors of the
  * last Newton tangent, which predict the next speed's first step. */
 typedef struct eq_carry eq_carry;
 
@@ -340,6 +340,8 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
 typedef struct tree_ws {
     int S, n;           /* substructures, coordinates */
     int d;              /* frame-pose coordinates: 3 planar (x, y, theta), 6 spatial (dR, dtheta) */
+    int fixed_bits;     /* the kind's fixed_bits (kind.h): LAPACK front solves, the links of the
+                           latest iterate, dgeev projections, every refinement */
     int max_m;          /* largest m_s */
     int *mp_ptr;        /* S+1: mass points of s are mp_idx[mp_ptr[s] .. mp_ptr[s+1]) */
     int *mp_idx;        /* n_mp mass point indices grouped by substructure */

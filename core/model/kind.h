@@ -41,9 +41,12 @@ typedef struct smi_kind {
     int ubar_dim;        /* undeformed local coordinates per free node: 2 | 3 */
     int stiffened_start; /* 1: the continuation from rest starts with a small increment and a
                             stiffened predictor (equilibrium.c, DESIGN.md 7.3) */
-    int carry_tangent;   /* 1: a sweep's next speed predicts with the last Newton tangent of the
-                            speed before instead of a fresh one at its equilibrium (eq_carry;
-                            the planar kind keeps its Newton path, and its bytes: issue 27) */
+    int fixed_bits;      /* 1: results are fixed to the byte (the planar kind, issue 27): the
+                            solver keeps the operations that produced them.  0 (spatial): a
+                            sweep predicts with the carried Newton tangent (eq_carry), and the
+                            tree path solves its fronts itself, projects by the Hermitian
+                            inverse form and stops refining once it corrects nothing (tree.c,
+                            eigen_tree.c): the same answers to ~1e-12, in other last bits */
 
     /* ---- model build (mesh.c, modes.c, model.c) ---- */
     /** Length of a member from its joints' differences (the kind's own rounding). */

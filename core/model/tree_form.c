@@ -72,6 +72,7 @@ int tree_alloc(const sm_model *m, tree_ws *t)
     t->S = S;
     t->n = m->n;
     t->d = d;
+    t->fixed_bits = m->kind->fixed_bits;
     t->mp_ptr = calloc((size_t)S + 1, sizeof(int));
     t->mp_idx = calloc((size_t)(m->n_mp ? m->n_mp : 1), sizeof(int));
     t->loc_off = calloc((size_t)S + 1, sizeof(size_t));

@@ -74,7 +74,7 @@ static int eig_tree_op(const sm_model *m, tree_ws *t, int coriolis, const double
         tmp[i] = b[i] - tmp[i];
     if ((rc = tree_solve(m, t, tmp)) < 0)
         return rc;
-    if (t->d == 6 && dm_norm(tmp, n) <= EIG_TREE_REFINE_SKIP * dm_norm(w, n))
+    if (!t->fixed_bits && dm_norm(tmp, n) <= EIG_TREE_REFINE_SKIP * dm_norm(w, n))
         *refine = 0; /* planar models keep every refinement: their bytes are fixed (issue 27) */
     for (int i = 0; i < n; i++)
         w[i] += tmp[i];
@@ -246,7 +246,7 @@ static int eig_tree_project(const sm_model *m, tree_ws *t, int coriolis, int mod
         }
     for (int i = 0; i < nv; i++)
         DM(&Cp, i, i) = 0;
-    if (coriolis && t->d != 6) {
+    if (coriolis && t->fixed_bits) {
         rc = eig_alloc_out(&e, nv, modes);
         if (rc == SM_OK)
             rc = eig_gyro_inverse(nv, &Mp, &Cp, &Kp, modes, e.wim, e.xre, e.xim);
@@ -274,7 +274,7 @@ static int eig_tree_project(const sm_model *m, tree_ws *t, int coriolis, int mod
         out->wre[j] = e.wre[j];
         out->wim[j] = e.wim[j];
         double r =
-            t->d == 6
+            !t->fixed_bits
                 ? eig_basis_residual(n, nv, coriolis, MV, CV, KV, e.wre[j], e.wim[j],
                                      e.xre + (size_t)j * nv, e.xim + (size_t)j * nv, scratch)
                 : eig_tree_residual(m, t, coriolis, e.wre[j], e.wim[j], out->xre + (size_t)j * n,

@@ -48,7 +48,7 @@ typedef struct eq_ws {
 
 struct eq_carry {
     eq_ws w;
-    int valid; /* w->L holds the factors of a Newton tangent at s (carry_tangent kinds) */
+    int valid; /* w->L holds the factors of a Newton tangent at s (kinds without fixed_bits) */
     int sign;  /* the continuation's sign of det Kt there */
     double s;
 };
@@ -226,7 +226,7 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
     const char *why = "";
     /* tangent at the start for the first predictor: at (q, s_from), or the one carried over */
     int sign = 1;
-    if (carry && carry->valid && !from_rest && m->kind->carry_tangent && carry->s == s_from) {
+    if (carry && carry->valid && !from_rest && !m->kind->fixed_bits && carry->s == s_from) {
         have_lu = 1;
         sign = carry->sign;
     } else {

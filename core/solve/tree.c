@@ -134,7 +134,7 @@ static void tree_coupling(const sm_model *m, const tree_ws *t, int s, double *C)
  * LAPACK's dsytrs step for step, written out.  Fronts are 18 x 18 for a spatial frame of 6
  * modes, where dsytrs's 17 dger and 17 dgemv calls cost 13 400 instructions a solve, mostly
  * per-call overhead: 32 % of a 288-coordinate spatial sweep (issue 27).  The sums run in another
- * order than OpenBLAS's kernels, so the last bits differ: planar fronts keep dsytrs (their
+ * order than OpenBLAS's kernels, so the last bits differ: fixed_bits (planar) fronts keep dsytrs (their
  * results are fixed to the byte), spatial fronts take this one (tree_front_solve).
  */
 static void tree_sytrs_l(int n, const double *A, const int *ip, double *b)
@@ -256,7 +256,7 @@ static int tree_front_solve(const tree_ws *t, int s, int nb, int nrhs, double *B
 {
     const double *F = t->F + t->fr_off[s];
     const int *ip = t->ipiv + t->v_off[s];
-    if (t->d == 6) {
+    if (!t->fixed_bits) {
         for (int j = 0; j < nrhs; j++)
             if (t->sym)
                 tree_sytrs_l(nb, F, ip, B + (size_t)j * nb);
@@ -292,9 +292,10 @@ int tree_factor(const sm_model *m, tree_ws *t, int sym)
                 return rc;
             neg += dm_sytrf_negative(nb, F, ip);
         } else {
-            rc = d == 6 ? tree_getrf(nb, F, ip)
-                        : dm_lapack_status(LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, nb, nb, F, nb, ip),
-                                           SM_SINGULAR);
+            rc = !t->fixed_bits
+                     ? tree_getrf(nb, F, ip)
+                     : dm_lapack_status(LAPACKE_dgetrf_work(LAPACK_COL_MAJOR, nb, nb, F, nb, ip),
+                                        SM_SINGULAR);
             if (rc < 0)
                 return rc;
             for (int i = 0; i < nb; i++) {
@@ -343,7 +344,7 @@ int tree_factor(const sm_model *m, tree_ws *t, int sym)
  * latest iterate; planar results are fixed to the byte (issue 27), so that stays. */
 static const double *tree_solve_coupling(const sm_model *m, tree_ws *t, int s)
 {
-    if (t->d == 6)
+    if (!t->fixed_bits)
         return t->Cc + t->c_off[s];
     tree_coupling(m, t, s, t->work);
     return t->work;
