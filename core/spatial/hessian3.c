@@ -108,12 +108,12 @@ static void sp_base(const sm_model *m, sp_kin *k)
 }
 
 /*
- * Column j of H, a coordinate of frame s (k->cq[j] = q_j + i h), into col (n).  The points of s
- * take the complex step themselves; each child frame c of s takes the pose change v_c of the
- * step, and everything below it moves rigidly: rows of a descendant t are Gown_t v_t with v_t
- * transported down the tree, the child's wrench is bF_c + i h Psi_c v_c.  Above s only the
- * imaginary part of the wrench on the path to the root is nonzero; it is carried up through the
- * child on the path alone.  Rows of the frames off the path and outside the subtree are zero.
+ * Column j of H, a coordinate of frame s (k->cq[j] = q_j + i h), into col (n): the rows of s and
+ * of its subtree.  The points of s take the complex step themselves; each child frame c of s
+ * takes the pose change v_c of the step, and everything below it moves rigidly: rows of a
+ * descendant t are Gown_t v_t with v_t transported down the tree, the child's wrench is
+ * bF_c + i h Psi_c v_c.  The rows of the ancestors of s are H's symmetry (sp_fill_up); rows of
+ * the frames off the path and outside the subtree are zero.
  */
 /* The step of sp_step within frame s: its children take their pose changes (k->v), and g_s and
  * the wrench of s are recomputed at the complex q (k->cg rows of s, k->cF of s). */
@@ -170,22 +170,26 @@ static void sp_step(const sm_model *m, sp_kin *k, int s, double h, double *col)
             col[b->q0 + i] = sum;
         }
     }
-    for (int c = s, a = bs->parent; a >= 0; c = a, a = m->subs[a].parent) {
-        const sm_sub *b = &m->subs[a];
-        int pi = m->subs[c].root;
-        sp_cx *Fs = k->cF + 6 * a, aw[3];
-        for (int i = 0; i < 6; i++)
-            Fs[i] = 0;
-        memset(k->cg + b->q0, 0, (size_t)b->m * sizeof(sp_cx));
-        rot3_mv(k->cA + 9 * a, k->lw + 3 * pi, aw);
-        sp_apply(b, &m->pt[pi], k->cA + 9 * a, k->lT + 9 * pi, aw, k->cF + 6 * c, k->cF + 6 * c + 3,
-                 k->cg + b->q0, Fs, Fs + 3);
-        for (int i = 0; i < b->m; i++)
-            col[b->q0 + i] = cimag(k->cg[b->q0 + i]) / h;
-    }
     for (int t = s; t < S; t++)
         k->mark[t] = 0;
     k->pert = -1;
+}
+
+/*
+ * The rows of the ancestors of frame s in column j (a coordinate of s).  H = dg/dq is the
+ * Hessian of T0~, so H(i, j) = H(j, i), and the column of a coordinate i of an ancestor, done
+ * before s's (parents come first), holds H(j, i) among its subtree rows (Gown_s v_s).  This
+ * replaced carrying the step's wrench up the path to the root once per column (issue 27: 9 %
+ * of a 12-element blade's Newton tangent); the tree path's block Hessian (tree3.c) has always
+ * taken these blocks as Gown'.  The two differ by round-off (H's asymmetry, 1e-16 relative).
+ */
+static void sp_fill_up(const sm_model *m, int s, int j, dmat *H)
+{
+    for (int a = m->subs[s].parent; a >= 0; a = m->subs[a].parent) {
+        const sm_sub *b = &m->subs[a];
+        for (int i = b->q0; i < b->q0 + b->m; i++)
+            DM(H, i, j) = DM(H, j, i);
+    }
 }
 
 void sp_hessian_base(const sm_model *m, const double *q, sp_kin *k)
@@ -231,6 +235,7 @@ void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat
             k->cq[j] = q[j] + _Complex_I * h;
             k->pert_j = j;
             sp_step(m, k, s, h, &DM(H, 0, j));
+            sp_fill_up(m, s, j, H);
             k->cq[j] = q[j];
             k->pert_j = -1;
         }
