@@ -47,6 +47,8 @@ void sp_kin_free(sp_kin *k)
     free(k->Psi);
     free(k->Gown);
     free(k->v);
+    free(k->sw);
+    free(k->sstep);
     free(k->pt_ptr);
     free(k->pt_idx);
     free(k->ch_ptr);
@@ -125,11 +127,13 @@ int sp_kin_alloc(const sm_model *m, sp_kin *k, int jac)
     k->Psi = dm_vec(36 * (size_t)S + 1);
     k->Gown = dm_vec(6 * (size_t)n + 1);
     k->v = dm_vec(6 * (size_t)S + 1);
+    k->sw = calloc(24 * (size_t)P + 1, sizeof(sp_cx));
+    k->sstep = calloc((size_t)P + 1, sizeof(long long));
     k->pert = -1;
     k->pert_j = -1;
     if (!k->R || !k->A || !k->r || !k->psi || !k->AT || !k->dh || !k->cq || !k->cR || !k->cA || !k->cF || !k->cg ||
         !k->lw || !k->lpsi || !k->lL || !k->lT || !k->bR || !k->bA || !k->mark || !k->bF || !k->Psi || !k->Gown ||
-        !k->v ||
+        !k->v || !k->sw || !k->sstep ||
         sp_lists(m, k) || (jac && (dm_alloc(&k->JRT, n, 6 * S) || dm_alloc(&k->JW, n, 6 * P)))) {
         sp_kin_free(k);
         return SM_NOMEM;
@@ -163,7 +167,9 @@ static void sp_local(const sm_model *m, const sp_point *p, const sp_cx *q, sp_cx
  * With the stepped coordinate j known (k->pert_j), w and psi of those points are the base values
  * with the imaginary parts h N_j: what sp_local's sum gives, as every other q_c is real (its
  * real parts are the base's operations on the base's values; its imaginary parts add N_c 0 = +-0
- * to +0 and N_j h once), in O(1) instead of O(m_s) (issue 27).
+ * to +0 and N_j h once), in O(1) instead of O(m_s) (issue 27).  A stepped point's Lambda and T
+ * are kept for the step (k->sw): a frame's end node is asked for them up to three times a step
+ * (its own mass, its child's pose, its child's wrench), the same values each time.
  */
 void sp_point_state(const sm_model *m, sp_kin *k, int pi, const sp_cx *q, int want_L, sp_cx w[3],
                     sp_cx psi[3], sp_cx L[9], sp_cx T[9])
@@ -179,15 +185,31 @@ void sp_point_state(const sm_model *m, sp_kin *k, int pi, const sp_cx *q, int wa
         return;
     }
     if (k->cached && k->pert_j >= 0) {
+        sp_cx *sv = k->sw + 24 * (size_t)pi;
+        if (want_L && k->sstep[pi] == k->step) { /* evaluated already for this step */
+            memcpy(w, sv, 3 * sizeof(sp_cx));
+            memcpy(psi, sv + 3, 3 * sizeof(sp_cx));
+            memcpy(L, sv + 6, 9 * sizeof(sp_cx));
+            memcpy(T, sv + 15, 9 * sizeof(sp_cx));
+            return;
+        }
         const double *Nj = p->N + (size_t)p->ldn * (k->pert_j - m->subs[p->sub].q0);
         double h = cimag(q[k->pert_j]);
         for (int i = 0; i < 3; i++) { /* + 0.0: a product -0 summed onto +0 is +0 */
             w[i] = rot3_cx(creal(k->lw[3 * pi + i]), Nj[i] * h + 0.0);
             psi[i] = rot3_cx(creal(k->lpsi[3 * pi + i]), Nj[3 + i] * h + 0.0);
         }
-    } else {
-        sp_local(m, p, q, w, psi);
+        if (want_L) {
+            rot3_exp(psi, L, T);
+            memcpy(sv, w, 3 * sizeof(sp_cx));
+            memcpy(sv + 3, psi, 3 * sizeof(sp_cx));
+            memcpy(sv + 6, L, 9 * sizeof(sp_cx));
+            memcpy(sv + 15, T, 9 * sizeof(sp_cx));
+            k->sstep[pi] = k->step;
+        }
+        return;
     }
+    sp_local(m, p, q, w, psi);
     if (want_L)
         rot3_exp(psi, L, T);
 }

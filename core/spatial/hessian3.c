@@ -205,6 +205,7 @@ void sp_hessian_own(const sm_model *m, sp_kin *k, int s, int j, double *col)
     double qj = creal(k->cq[j]), h = SP_STEP * fmax(1.0, fabs(qj));
     k->cq[j] = qj + _Complex_I * h;
     k->pert_j = j;
+    k->step++;
     sp_step_own(m, k, s, h);
     for (int i = 0; i < b->m; i++)
         col[i] = cimag(k->cg[b->q0 + i]) / h;
@@ -234,6 +235,7 @@ void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat
             double h = SP_STEP * fmax(1.0, fabs(q[j]));
             k->cq[j] = q[j] + _Complex_I * h;
             k->pert_j = j;
+            k->step++;
             sp_step(m, k, s, h, &DM(H, 0, j));
             sp_fill_up(m, s, j, H);
             k->cq[j] = q[j];

@@ -114,6 +114,9 @@ typedef struct sp_kin {
     int cached;         /* 1 while lw.. hold the base state */
     int pert;           /* the substructure stepped (-1: none) */
     int pert_j;         /* the coordinate stepped, of substructure pert (-1: none) */
+    long long step;     /* count of the coordinates stepped: set pert_j, then step++ */
+    sp_cx *sw;          /* 24P: w, psi, Lambda, T of the points of the stepped frame at step */
+    long long *sstep;   /* P: the step sw holds point p's state for (0: none) */
 } sp_kin;
 
 /** Allocate k for m; jac: also the dense Jacobians JRT, JW (O(n (S + P))).  SM_OK or SM_NOMEM. */
