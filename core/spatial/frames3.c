@@ -44,6 +44,7 @@ void sp_kin_free(sp_kin *k)
     free(k->bA);
     free(k->mark);
     free(k->bF);
+    free(k->bq);
     free(k->Psi);
     free(k->Gown);
     free(k->v);
@@ -124,6 +125,7 @@ int sp_kin_alloc(const sm_model *m, sp_kin *k, int jac)
     k->bA = calloc(9 * (size_t)S + 1, sizeof(sp_cx));
     k->mark = calloc((size_t)S + 1, sizeof(int));
     k->bF = calloc(6 * (size_t)S + 1, sizeof(sp_cx));
+    k->bq = dm_vec((size_t)n + 1);
     k->Psi = dm_vec(36 * (size_t)S + 1);
     k->Gown = dm_vec(6 * (size_t)n + 1);
     k->v = dm_vec(6 * (size_t)S + 1);
@@ -132,7 +134,7 @@ int sp_kin_alloc(const sm_model *m, sp_kin *k, int jac)
     k->pert = -1;
     k->pert_j = -1;
     if (!k->R || !k->A || !k->r || !k->psi || !k->AT || !k->dh || !k->cq || !k->cR || !k->cA || !k->cF || !k->cg ||
-        !k->lw || !k->lpsi || !k->lL || !k->lT || !k->bR || !k->bA || !k->mark || !k->bF || !k->Psi || !k->Gown ||
+        !k->lw || !k->lpsi || !k->lL || !k->lT || !k->bR || !k->bA || !k->mark || !k->bF || !k->bq || !k->Psi || !k->Gown ||
         !k->v || !k->sw || !k->sstep ||
         sp_lists(m, k) || (jac && (dm_alloc(&k->JRT, n, 6 * S) || dm_alloc(&k->JW, n, 6 * P)))) {
         sp_kin_free(k);
@@ -367,6 +369,13 @@ void sp_centrifugal(const sm_model *m, const double *q, sp_kin *k, double *g)
     sp_centrifugal_c(m, k);
     for (int i = 0; i < m->n; i++)
         g[i] = creal(k->cg[i]);
+    if (!k->cached) { /* the base of a Jacobian at q, should one follow (sp_base) */
+        memcpy(k->bR, k->cR, 3 * (size_t)m->n_subs * sizeof(sp_cx));
+        memcpy(k->bA, k->cA, 9 * (size_t)m->n_subs * sizeof(sp_cx));
+        memcpy(k->bF, k->cF, 6 * (size_t)m->n_subs * sizeof(sp_cx));
+        memcpy(k->bq, q, (size_t)m->n * sizeof(double));
+        k->bvalid = 1;
+    }
 }
 
 /*

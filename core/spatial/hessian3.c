@@ -88,16 +88,27 @@ static void sp_rigid(const sm_model *m, sp_kin *k, int c)
         memcpy(k->cF + 6 * k->ch_idx[t], k->bF + 6 * k->ch_idx[t], 6 * sizeof(sp_cx));
 }
 
-/* The base of the complex steps at the real q (k->cq): local state of every point (k->lw..),
- * poses (bR, bA), subtree wrenches (bF), and the rigid-motion responses Gown, Psi. */
-static void sp_base(const sm_model *m, sp_kin *k)
+/* The base of the complex steps at the real q (= k->cq): local state of every point (k->lw..),
+ * poses (bR, bA), subtree wrenches (bF), and the rigid-motion responses Gown, Psi.  Poses and
+ * wrenches are those of g at q: a Newton tangent follows a residual at the same q, whose
+ * sp_centrifugal left them in bR, bA, bF (the same operations on the same values). */
+static void sp_base(const sm_model *m, const double *q, sp_kin *k)
 {
+    size_t S = (size_t)m->n_subs;
     k->cached = 0;
     k->pert = -1;
-    sp_centrifugal_c(m, k);
-    memcpy(k->bR, k->cR, 3 * (size_t)m->n_subs * sizeof(sp_cx));
-    memcpy(k->bA, k->cA, 9 * (size_t)m->n_subs * sizeof(sp_cx));
-    memcpy(k->bF, k->cF, 6 * (size_t)m->n_subs * sizeof(sp_cx));
+    if (k->bvalid && !memcmp(k->bq, q, (size_t)m->n * sizeof(double))) {
+        memcpy(k->cR, k->bR, 3 * S * sizeof(sp_cx));
+        memcpy(k->cA, k->bA, 9 * S * sizeof(sp_cx));
+        memcpy(k->cF, k->bF, 6 * S * sizeof(sp_cx));
+    } else {
+        sp_centrifugal_c(m, k);
+        memcpy(k->bR, k->cR, 3 * S * sizeof(sp_cx));
+        memcpy(k->bA, k->cA, 9 * S * sizeof(sp_cx));
+        memcpy(k->bF, k->cF, 6 * S * sizeof(sp_cx));
+        memcpy(k->bq, q, (size_t)m->n * sizeof(double));
+        k->bvalid = 1;
+    }
     for (int pi = 0; pi < m->n_pt; pi++)
         if (m->pt[pi].sub >= 0)
             sp_point_state(m, k, pi, k->cq, 1, k->lw + 3 * pi, k->lpsi + 3 * pi, k->lL + 9 * pi,
@@ -196,7 +207,7 @@ void sp_hessian_base(const sm_model *m, const double *q, sp_kin *k)
 {
     for (int i = 0; i < m->n; i++)
         k->cq[i] = q[i];
-    sp_base(m, k);
+    sp_base(m, q, k);
 }
 
 void sp_hessian_own(const sm_model *m, sp_kin *k, int s, int j, double *col)
@@ -228,7 +239,7 @@ void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat
     int n = m->n;
     for (int i = 0; i < n; i++)
         k->cq[i] = q[i];
-    sp_base(m, k);
+    sp_base(m, q, k);
     for (int s = 0; s < m->n_subs; s++) {
         const sm_sub *b = &m->subs[s];
         for (int j = b->q0; j < b->q0 + b->m; j++) {

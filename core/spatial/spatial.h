@@ -108,6 +108,9 @@ typedef struct sp_kin {
     sp_cx *bR, *bA;     /* 3S, 9S: the poses at the base point */
     int *mark;          /* S: 1 for the frames of the subtree being stepped */
     sp_cx *bF;          /* 6S: subtree wrenches at the base point */
+    double *bq;         /* n: with bvalid, the real q at which bR, bA, bF are the poses and the
+                           subtree wrenches (sp_centrifugal or a Jacobian's base left them) */
+    int bvalid;
     double *Psi;        /* 36S: d wrench_c / d pose_c under a rigid motion of c's subtree (6x6 each) */
     double *Gown;       /* n x 6: d g_c / d pose_c, rows of c, under that rigid motion */
     double *v;          /* 6S: pose change of each frame below a stepped coordinate */
