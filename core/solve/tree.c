@@ -137,7 +137,7 @@ static void tree_coupling(const sm_model *m, const tree_ws *t, int s, double *C)
  * order than OpenBLAS's kernels, so the last bits differ: fixed_bits (planar) fronts keep dsytrs (their
  * results are fixed to the byte), spatial fronts take this one (tree_front_solve).
  */
-static void tree_sytrs_l(int n, const double *A, const int *ip, double *b)
+static inline void tree_sytrs_ln(int n, const double *restrict A, const int *restrict ip, double *restrict b)
 {
     for (int k = 0; k < n;) { /* L D y = P b, leading column first */
         const double *ak = A + (size_t)k * n;
@@ -189,6 +189,17 @@ static void tree_sytrs_l(int n, const double *A, const int *ip, double *b)
             k -= 2;
         }
     }
+}
+
+/* tree_sytrs_ln for one front; a spatial one-element frame's front (6 own + 2 x 6 pose
+ * coordinates) with its size a constant, so that the compiler drops the run-time loop bounds:
+ * the same operations in the same order (issue 27). */
+static void tree_sytrs_l(int n, const double *A, const int *ip, double *b)
+{
+    if (n == 18)
+        tree_sytrs_ln(18, A, ip, b);
+    else
+        tree_sytrs_ln(n, A, ip, b);
 }
 
 /*
@@ -350,9 +361,12 @@ static const double *tree_solve_coupling(const sm_model *m, tree_ws *t, int s)
     return t->work;
 }
 
-int tree_solve(const sm_model *m, tree_ws *t, double *x)
+/* tree_solve with the pose size d a parameter: tree_solve passes the constant 6 for a spatial
+ * model, so that the coupling products' loops of length d unroll (the same operations in the
+ * same order for either kind: issue 27). */
+static inline int tree_solve_d(const sm_model *m, tree_ws *t, double *x, int d)
 {
-    int S = m->n_subs, d = t->d, rc;
+    int S = m->n_subs, rc;
     for (int s = 0; s < S; s++) { /* right-hand sides [b_s; 0; 0] */
         double *zs = t->z + t->v_off[s];
         int mm = m->subs[s].m;
@@ -401,6 +415,42 @@ int tree_solve(const sm_model *m, tree_ws *t, double *x)
     return SM_OK;
 }
 
+int tree_solve(const sm_model *m, tree_ws *t, double *x)
+{
+    return t->d == 6 ? tree_solve_d(m, t, x, 6) : tree_solve_d(m, t, x, t->d);
+}
+
+/*
+ * The local product of tree_apply for a 12 x 12 block (6 pose and 6 own coordinates: a spatial
+ * frame of one element, the frames of a blade's tree path): out = L (u_s; x_s), each out[i] the
+ * sum over j = 0..11 in order, as the general loop forms it (the same bits); constant bounds let
+ * the compiler keep out in registers instead of a loop of run-time length 12 with its vector
+ * prologue and epilogue (issue 27: 6.5 instructions a multiply-add, 15 % of a spatial sweep).
+ */
+static void tree_local12(const double *restrict Ls, const double *restrict us, const double *restrict xs,
+                         double scale, double *restrict vs, double *restrict ys)
+{
+    double out[12];
+    for (int i = 0; i < 12; i++)
+        out[i] = 0;
+    for (int j = 0; j < 6; j++) {
+        const double *restrict Lj = Ls + 12 * j;
+        double xj = us[j];
+        for (int i = 0; i < 12; i++)
+            out[i] += Lj[i] * xj;
+    }
+    for (int j = 0; j < 6; j++) {
+        const double *restrict Lj = Ls + 12 * (6 + j);
+        double xj = xs[j];
+        for (int i = 0; i < 12; i++)
+            out[i] += Lj[i] * xj;
+    }
+    for (int i = 0; i < 6; i++)
+        vs[i] = scale * out[i];
+    for (int i = 0; i < 6; i++)
+        ys[i] = scale * out[6 + i];
+}
+
 void tree_apply(const sm_model *m, tree_ws *t, int which, const double *x, double *y)
 {
     const double *L = which == TREE_K ? t->Kl : which == TREE_M ? t->Ml : t->Cl;
@@ -414,6 +464,10 @@ void tree_apply(const sm_model *m, tree_ws *t, int which, const double *x, doubl
         const sm_sub *b = &m->subs[s];
         int l = d + b->m;
         const double *Ls = L + t->loc_off[s];
+        if (l == 12 && d == 6) { /* a spatial frame of one element: the same sums, unrolled */
+            tree_local12(Ls, t->u + 6 * (size_t)s, x + b->q0, scale, t->v + 6 * (size_t)s, y + b->q0);
+            continue;
+        }
         memcpy(in, t->u + (size_t)d * s, (size_t)d * sizeof(double));
         memcpy(in + d, x + b->q0, (size_t)b->m * sizeof(double));
         for (int i = 0; i < l; i++)
