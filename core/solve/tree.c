@@ -280,9 +280,11 @@ static int tree_front_solve(const tree_ws *t, int s, int nb, int nrhs, double *B
     return dm_lapack_status(info, SM_LAPACK_FAILED);
 }
 
-int tree_factor(const sm_model *m, tree_ws *t, int sym)
+/* tree_factor with the pose size d a parameter (the constant 6 for a spatial model, as
+ * tree_solve_d: the Schur updates' loops of length d unroll, each sum in the same order). */
+static inline int tree_factor_d(const sm_model *m, tree_ws *t, int sym, int d)
 {
-    int S = m->n_subs, d = t->d, neg = 0, sign = (d * S) % 2 ? -1 : 1, rc;
+    int S = m->n_subs, neg = 0, sign = (d * S) % 2 ? -1 : 1, rc;
     double *W = t->work;
     t->sym = sym;
     t->neg = 0;
@@ -347,6 +349,11 @@ int tree_factor(const sm_model *m, tree_ws *t, int sym)
     t->neg = neg - d * S;
     t->det_sign = sign;
     return SM_OK;
+}
+
+int tree_factor(const sm_model *m, tree_ws *t, int sym)
+{
+    return t->d == 6 ? tree_factor_d(m, t, sym, 6) : tree_factor_d(m, t, sym, t->d);
 }
 
 /* C_s for a solve.  Spatial: the one tree_factor built.  Planar: rebuilt from the current links,
