@@ -130,6 +130,26 @@ fail:
     return SM_NOMEM;
 }
 
+/* us (6) += D xp, D 6 x mp; and yp (mp) += D' vs.  Inlined with mp = 6 a constant where the
+ * parent is a one-element frame, so that the loops unroll: the same sums in the same order
+ * (issue 27: tree_forward and tree_adjoint were 8 % of a spatial sweep). */
+static inline void tree_dx6(int mp, const double *restrict D, const double *restrict xp, double *restrict us)
+{
+    for (int j = 0; j < mp; j++)
+        for (int i = 0; i < 6; i++)
+            us[i] += D[6 * j + i] * xp[j];
+}
+
+static inline void tree_dtv6(int mp, const double *restrict D, const double *restrict vs, double *restrict yp)
+{
+    for (int j = 0; j < mp; j++) {
+        double acc = 0;
+        for (int i = 0; i < 6; i++)
+            acc += D[6 * j + i] * vs[i];
+        yp[j] += acc;
+    }
+}
+
 /* Spatial forward step: u_s = T_s u_p + D_s x_p, T_s u = (dR + dtheta x a, dtheta). */
 static void tree_forward6(const sm_model *m, const tree_ws *t, int s, const double *x, double *u)
 {
@@ -143,9 +163,10 @@ static void tree_forward6(const sm_model *m, const tree_ws *t, int s, const doub
     us[3] = up[3];
     us[4] = up[4];
     us[5] = up[5];
-    for (int j = 0; j < p->m; j++)
-        for (int i = 0; i < 6; i++)
-            us[i] += D[6 * j + i] * xp[j];
+    if (p->m == 6)
+        tree_dx6(6, D, xp, us);
+    else
+        tree_dx6(p->m, D, xp, us);
 }
 
 /* Spatial adjoint step: v_p += T_s' v_s = (v_R, v_theta + a x v_R); y_p += D_s' v_s. */
@@ -160,12 +181,10 @@ static void tree_adjoint6(const sm_model *m, const tree_ws *t, int s, double *v,
     vp[3] += vs[3] + a[1] * vs[2] - a[2] * vs[1];
     vp[4] += vs[4] + a[2] * vs[0] - a[0] * vs[2];
     vp[5] += vs[5] + a[0] * vs[1] - a[1] * vs[0];
-    for (int j = 0; j < p->m; j++) {
-        double acc = 0;
-        for (int i = 0; i < 6; i++)
-            acc += D[6 * j + i] * vs[i];
-        yp[j] += acc;
-    }
+    if (p->m == 6)
+        tree_dtv6(6, D, vs, yp);
+    else
+        tree_dtv6(p->m, D, vs, yp);
 }
 
 /* u (d S) = dy/dq x: the forward recursion dy_c = T_c dy_p + D_c x_p, dy = 0 at the hub. */

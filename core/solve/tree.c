@@ -353,7 +353,9 @@ static inline int tree_factor_d(const sm_model *m, tree_ws *t, int sym, int d)
 
 int tree_factor(const sm_model *m, tree_ws *t, int sym)
 {
-    return t->d == 6 ? tree_factor_d(m, t, sym, 6) : tree_factor_d(m, t, sym, t->d);
+    if (t->d == 6)
+        return tree_factor_d(m, t, sym, 6);
+    return tree_factor_d(m, t, sym, t->d);
 }
 
 /* C_s for a solve.  Spatial: the one tree_factor built.  Planar: rebuilt from the current links,
@@ -424,7 +426,9 @@ static inline int tree_solve_d(const sm_model *m, tree_ws *t, double *x, int d)
 
 int tree_solve(const sm_model *m, tree_ws *t, double *x)
 {
-    return t->d == 6 ? tree_solve_d(m, t, x, 6) : tree_solve_d(m, t, x, t->d);
+    if (t->d == 6)
+        return tree_solve_d(m, t, x, 6);
+    return tree_solve_d(m, t, x, t->d);
 }
 
 /*
