@@ -93,4 +93,24 @@ static inline void rot3_tmul_r(const double a[9], const double b[9], double c[9]
                 a[3 * i] * b[3 * j] + a[3 * i + 1] * b[3 * j + 1] + a[3 * i + 2] * b[3 * j + 2];
 }
 
+/** Real: y = a x, y = a' x (3x3 times 3), c = a x b. */
+static inline void rot3_mv_r(const double a[9], const double x[3], double y[3])
+{
+    for (int i = 0; i < 3; i++)
+        y[i] = a[i] * x[0] + a[i + 3] * x[1] + a[i + 6] * x[2];
+}
+
+static inline void rot3_tmv_r(const double a[9], const double x[3], double y[3])
+{
+    for (int i = 0; i < 3; i++)
+        y[i] = a[3 * i] * x[0] + a[3 * i + 1] * x[1] + a[3 * i + 2] * x[2];
+}
+
+static inline void rot3_cross_r(const double a[3], const double b[3], double c[3])
+{
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
 #endif
