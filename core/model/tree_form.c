@@ -133,14 +133,16 @@ fail:
 /* us (6) += D xp, D 6 x mp; and yp (mp) += D' vs.  Inlined with mp = 6 a constant where the
  * parent is a one-element frame, so that the loops unroll: the same sums in the same order
  * (issue 27: tree_forward and tree_adjoint were 8 % of a spatial sweep). */
-static inline void tree_dx6(int mp, const double *restrict D, const double *restrict xp, double *restrict us)
+static inline void tree_dx6(int mp, const double *restrict D, const double *restrict xp,
+                            double *restrict us)
 {
     for (int j = 0; j < mp; j++)
         for (int i = 0; i < 6; i++)
             us[i] += D[6 * j + i] * xp[j];
 }
 
-static inline void tree_dtv6(int mp, const double *restrict D, const double *restrict vs, double *restrict yp)
+static inline void tree_dtv6(int mp, const double *restrict D, const double *restrict vs,
+                             double *restrict yp)
 {
     for (int j = 0; j < mp; j++) {
         double acc = 0;

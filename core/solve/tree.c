@@ -137,7 +137,8 @@ static void tree_coupling(const sm_model *m, const tree_ws *t, int s, double *C)
  * order than OpenBLAS's kernels, so the last bits differ: fixed_bits (planar) fronts keep dsytrs (their
  * results are fixed to the byte), spatial fronts take this one (tree_front_solve).
  */
-static inline void tree_sytrs_ln(int n, const double *restrict A, const int *restrict ip, double *restrict b)
+static inline void tree_sytrs_ln(int n, const double *restrict A, const int *restrict ip,
+                                 double *restrict b)
 {
     for (int k = 0; k < n;) { /* L D y = P b, leading column first */
         const double *ak = A + (size_t)k * n;
@@ -438,8 +439,9 @@ int tree_solve(const sm_model *m, tree_ws *t, double *x)
  * the compiler keep out in registers instead of a loop of run-time length 12 with its vector
  * prologue and epilogue (issue 27: 6.5 instructions a multiply-add, 15 % of a spatial sweep).
  */
-static void tree_local12(const double *restrict Ls, const double *restrict us, const double *restrict xs,
-                         double scale, double *restrict vs, double *restrict ys)
+static void tree_local12(const double *restrict Ls, const double *restrict us,
+                         const double *restrict xs, double scale, double *restrict vs,
+                         double *restrict ys)
 {
     double out[12];
     for (int i = 0; i < 12; i++)
@@ -476,7 +478,8 @@ void tree_apply(const sm_model *m, tree_ws *t, int which, const double *x, doubl
         int l = d + b->m;
         const double *Ls = L + t->loc_off[s];
         if (l == 12 && d == 6) { /* a spatial frame of one element: the same sums, unrolled */
-            tree_local12(Ls, t->u + 6 * (size_t)s, x + b->q0, scale, t->v + 6 * (size_t)s, y + b->q0);
+            tree_local12(Ls, t->u + 6 * (size_t)s, x + b->q0, scale, t->v + 6 * (size_t)s,
+                         y + b->q0);
             continue;
         }
         memcpy(in, t->u + (size_t)d * s, (size_t)d * sizeof(double));

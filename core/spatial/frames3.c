@@ -133,9 +133,9 @@ int sp_kin_alloc(const sm_model *m, sp_kin *k, int jac)
     k->sstep = calloc((size_t)P + 1, sizeof(long long));
     k->pert = -1;
     k->pert_j = -1;
-    if (!k->R || !k->A || !k->r || !k->psi || !k->AT || !k->dh || !k->cq || !k->cR || !k->cA || !k->cF || !k->cg ||
-        !k->lw || !k->lpsi || !k->lL || !k->lT || !k->bR || !k->bA || !k->mark || !k->bF || !k->bq || !k->Psi || !k->Gown ||
-        !k->v || !k->sw || !k->sstep ||
+    if (!k->R || !k->A || !k->r || !k->psi || !k->AT || !k->dh || !k->cq || !k->cR || !k->cA ||
+        !k->cF || !k->cg || !k->lw || !k->lpsi || !k->lL || !k->lT || !k->bR || !k->bA ||
+        !k->mark || !k->bF || !k->bq || !k->Psi || !k->Gown || !k->v || !k->sw || !k->sstep ||
         sp_lists(m, k) || (jac && (dm_alloc(&k->JRT, n, 6 * S) || dm_alloc(&k->JW, n, 6 * P)))) {
         sp_kin_free(k);
         return SM_NOMEM;
@@ -278,8 +278,8 @@ void sp_apply(const sm_sub *b, const sp_point *p, const sp_cx A[9], const sp_cx 
 /* Force and moment (hub frame) of the centrifugal potential on point p of frame s at its local
  * state (w, L), aw = A_s w: F = m P r (r = R + A w, + A Lambda c for an offset mass), Mo = the
  * moment of F about the node at the offset plus (X e) x e, X e = A Lambda I Lambda' A' e. */
-void sp_point_wrench(const sp_point *p, const sp_cx R[3], const sp_cx A[9],
-                     const sp_cx aw[3], const sp_cx L[9], const double *grav, sp_cx F[3], sp_cx Mo[3])
+void sp_point_wrench(const sp_point *p, const sp_cx R[3], const sp_cx A[9], const sp_cx aw[3],
+                     const sp_cx L[9], const double *grav, sp_cx F[3], sp_cx Mo[3])
 {
     static const sp_cx ez[3] = {0, 0, 1};
     if (grav) { /* the weight m g at the centre of mass (DESIGN.md 8.8): no moment about it */

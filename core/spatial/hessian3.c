@@ -50,8 +50,9 @@ static void sp_child_step(sp_kin *k, int c, const double vc[6], double h)
  *   d wrench = (dF, dMo + (dth x aw) x F + aw x dF),
  * and the rows of the frame by N' (d(A' F), d(T' A' Mo)). */
 static void sp_rigid_apply(const sm_sub *b, const sp_point *p, const double A[9], const double *T,
-                           const double aw[3], const double F[3], const double Mo[3], const double dF[3],
-                           const double dMo[3], const double dth[3], double *gcol, double dW[6])
+                           const double aw[3], const double F[3], const double Mo[3],
+                           const double dF[3], const double dMo[3], const double dth[3],
+                           double *gcol, double dW[6])
 {
     double t[3], u[3], f[3], mo[3] = {0, 0, 0}, c[3], e[3];
     rot3_cross_r(dth, F, t);
@@ -67,7 +68,8 @@ static void sp_rigid_apply(const sm_sub *b, const sp_point *p, const double A[9]
     }
     for (int j = 0; j < b->m; j++) {
         const double *Nc = p->N + (size_t)p->ldn * j;
-        gcol[j] += Nc[0] * f[0] + Nc[1] * f[1] + Nc[2] * f[2] + Nc[3] * mo[0] + Nc[4] * mo[1] + Nc[5] * mo[2];
+        gcol[j] += Nc[0] * f[0] + Nc[1] * f[1] + Nc[2] * f[2] + Nc[3] * mo[0] + Nc[4] * mo[1] +
+                   Nc[5] * mo[2];
     }
     rot3_cross_r(dth, aw, t);
     rot3_cross_r(t, F, c);
@@ -90,9 +92,10 @@ static void sp_re(const sp_cx *z, int n, double *x)
  *   F = m P (R + aw + dh): dF = m P (dR + dth x (aw + dh)), dh = A Lambda c its offset mass;
  *   Mo = dh x F: dMo = (dth x dh) x F + dh x dF (the weight: dF = 0);
  *   rotary: Mo += y x e, y = X e, X = A Lambda Ic Lambda' A': dy = dth x y - X (dth x e). */
-static void sp_rigid_point(const sp_point *p, const double A[9], const double L[9], const double aw[3],
-                           const double dh[3], const double F[3], const double y[3], int grav,
-                           const double dR[3], const double dth[3], double dF[3], double dMo[3])
+static void sp_rigid_point(const sp_point *p, const double A[9], const double L[9],
+                           const double aw[3], const double dh[3], const double F[3],
+                           const double y[3], int grav, const double dR[3], const double dth[3],
+                           double dF[3], double dMo[3])
 {
     static const double ez[3] = {0, 0, 1};
     double t[3], a[3], c[3];
@@ -209,8 +212,8 @@ static void sp_rigid(const sm_model *m, sp_kin *k, int c)
                     sum += Pc[r + 6 * j] * vc[j];
                 dW[r] = sum;
             }
-            sp_rigid_apply(b, p, A, Tr, awr, Fc, Fc + 3, dW, dW + 3, v + 3, k->Gown + b->q0 + (size_t)n * kk,
-                           Psi + 6 * kk);
+            sp_rigid_apply(b, p, A, Tr, awr, Fc, Fc + 3, dW, dW + 3, v + 3,
+                           k->Gown + b->q0 + (size_t)n * kk, Psi + 6 * kk);
         }
     }
     memcpy(k->Psi + 36 * c, Psi, sizeof Psi);

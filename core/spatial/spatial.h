@@ -132,8 +132,8 @@ void sp_point_state(const sm_model *m, sp_kin *k, int pi, const sp_cx *q, int wa
                     sp_cx psi[3], sp_cx L[9], sp_cx T[9]);
 /** Force F and moment Mo (hub frame, added to what they hold) of the centrifugal potential (or of
  *  the weight, grav non-NULL) on point p at its local state (w, L) in a frame at (R, A), aw = A w. */
-void sp_point_wrench(const sp_point *p, const sp_cx R[3], const sp_cx A[9], const sp_cx aw[3], const sp_cx L[9],
-                     const double *grav, sp_cx F[3], sp_cx Mo[3]);
+void sp_point_wrench(const sp_point *p, const sp_cx R[3], const sp_cx A[9], const sp_cx aw[3],
+                     const sp_cx L[9], const double *grav, sp_cx F[3], sp_cx Mo[3]);
 /** The pose (R, A) of frame s from its parent's at complex q. */
 void sp_pose(const sm_model *m, sp_kin *k, int s, const sp_cx *q);
 /** The subtree wrench of frame s (points of s and the wrenches of its children). */
