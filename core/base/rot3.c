@@ -2,8 +2,10 @@
  * rot3.c — 3x3 rotations (rot3.h), real and complex: the exponential
  * map Lambda(psi) = exp(skew psi) of DESIGN.md 7.2 and its left tangent T
  * (d Lambda = skew(T d psi) Lambda), written so that every function is
- * analytic in psi (powers of psi.psi, no conjugates, series near zero):
- * frames3.c differentiates the kinematics by complex steps through them.
+ * analytic in psi (powers of psi.psi, no conjugates, series near zero), so
+ * that complex steps go through them (the tests' reference for the closed-form
+ * Jacobian of hessian3.c); and the derivative of T along a direction, real
+ * (rot3_dtangent), for that Jacobian.
  */
 #include "rot3.h"
 
@@ -68,6 +70,51 @@ void rot3_exp(const sp_cx psi[3], sp_cx L[9], sp_cx T[9])
         if (T)
             T[i] = id + c2 * K[i] + c3 * K2[i];
     }
+}
+
+/* Real c2, c3 of rot3_coeffs and their derivatives d/dt2 (the same series switch). */
+static void rot3_coeffs_d(double t2, double *c2, double *c3, double *d2, double *d3)
+{
+    if (fabs(t2) < ROT3_SERIES) {
+        /* c2 = sum x^k / (2k+2)!, c3 = sum x^k / (2k+3)!, x = -t2; d/dt2 = -sum k x^(k-1) / ... */
+        double p = 1, a = 0, b = 0, da = 0, db = 0, f2 = 2, f3 = 6;
+        for (int k = 0; k < 6; k++) {
+            a += p / f2;
+            b += p / f3;
+            if (k < 5) { /* the next term's derivative: -(k+1) x^k / (2k+4)!, / (2k+5)! */
+                double g2 = f2 * (2 * k + 3) * (2 * k + 4), g3 = f3 * (2 * k + 4) * (2 * k + 5);
+                da -= (k + 1) * p / g2;
+                db -= (k + 1) * p / g3;
+            }
+            p *= -t2;
+            f2 *= (2 * k + 3) * (2 * k + 4);
+            f3 *= (2 * k + 4) * (2 * k + 5);
+        }
+        *c2 = a, *c3 = b, *d2 = da, *d3 = db;
+        return;
+    }
+    double t = sqrt(t2), sn = sin(t), co = cos(t);
+    *c2 = (1 - co) / t2;
+    *c3 = (t - sn) / (t2 * t);
+    *d2 = (0.5 * t * sn - (1 - co)) / (t2 * t2);
+    *d3 = ((1 - co) * t - 3 * (t - sn)) / (2 * t2 * t2 * t);
+}
+
+void rot3_dtangent(const double psi[3], const double d[3], double dT[9])
+{
+    double t2 = psi[0] * psi[0] + psi[1] * psi[1] + psi[2] * psi[2], c2, c3, d2, d3;
+    rot3_coeffs_d(t2, &c2, &c3, &d2, &d3);
+    double dt2 = 2 * (psi[0] * d[0] + psi[1] * d[1] + psi[2] * d[2]), pd = 0.5 * dt2;
+    /* T = I + c2 K + c3 K^2, K = skew(psi), K^2 = psi psi' - t2 I; along d (D = skew(d)):
+     * dT = c2' dt2 K + c2 D + c3' dt2 K^2 + c3 (D K + K D), D K + K D = psi d' + d psi' - 2 (psi.d) I */
+    double K[9] = {0, psi[2], -psi[1], -psi[2], 0, psi[0], psi[1], -psi[0], 0};
+    double D[9] = {0, d[2], -d[1], -d[2], 0, d[0], d[1], -d[0], 0};
+    for (int j = 0; j < 3; j++)
+        for (int i = 0; i < 3; i++) {
+            double id = i == j ? 1.0 : 0.0;
+            double K2 = psi[i] * psi[j] - t2 * id, DK = psi[i] * d[j] + d[i] * psi[j] - 2 * pd * id;
+            dT[i + 3 * j] = d2 * dt2 * K[i + 3 * j] + c2 * D[i + 3 * j] + d3 * dt2 * K2 + c3 * DK;
+        }
 }
 
 void rot3_log(const double R[9], double v[3])

@@ -1,7 +1,8 @@
 /*
  * rot3.h — 3x3 rotations, real and complex (not installed; base layer: no model).  The complex
- * ones are analytic in their arguments, so the spatial kind differentiates its kinematics by
- * complex steps through them (DESIGN.md 7.2).  3x3 matrices column-major (a[i + 3 j]).
+ * ones are analytic in their arguments, so complex steps go through them (the tests take them as
+ * the reference for the spatial kind's closed-form Jacobian, DESIGN.md 7.2-7.3).  3x3 matrices
+ * column-major (a[i + 3 j]).
  */
 #ifndef SM_ROT3_H
 #define SM_ROT3_H
@@ -30,6 +31,8 @@ static inline sp_cx rot3_cx(double re, double im)
 /** L = Lambda(psi) = exp(skew psi) and T = its left tangent (d Lambda = skew(T d psi) Lambda);
  *  T may be NULL.  Analytic in psi (series near zero), so complex steps go through. */
 void rot3_exp(const sp_cx psi[3], sp_cx L[9], sp_cx T[9]);
+/** dT (real) = the derivative of the left tangent T(psi) along d (real psi). */
+void rot3_dtangent(const double psi[3], const double d[3], double dT[9]);
 /** Rotation vector (rad) of the real rotation matrix R (log map), |v| <= pi. */
 void rot3_log(const double R[9], double v[3]);
 

@@ -4,10 +4,10 @@
  * J (translation) and W (hub-frame rotation) of every point, the centrifugal
  * force g = dT0~/dq and its Jacobian H.
  *
- * Poses are computed in complex arithmetic: every quantity is analytic in q
- * (rot3.c), so H is obtained column by column by a complex step,
- * H e_j = Im g(q + i h e_j) / h, exact to round-off (no subtractive
- * cancellation), from the O(n) reverse recursion for g:
+ * Poses are computed in complex arithmetic, every quantity analytic in q
+ * (rot3.c): H = dg/dq was a complex step of this recursion up to solver
+ * 0.8.1 (hessian3.c now differentiates it in closed form; the tests keep the
+ * complex steps as their reference).  g comes from the O(n) reverse recursion:
  *   virtual work  dT0~ = sum_p F_p . dr_p + M_p . dtheta_p,
  *   F_p = m_p P r_p,  M_p = (X_p e_z) x e_z,  X_p = A_p I_p A_p',
  * accumulated leaves first as the wrench (F, M about R_s) of each subtree.
@@ -46,10 +46,9 @@ void sp_kin_free(sp_kin *k)
     free(k->bF);
     free(k->bq);
     free(k->Psi);
+    free(k->pb);
     free(k->Gown);
     free(k->v);
-    free(k->sw);
-    free(k->sstep);
     free(k->pt_ptr);
     free(k->pt_idx);
     free(k->ch_ptr);
@@ -127,16 +126,13 @@ int sp_kin_alloc(const sm_model *m, sp_kin *k, int jac)
     k->bF = calloc(6 * (size_t)S + 1, sizeof(sp_cx));
     k->bq = dm_vec((size_t)n + 1);
     k->Psi = dm_vec(36 * (size_t)S + 1);
+    k->pb = dm_vec(12 * (size_t)P + 1);
     k->Gown = dm_vec(6 * (size_t)n + 1);
     k->v = dm_vec(6 * (size_t)S + 1);
-    k->sw = calloc(24 * (size_t)P + 1, sizeof(sp_cx));
-    k->sstep = calloc((size_t)P + 1, sizeof(long long));
-    k->pert = -1;
-    k->pert_j = -1;
     if (!k->R || !k->A || !k->r || !k->psi || !k->AT || !k->dh || !k->cq || !k->cR || !k->cA ||
         !k->cF || !k->cg || !k->lw || !k->lpsi || !k->lL || !k->lT || !k->bR || !k->bA ||
-        !k->mark || !k->bF || !k->bq || !k->Psi || !k->Gown || !k->v || !k->sw || !k->sstep ||
-        sp_lists(m, k) || (jac && (dm_alloc(&k->JRT, n, 6 * S) || dm_alloc(&k->JW, n, 6 * P)))) {
+        !k->mark || !k->bF || !k->bq || !k->Psi || !k->pb || !k->Gown || !k->v || sp_lists(m, k) ||
+        (jac && (dm_alloc(&k->JRT, n, 6 * S) || dm_alloc(&k->JW, n, 6 * P)))) {
         sp_kin_free(k);
         return SM_NOMEM;
     }
@@ -163,51 +159,19 @@ static void sp_local(const sm_model *m, const sp_point *p, const sp_cx *q, sp_cx
 
 /*
  * Local state of point pi at the complex q: w = ub + N^u q_s, psi = N^psi q_s, L = Lambda(psi),
- * T = its tangent.  When k->lw holds the local state at the real base point of a complex-step
- * Jacobian (sp_centrifugal_jacobian), only the points of the perturbed substructure k->pert
- * are recomputed; the others are copied (the same operations on the same values: bitwise equal).
- * With the stepped coordinate j known (k->pert_j), w and psi of those points are the base values
- * with the imaginary parts h N_j: what sp_local's sum gives, as every other q_c is real (its
- * real parts are the base's operations on the base's values; its imaginary parts add N_c 0 = +-0
- * to +0 and N_j h once), in O(1) instead of O(m_s) (issue 27).  A stepped point's Lambda and T
- * are kept for the step (k->sw): a frame's end node is asked for them up to three times a step
- * (its own mass, its child's pose, its child's wrench), the same values each time.
+ * T = its tangent.  While k->lw.. hold the local state at the base of a Jacobian (k->cached,
+ * sp_base), they are copied: the closed-form derivatives (hessian3.c) ask for the base state only.
  */
 void sp_point_state(const sm_model *m, sp_kin *k, int pi, const sp_cx *q, int want_L, sp_cx w[3],
                     sp_cx psi[3], sp_cx L[9], sp_cx T[9])
 {
     const sp_point *p = &m->pt[pi];
-    if (k->cached && p->sub != k->pert) {
+    if (k->cached && p->sub >= 0) {
         memcpy(w, k->lw + 3 * pi, 3 * sizeof(sp_cx));
         memcpy(psi, k->lpsi + 3 * pi, 3 * sizeof(sp_cx));
         if (want_L) {
             memcpy(L, k->lL + 9 * pi, 9 * sizeof(sp_cx));
             memcpy(T, k->lT + 9 * pi, 9 * sizeof(sp_cx));
-        }
-        return;
-    }
-    if (k->cached && k->pert_j >= 0) {
-        sp_cx *sv = k->sw + 24 * (size_t)pi;
-        if (want_L && k->sstep[pi] == k->step) { /* evaluated already for this step */
-            memcpy(w, sv, 3 * sizeof(sp_cx));
-            memcpy(psi, sv + 3, 3 * sizeof(sp_cx));
-            memcpy(L, sv + 6, 9 * sizeof(sp_cx));
-            memcpy(T, sv + 15, 9 * sizeof(sp_cx));
-            return;
-        }
-        const double *Nj = p->N + (size_t)p->ldn * (k->pert_j - m->subs[p->sub].q0);
-        double h = cimag(q[k->pert_j]);
-        for (int i = 0; i < 3; i++) { /* + 0.0: a product -0 summed onto +0 is +0 */
-            w[i] = rot3_cx(creal(k->lw[3 * pi + i]), Nj[i] * h + 0.0);
-            psi[i] = rot3_cx(creal(k->lpsi[3 * pi + i]), Nj[3 + i] * h + 0.0);
-        }
-        if (want_L) {
-            rot3_exp(psi, L, T);
-            memcpy(sv, w, 3 * sizeof(sp_cx));
-            memcpy(sv + 3, psi, 3 * sizeof(sp_cx));
-            memcpy(sv + 6, L, 9 * sizeof(sp_cx));
-            memcpy(sv + 15, T, 9 * sizeof(sp_cx));
-            k->sstep[pi] = k->step;
         }
         return;
     }

@@ -1,21 +1,21 @@
 /*
- * hessian3.c — the spatial kind's centrifugal Jacobian H = dg/dq by complex step, exact to
- * round-off (DESIGN.md 7.3): a step in a coordinate of frame s goes through the points of s
- * only; below s the subtrees move rigidly (their 6-column responses computed once per
- * Jacobian, leaves first), above s the wrench is carried up the path.  Also the pieces of the
- * tree path's block Hessian (sp_hessian_base, _own, _end: tree3.c).
+ * hessian3.c — the spatial kind's centrifugal Jacobian H = dg/dq in closed form (DESIGN.md 7.3):
+ * a coordinate of frame s moves the points of s in their frame (sp_own_column: the rows of s);
+ * below s the subtrees move rigidly (their 6-column responses Gown, Psi computed once per
+ * Jacobian, leaves first: sp_rigid); the rows above s are H's symmetry (sp_fill_up).  Also the
+ * pieces of the tree path's block Hessian (sp_hessian_base, _own, _end: tree3.c).  Each
+ * derivative is frames3.c's wrench recursion (sp_point_wrench, sp_apply) differentiated by hand
+ * at the base state; they were complex steps through it up to solver 0.8.1, which
+ * tests/core/test_spatial_hessian.c still takes as its reference.
  *
- * How it fits: frames3.c evaluates poses, points and the wrench recursion at complex q; this
- * file perturbs that state one coordinate at a time.
+ * How it fits: frames3.c evaluates poses, points and the wrench recursion at q (sp_base keeps
+ * that state); this file differentiates it one coordinate at a time.
  */
 #include "spatial.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* Complex step: small enough that h^2 terms vanish against round-off. */
-#define SP_STEP 1e-20
 
 /* The rigid transport of a pose change v = (dR, dtheta) of frame p to its child frame c:
  * dR_c = dR + dtheta x (R_c - R_p), dtheta_c = dtheta (base poses). */
@@ -28,18 +28,6 @@ static void sp_transport(const sp_kin *k, int p, int c, const double v[6], doubl
     vc[1] = v[1] + v[5] * a[0] - v[3] * a[2];
     vc[2] = v[2] + v[3] * a[1] - v[4] * a[0];
     vc[3] = v[3], vc[4] = v[4], vc[5] = v[5];
-}
-
-/* The child wrench of c stepped by its pose change vc: F_c = bF_c + i h Psi_c vc. */
-static void sp_child_step(sp_kin *k, int c, const double vc[6], double h)
-{
-    const double *Ps = k->Psi + 36 * c;
-    for (int r = 0; r < 6; r++) {
-        double s = 0;
-        for (int j = 0; j < 6; j++)
-            s += Ps[r + 6 * j] * vc[j];
-        k->cF[6 * c + r] = k->bF[6 * c + r] + _Complex_I * h * s;
-    }
 }
 
 /* A point's share of a rigid motion's response, one direction: the point's force F and moment
@@ -183,6 +171,11 @@ static void sp_rigid(const sm_model *m, sp_kin *k, int c)
             rot3_mv_r(Lr, u, v);
             rot3_mv_r(A, v, y);
         }
+        double *pb = k->pb + 12 * (size_t)pi; /* for the own columns (sp_own_column) */
+        memcpy(pb, Fr, sizeof Fr);
+        memcpy(pb + 3, Mr, sizeof Mr);
+        memcpy(pb + 6, dh, sizeof dh);
+        memcpy(pb + 9, y, sizeof y);
         for (int kk = 0; kk < 6; kk++) {
             double v[6] = {0, 0, 0, 0, 0, 0}, dF[3], dMo[3];
             v[kk] = 1;
@@ -219,7 +212,129 @@ static void sp_rigid(const sm_model *m, sp_kin *k, int c)
     memcpy(k->Psi + 36 * c, Psi, sizeof Psi);
 }
 
-/* The base of the complex steps at the real q (= k->cq): local state of every point (k->lw..),
+/*
+ * Column j (a coordinate of frame s) of H in the rows of s, in closed form, into col (m_s), and
+ * the pose change v_c of each child c of s (k->v), from the base (sp_base: k->pb, lw.., bA, bF,
+ * Psi).  A step dq_j moves the points of s in their frame: dw = N^u_j, dpsi = N^psi_j, so
+ * dLambda = skew(om) Lambda with om = T dpsi, and with A and R of s fixed:
+ *   d dh = A (om x Lambda c),  dF = m P (A dw + d dh) (the weight: 0),
+ *   dMo = d dh x F + dh x dF,  rotary: dy = A (om x z - Lambda Ic Lambda' (om x A' e_z)),
+ *   z = A' y, dMo += dy x e_z;
+ * sp_apply's rows change by N' (A' dF, dT' A' Mo + T' A' dMo), dT = rot3_dtangent(psi, dpsi).
+ * A child c at node e of s moves rigidly by v_c = (A dw_e, A T_e dpsi_e): its wrench by Psi_c v_c.
+ * It was a complex step of the frame's wrench recursion, child poses included (issue 27).
+ */
+static void sp_own_column(const sm_model *m, sp_kin *k, int s, int j, double *col)
+{
+    static const double ez[3] = {0, 0, 1};
+    const sm_sub *b = &m->subs[s];
+    int jj = j - b->q0, grav = m->gravity;
+    double A[9];
+    sp_re(k->bA + 9 * s, 9, A);
+    for (int i = 0; i < b->m; i++)
+        col[i] = 0;
+    for (int t = k->pt_ptr[s]; t < k->pt_ptr[s + 1]; t++) {
+        int pi = k->pt_idx[t];
+        const sp_point *p = &m->pt[pi];
+        const double *Nj = p->N + (size_t)p->ldn * jj, *pb = k->pb + 12 * (size_t)pi;
+        int rot = p->has_Ic || p->has_c;
+        double dF[3] = {0, 0, 0}, dMo[3] = {0, 0, 0}, u[3], v[3], f[3], mo[3] = {0, 0, 0};
+        if (!rot) {
+            if (p->mass != 0 && !grav) {
+                rot3_mv_r(A, Nj, u);
+                dF[0] = p->mass * u[0];
+                dF[1] = p->mass * u[1];
+            }
+        } else {
+            double psi[3], T[9], L[9], om[3], ddh[3] = {0, 0, 0}, a[3], c[3];
+            sp_re(k->lpsi + 3 * pi, 3, psi);
+            sp_re(k->lT + 9 * pi, 9, T);
+            sp_re(k->lL + 9 * pi, 9, L);
+            rot3_mv_r(T, Nj + 3, om);
+            if (p->has_c) { /* d dh = A (om x Lambda c), Lambda c = A' dh */
+                rot3_tmv_r(A, pb + 6, a);
+                rot3_cross_r(om, a, c);
+                rot3_mv_r(A, c, ddh);
+            }
+            if (p->mass != 0) {
+                if (!grav) {
+                    rot3_mv_r(A, Nj, u);
+                    dF[0] = p->mass * (u[0] + ddh[0]);
+                    dF[1] = p->mass * (u[1] + ddh[1]);
+                }
+                if (p->has_c) {
+                    rot3_cross_r(ddh, pb, dMo);
+                    rot3_cross_r(pb + 6, dF, c);
+                    for (int i = 0; i < 3; i++)
+                        dMo[i] += c[i];
+                }
+            }
+            if (p->has_Ic && !grav) { /* dy = A (om x z - L Ic L' (om x A' e)) */
+                double z[3], ae[3] = {A[2], A[5], A[8]}, w1[3], w2[3], dy[3];
+                rot3_tmv_r(A, pb + 9, z);
+                rot3_cross_r(om, ae, w1);
+                rot3_tmv_r(L, w1, w2);
+                rot3_mv_r(p->Ic, w2, w1);
+                rot3_mv_r(L, w1, w2);
+                rot3_cross_r(om, z, w1);
+                for (int i = 0; i < 3; i++)
+                    w1[i] -= w2[i];
+                rot3_mv_r(A, w1, dy);
+                rot3_cross_r(dy, ez, c);
+                for (int i = 0; i < 3; i++)
+                    dMo[i] += c[i];
+            }
+            double dT[9], am[3];
+            rot3_dtangent(psi, Nj + 3, dT);
+            rot3_tmv_r(A, pb + 3, am); /* dmo = dT' A' Mo + T' A' dMo */
+            rot3_tmv_r(dT, am, mo);
+            rot3_tmv_r(A, dMo, u);
+            rot3_tmv_r(T, u, v);
+            for (int i = 0; i < 3; i++)
+                mo[i] += v[i];
+        }
+        rot3_tmv_r(A, dF, f);
+        for (int c = 0; c < b->m; c++) {
+            const double *Nc = p->N + (size_t)p->ldn * c;
+            col[c] += Nc[0] * f[0] + Nc[1] * f[1] + Nc[2] * f[2] + Nc[3] * mo[0] + Nc[4] * mo[1] +
+                      Nc[5] * mo[2];
+        }
+    }
+    for (int t = k->ch_ptr[s]; t < k->ch_ptr[s + 1]; t++) { /* the children move rigidly */
+        int ch = k->ch_idx[t], pi = m->subs[ch].root;
+        const sp_point *p = &m->pt[pi];
+        const double *Nj = p->N + (size_t)p->ldn * jj, *Pc = k->Psi + 36 * ch;
+        double psi[3], T[9], dT[9], om[3], dW[6], Fc[6], f[3], mo[3], u[3], w[3];
+        double *vc = k->v + 6 * ch;
+        sp_re(k->lpsi + 3 * pi, 3, psi);
+        sp_re(k->lT + 9 * pi, 9, T);
+        sp_re(k->bF + 6 * ch, 6, Fc);
+        rot3_mv_r(A, Nj, vc); /* dR_c = A dw_e, dth_c = A T_e dpsi_e */
+        rot3_mv_r(T, Nj + 3, om);
+        rot3_mv_r(A, om, vc + 3);
+        for (int r = 0; r < 6; r++) {
+            double sum = 0;
+            for (int i = 0; i < 6; i++)
+                sum += Pc[r + 6 * i] * vc[i];
+            dW[r] = sum;
+        }
+        rot3_tmv_r(A, dW, f);
+        rot3_dtangent(psi, Nj + 3, dT);
+        rot3_tmv_r(A, Fc + 3, u);
+        rot3_tmv_r(dT, u, mo);
+        rot3_tmv_r(A, dW + 3, u);
+        rot3_tmv_r(T, u, w);
+        for (int i = 0; i < 3; i++)
+            mo[i] += w[i];
+        for (int c = 0; c < b->m; c++) {
+            const double *Nc = p->N + (size_t)p->ldn * c;
+            col[c] += Nc[0] * f[0] + Nc[1] * f[1] + Nc[2] * f[2] + Nc[3] * mo[0] + Nc[4] * mo[1] +
+                      Nc[5] * mo[2];
+        }
+    }
+}
+
+/* The base of the Jacobian at the real q (= k->cq): local state of every point (k->lw..),
  * poses (bR, bA), subtree wrenches (bF), and the rigid-motion responses Gown, Psi.  Poses and
  * wrenches are those of g at q: a Newton tangent follows a residual at the same q, whose
  * sp_centrifugal left them in bR, bA, bF (the same operations on the same values). */
@@ -227,7 +342,6 @@ static void sp_base(const sm_model *m, const double *q, sp_kin *k)
 {
     size_t S = (size_t)m->n_subs;
     k->cached = 0;
-    k->pert = -1;
     if (k->bvalid && !memcmp(k->bq, q, (size_t)m->n * sizeof(double))) {
         memcpy(k->cR, k->bR, 3 * S * sizeof(sp_cx));
         memcpy(k->cA, k->bA, 9 * S * sizeof(sp_cx));
@@ -250,51 +364,18 @@ static void sp_base(const sm_model *m, const double *q, sp_kin *k)
 }
 
 /*
- * Column j of H, a coordinate of frame s (k->cq[j] = q_j + i h), into col (n): the rows of s and
- * of its subtree.  The points of s take the complex step themselves; each child frame c of s
- * takes the pose change v_c of the step, and everything below it moves rigidly: rows of a
- * descendant t are Gown_t v_t with v_t transported down the tree, the child's wrench is
- * bF_c + i h Psi_c v_c.  The rows of the ancestors of s are H's symmetry (sp_fill_up); rows of
- * the frames off the path and outside the subtree are zero.
+ * Column j of H, a coordinate of frame s, into col (n): the rows of s (sp_own_column) and of its
+ * subtree: each child frame c of s takes the pose change v_c of the step, and everything below
+ * it moves rigidly, rows of a descendant t being Gown_t v_t with v_t transported down the tree.
+ * The rows of the ancestors of s are H's symmetry (sp_fill_up); rows of the frames off the path
+ * and outside the subtree are zero.
  */
-/* The step of sp_step within frame s: its children take their pose changes (k->v), and g_s and
- * the wrench of s are recomputed at the complex q (k->cg rows of s, k->cF of s). */
-static void sp_step_own(const sm_model *m, sp_kin *k, int s, double h)
-{
-    const sp_cx *q = k->cq;
-    const sm_sub *bs = &m->subs[s];
-    k->pert = s;
-    for (int t = k->ch_ptr[s]; t < k->ch_ptr[s + 1]; t++) {
-        int c = k->ch_idx[t];
-        const sp_cx *Ac = k->cA + 9 * c;
-        double *v = k->v + 6 * c;
-        sp_pose(m, k, c, q);
-        for (int i = 0; i < 3; i++)
-            v[i] = cimag(k->cR[3 * c + i]) / h;
-        /* skew(dtheta) = Im(A) Re(A)' / h: dtheta = (S21, S02, S10) */
-        for (int i = 0; i < 3; i++) {
-            int r = (i + 2) % 3, cc = (i + 1) % 3; /* S(r, cc) with (r, cc) = (2,1), (0,2), (1,0) */
-            double sum = 0;
-            for (int l = 0; l < 3; l++)
-                sum += cimag(Ac[r + 3 * l]) * creal(Ac[cc + 3 * l]);
-            v[3 + i] = sum / h;
-        }
-        sp_child_step(k, c, v, h);
-        memcpy(k->cR + 3 * c, k->bR + 3 * c, 3 * sizeof(sp_cx));
-        memcpy(k->cA + 9 * c, k->bA + 9 * c, 9 * sizeof(sp_cx));
-    }
-    memset(k->cg + bs->q0, 0, (size_t)bs->m * sizeof(sp_cx));
-    sp_frame_wrench(m, k, s, q);
-}
-
-static void sp_step(const sm_model *m, sp_kin *k, int s, double h, double *col)
+static void sp_step(const sm_model *m, sp_kin *k, int s, int j, double *col)
 {
     const sm_sub *bs = &m->subs[s];
     int S = m->n_subs, n = m->n;
     memset(col, 0, (size_t)n * sizeof(double));
-    sp_step_own(m, k, s, h);
-    for (int i = 0; i < bs->m; i++)
-        col[bs->q0 + i] = cimag(k->cg[bs->q0 + i]) / h;
+    sp_own_column(m, k, s, j, col + bs->q0);
     k->mark[s] = 1;
     for (int t = s + 1; t < S; t++) { /* the subtree of s: parents come first */
         int p = m->subs[t].parent;
@@ -314,7 +395,6 @@ static void sp_step(const sm_model *m, sp_kin *k, int s, double h, double *col)
     }
     for (int t = s; t < S; t++)
         k->mark[t] = 0;
-    k->pert = -1;
 }
 
 /*
@@ -343,20 +423,7 @@ void sp_hessian_base(const sm_model *m, const double *q, sp_kin *k)
 
 void sp_hessian_own(const sm_model *m, sp_kin *k, int s, int j, double *col)
 {
-    const sm_sub *b = &m->subs[s];
-    double qj = creal(k->cq[j]), h = SP_STEP * fmax(1.0, fabs(qj));
-    k->cq[j] = qj + _Complex_I * h;
-    k->pert_j = j;
-    k->step++;
-    sp_step_own(m, k, s, h);
-    for (int i = 0; i < b->m; i++)
-        col[i] = cimag(k->cg[b->q0 + i]) / h;
-    k->cq[j] = qj;
-    k->pert_j = -1;
-    memcpy(k->cF + 6 * s, k->bF + 6 * s, 6 * sizeof(sp_cx));
-    for (int t = k->ch_ptr[s]; t < k->ch_ptr[s + 1]; t++)
-        memcpy(k->cF + 6 * k->ch_idx[t], k->bF + 6 * k->ch_idx[t], 6 * sizeof(sp_cx));
-    k->pert = -1;
+    sp_own_column(m, k, s, j, col);
 }
 
 void sp_hessian_end(const sm_model *m, sp_kin *k)
@@ -374,14 +441,8 @@ void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat
     for (int s = 0; s < m->n_subs; s++) {
         const sm_sub *b = &m->subs[s];
         for (int j = b->q0; j < b->q0 + b->m; j++) {
-            double h = SP_STEP * fmax(1.0, fabs(q[j]));
-            k->cq[j] = q[j] + _Complex_I * h;
-            k->pert_j = j;
-            k->step++;
-            sp_step(m, k, s, h, &DM(H, 0, j));
+            sp_step(m, k, s, j, &DM(H, 0, j));
             sp_fill_up(m, s, j, H);
-            k->cq[j] = q[j];
-            k->pert_j = -1;
         }
     }
     memcpy(k->cF, k->bF, 6 * (size_t)m->n_subs * sizeof(sp_cx));

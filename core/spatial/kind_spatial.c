@@ -4,8 +4,8 @@
  *
  * How it fits: the table smi_kind_spatial routes the shared code (mesh.c, modes.c,
  * equilibrium.c, linsys.c, sweep.c) to the spatial modules of spatial.h — mesh3.c
- * (checks, axes, orientations), modes3.c (bases, points), frames3.c (poses, g, H by
- * complex step), lin3.c (f_g, tangent, M*, C*, nodal outputs), tree3.c (the block form).
+ * (checks, axes, orientations), modes3.c (bases, points), frames3.c (poses, g),
+ * hessian3.c (H in closed form), lin3.c (f_g, tangent, M*, C*, nodal outputs), tree3.c (the block form).
  * Each entry makes the calls the spatial path made before the table, in the same order.
  */
 #include "element.h"

@@ -13,7 +13,7 @@
  *   modes3.c  complete component-mode bases (+ static attachment modes under
  *             modes_per_frame), element maps T_e, d_e, the points
  *   frames3.c poses along the frame tree, J and W, the centrifugal force g and
- *             its Jacobian H (complex step: exact to round-off)
+ *             its Jacobian H (hessian3.c, in closed form)
  *   lin3.c    F(q), the Newton tangent, M*, C*, K*, nodal outputs
  * The Newton continuation (equilibrium.c), the eigen-analysis (eigen.c) and
  * the sweep (sweep.c) are shared with the planar path.
@@ -103,7 +103,7 @@ typedef struct sp_kin {
     int *ch_ptr, *ch_idx; /* child frames of s, likewise */
     /* complex scratch of the centrifugal recursion */
     sp_cx *cq, *cR, *cA, *cF, *cg; /* n, 3S, 9S, 6S (subtree wrench), n */
-    /* base state of the complex steps of sp_centrifugal_jacobian (frames3.c) */
+    /* base state of the Jacobian (sp_centrifugal_jacobian, sp_hessian_base: hessian3.c) */
     sp_cx *lw, *lpsi, *lL, *lT; /* 3P, 3P, 9P, 9P: w, psi, Lambda(psi), T(psi) of every point */
     sp_cx *bR, *bA;     /* 3S, 9S: the poses at the base point */
     int *mark;          /* S: 1 for the frames of the subtree being stepped */
@@ -112,21 +112,17 @@ typedef struct sp_kin {
                            subtree wrenches (sp_centrifugal or a Jacobian's base left them) */
     int bvalid;
     double *Psi;        /* 36S: d wrench_c / d pose_c under a rigid motion of c's subtree (6x6 each) */
+    double *pb;         /* 12P: F, Mo, dh = A Lambda c, y = X e_z of each point at the base, real */
     double *Gown;       /* n x 6: d g_c / d pose_c, rows of c, under that rigid motion */
     double *v;          /* 6S: pose change of each frame below a stepped coordinate */
     int cached;         /* 1 while lw.. hold the base state */
-    int pert;           /* the substructure stepped (-1: none) */
-    int pert_j;         /* the coordinate stepped, of substructure pert (-1: none) */
-    long long step;     /* count of the coordinates stepped: set pert_j, then step++ */
-    sp_cx *sw;          /* 24P: w, psi, Lambda, T of the points of the stepped frame at step */
-    long long *sstep;   /* P: the step sw holds point p's state for (0: none) */
 } sp_kin;
 
 /** Allocate k for m; jac: also the dense Jacobians JRT, JW (O(n (S + P))).  SM_OK or SM_NOMEM. */
 int sp_kin_alloc(const sm_model *m, sp_kin *k, int jac);
 /** Free and zero k; safe on a zeroed one. */
 void sp_kin_free(sp_kin *k);
-/* frames3.c's complex-state pieces that hessian3.c perturbs (not for other files). */
+/* frames3.c's pieces that hessian3.c differentiates (and the tests step: not for other files). */
 /** w, psi (and with want_L Lambda(psi), T(psi)) of point pi at complex q. */
 void sp_point_state(const sm_model *m, sp_kin *k, int pi, const sp_cx *q, int want_L, sp_cx w[3],
                     sp_cx psi[3], sp_cx L[9], sp_cx T[9]);
@@ -150,19 +146,19 @@ void sp_eval(const sm_model *m, const double *q, sp_kin *k);
 /** g (n) = d T0~/dq, T0~ = sum_p 1/2 m_p |P r_p|^2 + 1/2 e_z' A_p I_p A_p' e_z (DESIGN.md 7.3):
  *  the centrifugal force is Omega^2 g.  Uses the complex scratch of k. */
 void sp_centrifugal(const sm_model *m, const double *q, sp_kin *k, double *g);
-/** H (n x n) = dg/dq at q, column by column by complex step (exact to round-off); a step in a
- *  coordinate of frame s goes through the points of s only: below s the subtrees move rigidly
- *  (their 6-column responses are computed once per Jacobian, leaves first), above s the wrench
- *  is carried up the path. */
+/** H (n x n) = dg/dq at q, column by column in closed form (hessian3.c): a coordinate of frame s
+ *  moves the points of s (their rows), below s the subtrees move rigidly (their 6-column
+ *  responses are computed once per Jacobian, leaves first), the rows above s are H's symmetry. */
 void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat *H);
 
-/** The complex-step base of the block Hessian (tree3.c): local state, poses, subtree wrenches and
- *  the rigid-motion responses Gown (rows of each frame, n x 6) and Psi at q. */
+/** The base of the block Hessian (tree3.c): local state, poses, subtree wrenches, each point's
+ *  force and moment (k->pb) and the rigid-motion responses Gown (rows of each frame, n x 6) and
+ *  Psi at q; k->cached until sp_hessian_end. */
 void sp_hessian_base(const sm_model *m, const double *q, sp_kin *k);
 /** col (m_s) = rows of frame s of H e_j for coordinate j of frame s (after sp_hessian_base): the
- *  points of s take the step, its children the pose change, their subtrees move rigidly (Psi). */
+ *  points of s move, its children take the pose change, their subtrees move rigidly (Psi). */
 void sp_hessian_own(const sm_model *m, sp_kin *k, int s, int j, double *col);
-/** End of the block Hessian: the complex scratch back to the base. */
+/** End of the block Hessian: the scratch back to the base (k->cached 0). */
 void sp_hessian_end(const sm_model *m, sp_kin *k);
 
 /* ------------------------------------------------------------- lin3.c */

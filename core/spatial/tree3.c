@@ -16,8 +16,8 @@
  * pose change of t, and by symmetry of H the rows above by its transpose.  So
  *     H = Hd + G U + U' G',  Hd = blockdiag(H_ss),  G = blockdiag(Gown_s),  U = dy/dq,
  * i.e. Hl_s = [0, Gown_s'; Gown_s, H_ss] on (dy_s, dq_s): every entry of H (the dense
- * complex-step Jacobian of frames3.c) comes out, with H_ss by m_s complex steps through the
- * points of s alone.  The Newton tangent or K* is then
+ * Jacobian of hessian3.c) comes out, with H_ss from the m_s closed-form columns of the points
+ * of s alone (sp_hessian_own).  The Newton tangent or K* is then
  *     Kl_s = -Omega^2 Hl_s + [0 0; 0 K_s + Kg_s]
  * (the spatial g already holds the J' P J part that the planar form adds as -Omega^2 Ml).
  */
