@@ -32,7 +32,9 @@
  *         test_spatial_kin.c's potential()), not from sp_centrifugal or its complex-step Jacobian.
  *   0. The rigid-motion responses Gown, Psi of every frame (hessian3.c's sp_rigid, in closed
  *      form since solver 0.8.2) against complex steps of the frame's own wrench recursion
- *      (sp_frame_wrench, what sp_rigid did before), to 1e-12 (measured ~3e-16; dropping the
+ *      (sp_frame_wrench, what sp_rigid did before), and the whole H = dg/dq (closed form: own
+ *      columns, rigid responses, symmetry) against complex steps of the whole recursion for g
+ *      (sp_centrifugal_c at q + i h e_j), each to 1e-12 (measured ~3e-16; dropping the
  *      rotary-inertia term of dMo gives 1e-5).
  *   1. K* = lin3_tangent(frozen 1, s) against K + (central second differences of the
  *      non-elastic part Pi - 1/2 q'K q, steps h and h/2, Richardson extrapolation); the
@@ -390,6 +392,37 @@ static void point_rates(ctx *c, double *x, const double *q0, int j, double h, do
     }
 }
 
+/* ------------------------------------------------------------------ dT */
+
+/* rot3_dtangent (real, closed form) against the complex step of rot3_exp's T along d, at
+ * rotations from 0.01 to 2.5 rad: both sides of rot3.c's series switch (|psi| = 0.1). */
+static void dtangent_check(void)
+{
+    const double mags[7] = {0.01, 0.0999, 0.1001, 0.3, 1.0, 2.5, 0.0};
+    const double h = 1e-20;
+    double worst = 0;
+    for (int a = 0; a < 7; a++) {
+        double u[3] = {0.6, -0.48, 0.64}, d[3] = {-0.3, 0.9, 0.2}, psi[3], dT[9];
+        sp_cx cp[3], L[9], T[9];
+        for (int i = 0; i < 3; i++) {
+            psi[i] = mags[a] * u[i];
+            cp[i] = psi[i] + _Complex_I * h * d[i];
+        }
+        rot3_exp(cp, L, T);
+        rot3_dtangent(psi, d, dT);
+        double e = 0, nr = 0;
+        for (int i = 0; i < 9; i++) {
+            double r = cimag(T[i]) / h;
+            e = fmax(e, fabs(dT[i] - r));
+            nr = fmax(nr, fabs(r));
+        }
+        worst = fmax(worst, e / nr);
+    }
+    snprintf(tag, sizeof tag, "rot3");
+    check(worst, 1e-12,
+          "dT of rot3_dtangent = complex step of rot3_exp's T, |psi| 0 .. 2.5 rad (max rel.)");
+}
+
 /* ------------------------------------------------------------------ rigid-motion responses */
 
 /* Gown and Psi of sp_hessian_base (hessian3.c: in closed form) against complex steps of each
@@ -451,6 +484,28 @@ static void rigid_reference(const sm_model *m, const double *q, sp_kin *k, doubl
     sp_hessian_end(m, k);
     free(G);
     free(Ps);
+}
+
+/* H = dg/dq of sp_centrifugal_jacobian (closed form) against the complex step of the whole
+ * recursion, column by column: Im g(q + i h e_j) / h by sp_centrifugal_c.  Relative 2-norm. */
+static double jacobian_reference(const sm_model *m, const double *q, sp_kin *k, dmat *H)
+{
+    int n = m->n;
+    const double h = 1e-20;
+    double d = 0, s = 0;
+    sp_centrifugal_jacobian(m, q, k, H);
+    for (int j = 0; j < n; j++) {
+        for (int i = 0; i < n; i++)
+            k->cq[i] = q[i];
+        k->cq[j] = q[j] + _Complex_I * h;
+        sp_centrifugal_c(m, k);
+        for (int i = 0; i < n; i++) {
+            double r = cimag(k->cg[i]) / h;
+            d += (DM(H, i, j) - r) * (DM(H, i, j) - r);
+            s += r * r;
+        }
+    }
+    return sqrt(d) / fmax(sqrt(s), 1e-300);
 }
 
 /* ------------------------------------------------------------------ one case */
@@ -534,6 +589,8 @@ static void run_case(const spec *sp, sm_frame_scheme fr, int param, sm_mass_mode
           "0. Gown (d g_c under the rigid motions of frame c) = complex steps (rel. 2-norm)");
     check(erp, 1e-12,
           "0. Psi (d wrench_c under the rigid motions of frame c) = complex steps (rel. 2-norm)");
+    check(jacobian_reference(m, q0, &kp, &A1), 1e-12,
+          "0. H = dg/dq (closed form) = complex steps of the whole recursion for g (rel. 2-norm)");
 
     /* ---- K from the element matrices, P* and G per element */
     double ek = 0, nk = 0, eP = 0, nP = 0, eG = 0, nG = 0;
@@ -747,6 +804,7 @@ done:
 
 int main(void)
 {
+    dtangent_check();
     double pc = 15 * PI / 180;
     const spec cases[5] = {
         {"a: R2 mast parallel to the spin axis", 15, 3, {{0.5, 0, 0}, {3.5, 0, 0}, {3.5, 0, 2}}, 2,
