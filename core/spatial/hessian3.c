@@ -337,16 +337,13 @@ static void sp_own_column(const sm_model *m, sp_kin *k, int s, int j, double *co
 /* The base of the Jacobian at the real q (= k->cq): local state of every point (k->lw..),
  * poses (bR, bA), subtree wrenches (bF), and the rigid-motion responses Gown, Psi.  Poses and
  * wrenches are those of g at q: a Newton tangent follows a residual at the same q, whose
- * sp_centrifugal left them in bR, bA, bF (the same operations on the same values). */
+ * sp_centrifugal left them in bR, bA, bF (the same operations on the same values).  The
+ * derivatives read the base only (b*, lw.., pb); cR, cA, cF are scratch. */
 static void sp_base(const sm_model *m, const double *q, sp_kin *k)
 {
     size_t S = (size_t)m->n_subs;
     k->cached = 0;
-    if (k->bvalid && !memcmp(k->bq, q, (size_t)m->n * sizeof(double))) {
-        memcpy(k->cR, k->bR, 3 * S * sizeof(sp_cx));
-        memcpy(k->cA, k->bA, 9 * S * sizeof(sp_cx));
-        memcpy(k->cF, k->bF, 6 * S * sizeof(sp_cx));
-    } else {
+    if (!(k->bvalid && !memcmp(k->bq, q, (size_t)m->n * sizeof(double)))) {
         sp_centrifugal_c(m, k);
         memcpy(k->bR, k->cR, 3 * S * sizeof(sp_cx));
         memcpy(k->bA, k->cA, 9 * S * sizeof(sp_cx));
@@ -428,7 +425,7 @@ void sp_hessian_own(const sm_model *m, sp_kin *k, int s, int j, double *col)
 
 void sp_hessian_end(const sm_model *m, sp_kin *k)
 {
-    memcpy(k->cF, k->bF, 6 * (size_t)m->n_subs * sizeof(sp_cx));
+    (void)m;
     k->cached = 0;
 }
 
@@ -445,6 +442,5 @@ void sp_centrifugal_jacobian(const sm_model *m, const double *q, sp_kin *k, dmat
             sp_fill_up(m, s, j, H);
         }
     }
-    memcpy(k->cF, k->bF, 6 * (size_t)m->n_subs * sizeof(sp_cx));
     k->cached = 0;
 }

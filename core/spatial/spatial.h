@@ -158,7 +158,7 @@ void sp_hessian_base(const sm_model *m, const double *q, sp_kin *k);
 /** col (m_s) = rows of frame s of H e_j for coordinate j of frame s (after sp_hessian_base): the
  *  points of s move, its children take the pose change, their subtrees move rigidly (Psi). */
 void sp_hessian_own(const sm_model *m, sp_kin *k, int s, int j, double *col);
-/** End of the block Hessian: the scratch back to the base (k->cached 0). */
+/** End of the block Hessian: k->cached 0, so that sp_point_state evaluates again. */
 void sp_hessian_end(const sm_model *m, sp_kin *k);
 
 /* ------------------------------------------------------------- lin3.c */
