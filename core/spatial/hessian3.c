@@ -30,6 +30,18 @@ static void sp_transport(const sp_kin *k, int p, int c, const double v[6], doubl
     vc[3] = v[3], vc[4] = v[4], vc[5] = v[5];
 }
 
+/* rows (m_s) += N' (f, mo): a force f and moment mo (frame axes) at point p into the rows of its
+ * frame b, as sp_apply adds them (the same sum per row). */
+static void sp_rows_add(const sm_sub *b, const sp_point *p, const double f[3], const double mo[3],
+                        double *rows)
+{
+    for (int j = 0; j < b->m; j++) {
+        const double *Nc = p->N + (size_t)p->ldn * j;
+        rows[j] += Nc[0] * f[0] + Nc[1] * f[1] + Nc[2] * f[2] + Nc[3] * mo[0] + Nc[4] * mo[1] +
+                   Nc[5] * mo[2];
+    }
+}
+
 /* A point's share of a rigid motion's response, one direction: the point's force F and moment
  * Mo (hub frame) change by dF, dMo while its frame turns by dth and T (NULL: no moment) maps
  * it into its coordinates.  With the frame's A and the point's offset aw = A w (both at rest in
@@ -54,11 +66,7 @@ static void sp_rigid_apply(const sm_sub *b, const sp_point *p, const double A[9]
         rot3_tmv_r(A, u, t);
         rot3_tmv_r(T, t, mo);
     }
-    for (int j = 0; j < b->m; j++) {
-        const double *Nc = p->N + (size_t)p->ldn * j;
-        gcol[j] += Nc[0] * f[0] + Nc[1] * f[1] + Nc[2] * f[2] + Nc[3] * mo[0] + Nc[4] * mo[1] +
-                   Nc[5] * mo[2];
-    }
+    sp_rows_add(b, p, f, mo, gcol);
     rot3_cross_r(dth, aw, t);
     rot3_cross_r(t, F, c);
     rot3_cross_r(aw, dF, e);
@@ -294,11 +302,7 @@ static void sp_own_column(const sm_model *m, sp_kin *k, int s, int j, double *co
                 mo[i] += v[i];
         }
         rot3_tmv_r(A, dF, f);
-        for (int c = 0; c < b->m; c++) {
-            const double *Nc = p->N + (size_t)p->ldn * c;
-            col[c] += Nc[0] * f[0] + Nc[1] * f[1] + Nc[2] * f[2] + Nc[3] * mo[0] + Nc[4] * mo[1] +
-                      Nc[5] * mo[2];
-        }
+        sp_rows_add(b, p, f, mo, col);
     }
     for (int t = k->ch_ptr[s]; t < k->ch_ptr[s + 1]; t++) { /* the children move rigidly */
         int ch = k->ch_idx[t], pi = m->subs[ch].root;
@@ -326,11 +330,7 @@ static void sp_own_column(const sm_model *m, sp_kin *k, int s, int j, double *co
         rot3_tmv_r(T, u, w);
         for (int i = 0; i < 3; i++)
             mo[i] += w[i];
-        for (int c = 0; c < b->m; c++) {
-            const double *Nc = p->N + (size_t)p->ldn * c;
-            col[c] += Nc[0] * f[0] + Nc[1] * f[1] + Nc[2] * f[2] + Nc[3] * mo[0] + Nc[4] * mo[1] +
-                      Nc[5] * mo[2];
-        }
+        sp_rows_add(b, p, f, mo, col);
     }
 }
 
