@@ -368,6 +368,12 @@ typedef struct tree_ws {
     int sym;            /* fronts factored by dsytrf (1) or dgetrf (0) */
     int neg;            /* negative eigenvalues of the factored matrix (sym) */
     int det_sign;       /* sign of its determinant (LU) */
+    /* The warm start of a spatial sweep's eigen-analysis (eigen_tree.c, issue 27): warm (n, or
+     * NULL) the sum of the last accepted modes' vectors on this workspace, warm_ok 1 when it is
+     * set, warm_next 1 when the next eig_solve_tree may start from it (smi_lin_warm; cleared
+     * by that call). */
+    double *warm;
+    int warm_ok, warm_next;
 } tree_ws;
 
 enum { TREE_K = 0, TREE_M = 1, TREE_C = 2 };

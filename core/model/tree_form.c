@@ -62,6 +62,7 @@ void tree_free(tree_ws *t)
     free(t->u);
     free(t->v);
     free(t->work);
+    free(t->warm);
     memset(t, 0, sizeof *t);
 }
 

@@ -210,6 +210,12 @@ int smi_lin_eigen(const sm_model *m, smi_lin *L, const sm_progress *pr, sm_eig_o
     return eig_solve(m->n, &L->D.M, &L->D.C, &L->D.K, m->opt.coriolis, m->opt.modes, e);
 }
 
+void smi_lin_warm(smi_lin *L, int chain)
+{
+    if (L->tree)
+        L->t.warm_next = chain;
+}
+
 int smi_lin_negative(const smi_lin *L)
 {
     return L->tree ? L->t.neg : 0;

@@ -54,6 +54,10 @@ int smi_lin_finite(const smi_lin *L);
  *  and SM_OK returned); pr (may be NULL): the tree path's stop callback. */
 int smi_lin_eigen(const sm_model *m, smi_lin *L, const sm_progress *pr, sm_eig_out *e,
                   int *fallback);
+/** Whether the next smi_lin_eigen on L may start from the modes of the last one on L (chain 1:
+ *  a sweep's consecutive speeds, sweep_pool.h's SWEEP_WARM_CHUNK) or starts cold (chain 0).  Only a
+ *  spatial model's tree path uses it (eig_solve_tree); each smi_lin_eigen reads it once. */
+void smi_lin_warm(smi_lin *L, int chain);
 /** Negative eigenvalues of K* found by the tree path's factorisation (0 on the dense path). */
 int smi_lin_negative(const smi_lin *L);
 /** yr, yi (node_dof n_nodes each) = nodal motion of the modal vector xr + i xi at the last

@@ -2,8 +2,9 @@
  * sweep_pool.c — worker threads that finish a sweep's cases at their equilibria (sweep_pool.h).
  *
  * sweep_run (sweep.c) queues each speed's case once its equilibrium is found; threads - 1
- * workers, each with its own smi_lin, take the cases in queue order, and the calling thread
- * takes its share once the continuation is done.  A case is written by one thread only after it
+ * workers, each with its own smi_lin, take the chunks of SWEEP_WARM_CHUNK cases in queue order
+ * and finish a chunk's cases one after the other as they are queued (warm starts), and the
+ * calling thread takes its share once the continuation is done.  A case is written by one thread only after it
  * is queued, under the pool's lock, so the hand-over orders the calling thread's writes (speed,
  * equilibrium status) before the worker's.  The model is read only.  Stopping: an atomic flag
  * the workers' progress callback returns (the tree path's Krylov iteration asks it), checked
@@ -29,8 +30,8 @@ struct sweep_pool {
     pthread_mutex_t mu;
     pthread_cond_t more;  /* a case was queued, or the pool closes */
     pthread_cond_t ended; /* a case was finished */
-    pool_job *jobs;       /* queue: jobs[head .. tail) wait, [0 .. head) taken */
-    int head, tail;
+    pool_job *jobs;       /* queue: jobs[0 .. tail) queued; chunks from head on not taken */
+    int head, tail, n_cases;
     int running, finished, closing;
     int rc; /* first SM_NOMEM / SM_CANCELED of a thread */
     atomic_int stop;
@@ -44,29 +45,44 @@ static int pool_stop_cb(void *user, int done, int total)
     return atomic_load(&((sweep_pool *)user)->stop);
 }
 
-/* Take the next queued case (lock held); 0 when none waits. */
-static int pool_take(sweep_pool *p, pool_job *job)
+/* Take the next chunk whose first case is queued (lock held): *start its first case; 0 when
+ * none. */
+static int pool_take(sweep_pool *p, int *start)
 {
-    if (p->head == p->tail)
+    if (p->head >= p->tail)
         return 0;
-    *job = p->jobs[p->head++];
+    *start = p->head;
+    p->head += SWEEP_WARM_CHUNK;
     p->running++;
     return 1;
 }
 
-/* Finish job on L (lock not held), then record its end (takes the lock). */
-static void pool_run(sweep_pool *p, pool_job *job, smi_lin *L, const sm_progress *pr)
+/* Finish the chunk from case start on L, each case once it is queued (takes the lock to wait
+ * and to record each end; not held on entry). */
+static void pool_run(sweep_pool *p, int start, smi_lin *L, const sm_progress *pr)
 {
-    int rc = atomic_load(&p->stop) ? SM_CANCELED : sweep_case_finish(p->m, job->q, L, pr, job->c);
-    free(job->q);
-    job->q = NULL;
+    int end = start + SWEEP_WARM_CHUNK < p->n_cases ? start + SWEEP_WARM_CHUNK : p->n_cases;
     pthread_mutex_lock(&p->mu);
-    p->running--;
-    p->finished++;
-    if (rc < 0 && p->rc == SM_OK) {
-        p->rc = rc;
-        atomic_store(&p->stop, 1);
+    for (int j = start; j < end; j++) {
+        while (j >= p->tail && !p->closing)
+            pthread_cond_wait(&p->more, &p->mu);
+        if (j >= p->tail)
+            break; /* closing: the sweep stopped before queueing it */
+        pool_job job = p->jobs[j];
+        p->jobs[j].q = NULL;
+        pthread_mutex_unlock(&p->mu);
+        smi_lin_warm(L, j > start);
+        int rc = atomic_load(&p->stop) ? SM_CANCELED : sweep_case_finish(p->m, job.q, L, pr, job.c);
+        free(job.q);
+        pthread_mutex_lock(&p->mu);
+        p->finished++;
+        if (rc < 0 && p->rc == SM_OK) {
+            p->rc = rc;
+            atomic_store(&p->stop, 1);
+        }
+        pthread_cond_broadcast(&p->ended);
     }
+    p->running--;
     pthread_cond_broadcast(&p->ended);
     pthread_mutex_unlock(&p->mu);
 }
@@ -76,20 +92,19 @@ static void *pool_worker(void *arg)
     sweep_pool *p = arg;
     smi_lin *L = NULL;
     sm_progress pr = {pool_stop_cb, p, 0, 0};
-    int rc = smi_lin_new(p->m, SMI_USE_MODES, tree_use(p->m), &L);
-    pool_job job;
+    int rc = smi_lin_new(p->m, SMI_USE_MODES, tree_use(p->m), &L), start;
     pthread_mutex_lock(&p->mu);
     if (rc < 0) { /* the other threads finish the cases */
         pthread_mutex_unlock(&p->mu);
         return NULL;
     }
     for (;;) {
-        while (p->head == p->tail && !p->closing)
+        while (p->head >= p->tail && !p->closing)
             pthread_cond_wait(&p->more, &p->mu);
-        if (!pool_take(p, &job))
+        if (!pool_take(p, &start))
             break; /* closing, nothing left */
         pthread_mutex_unlock(&p->mu);
-        pool_run(p, &job, L, &pr);
+        pool_run(p, start, L, &pr);
         pthread_mutex_lock(&p->mu);
     }
     pthread_mutex_unlock(&p->mu);
@@ -104,6 +119,7 @@ int sweep_pool_new(const sm_model *m, int threads, int n_cases, sweep_pool **out
     if (!p)
         return SM_NOMEM;
     p->m = m;
+    p->n_cases = n_cases;
     p->n_workers = threads - 1 < n_cases ? threads - 1 : n_cases;
     p->jobs = calloc((size_t)(n_cases > 0 ? n_cases : 1), sizeof *p->jobs);
     p->th = calloc((size_t)(p->n_workers > 0 ? p->n_workers : 1), sizeof *p->th);
@@ -134,7 +150,7 @@ int sweep_pool_add(sweep_pool *p, sm_case *c, const double *q)
     p->jobs[p->tail].c = c;
     p->jobs[p->tail].q = copy;
     p->tail++;
-    pthread_cond_signal(&p->more);
+    pthread_cond_broadcast(&p->more); /* a chunk's owner may wait for this very case */
     pthread_mutex_unlock(&p->mu);
     return SM_OK;
 }
@@ -168,12 +184,12 @@ static void pool_wait(sweep_pool *p)
 
 int sweep_pool_finish(sweep_pool *p, smi_lin *L, sm_progress *pr)
 {
-    pool_job job;
+    int start;
     pthread_mutex_lock(&p->mu);
     for (;;) {
-        if (pool_take(p, &job)) {
+        if (pool_take(p, &start)) {
             pthread_mutex_unlock(&p->mu);
-            pool_run(p, &job, L, pr);
+            pool_run(p, start, L, pr);
             pthread_mutex_lock(&p->mu);
         } else if (p->running > 0) {
             pool_wait(p);
@@ -207,7 +223,7 @@ void sweep_pool_free(sweep_pool *p)
     pthread_mutex_unlock(&p->mu);
     for (int i = 0; i < p->started; i++)
         pthread_join(p->th[i], NULL);
-    for (int i = p->head; i < p->tail; i++) /* left by a stop */
+    for (int i = 0; i < p->tail; i++) /* left by a stop (a taken case's is NULL) */
         free(p->jobs[i].q);
     pthread_cond_destroy(&p->more);
     pthread_cond_destroy(&p->ended);
