@@ -352,6 +352,8 @@ typedef struct tree_ws {
     double *Ml;         /* local M* blocks */
     double *Cl;         /* local C* blocks without the factor 2 Omega */
     double *F;          /* fronts: factors after tree_factor */
+    double *Finv;       /* spatial symmetric fronts: F_s^-1 itself (tree_factor, read by the
+                           solves of tree_solve; NULL until needed), offsets fr_off */
     double *X;          /* (m_s+2d) x d per s: F_s^-1 E_w */
     int *ipiv;          /* pivots of the fronts */
     double *lk;         /* 4 per s: cos, sin of the parent's angle and A' w_e (the link T_s);

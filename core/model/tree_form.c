@@ -51,6 +51,7 @@ void tree_free(tree_ws *t)
     free(t->Ml);
     free(t->Cl);
     free(t->F);
+    free(t->Finv);
     free(t->X);
     free(t->ipiv);
     free(t->lk);

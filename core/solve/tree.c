@@ -192,6 +192,127 @@ static inline void tree_sytrs_ln(int n, const double *restrict A, const int *res
     }
 }
 
+/*
+ * Z = F^-1 (n x n, column-major) from the Bunch-Kaufman factors of dsytrf ('L', 1-based ipiv) in
+ * A: the steps of tree_sytrs_ln on the n columns of the identity at once, rows of the row-major
+ * scratch W (n x n) as the unit of work, so that each step is a vectorised row operation instead
+ * of n scalar ones.  Spatial symmetric fronts (tree_factor) keep Z, and a solve with the front is
+ * then the product Z b (tree_front_solve): 324 multiply-adds in vector registers for an 18 x 18
+ * front instead of two triangular sweeps with pivots (issue 27).
+ */
+static inline void tree_sytri_ln(int n, const double *restrict A, const int *restrict ip,
+                                 double *restrict W, double *restrict Z)
+{
+    for (int i = 0; i < n; i++)
+        for (int r = 0; r < n; r++)
+            W[i * n + r] = i == r;
+    for (int k = 0; k < n;) { /* L D Y = P I */
+        const double *ak = A + (size_t)k * n;
+        double *wk = W + k * n;
+        if (ip[k] > 0) {
+            int kp = ip[k] - 1;
+            double *wp = W + kp * n;
+            for (int r = 0; r < n; r++) {
+                double t = wk[r];
+                wk[r] = wp[r], wp[r] = t;
+            }
+            for (int i = k + 1; i < n; i++) {
+                double a = ak[i], *wi = W + i * n;
+                for (int r = 0; r < n; r++)
+                    wi[r] -= a * wk[r];
+            }
+            double d = 1.0 / ak[k];
+            for (int r = 0; r < n; r++)
+                wk[r] *= d;
+            k++;
+        } else {
+            const double *ak1 = ak + n;
+            double *wk1 = wk + n, *wp = W + (-ip[k] - 1) * n;
+            for (int r = 0; r < n; r++) {
+                double t = wk1[r];
+                wk1[r] = wp[r], wp[r] = t;
+            }
+            for (int i = k + 2; i < n; i++) {
+                double a0 = ak[i], a1 = ak1[i], *wi = W + i * n;
+                for (int r = 0; r < n; r++)
+                    wi[r] = (wi[r] - a0 * wk[r]) - a1 * wk1[r];
+            }
+            double akm1k = ak[k + 1], akm1 = ak[k] / akm1k, akk = ak1[k + 1] / akm1k,
+                   den = akm1 * akk - 1.0;
+            for (int r = 0; r < n; r++) {
+                double bkm1 = wk[r] / akm1k, bkk = wk1[r] / akm1k;
+                wk[r] = (akk * bkm1 - bkk) / den;
+                wk1[r] = (akm1 * bkk - bkm1) / den;
+            }
+            k += 2;
+        }
+    }
+    for (int k = n - 1; k >= 0;) { /* L' X = Y, then P' X */
+        const double *ak = A + (size_t)k * n;
+        double *wk = W + k * n;
+        for (int i = k + 1; i < n; i++) {
+            double a = ak[i];
+            const double *wi = W + i * n;
+            for (int r = 0; r < n; r++)
+                wk[r] -= a * wi[r];
+        }
+        if (ip[k] > 0) {
+            double *wp = W + (ip[k] - 1) * n;
+            for (int r = 0; r < n; r++) {
+                double t = wk[r];
+                wk[r] = wp[r], wp[r] = t;
+            }
+            k--;
+        } else {
+            const double *ak1 = ak - n;
+            double *wk1 = wk - n, *wp = W + (-ip[k] - 1) * n;
+            for (int i = k + 1; i < n; i++) {
+                double a = ak1[i];
+                const double *wi = W + i * n;
+                for (int r = 0; r < n; r++)
+                    wk1[r] -= a * wi[r];
+            }
+            for (int r = 0; r < n; r++) {
+                double t = wk[r];
+                wk[r] = wp[r], wp[r] = t;
+            }
+            k -= 2;
+        }
+    }
+    for (int i = 0; i < n; i++) /* W holds Z row by row */
+        for (int r = 0; r < n; r++)
+            Z[(size_t)r * n + i] = W[i * n + r];
+}
+
+/* tree_sytri_ln with a spatial one-element frame's size as a constant (tree_sytrs_l). */
+static void tree_sytri(int n, const double *A, const int *ip, double *W, double *Z)
+{
+    if (n == 18)
+        tree_sytri_ln(18, A, ip, W, Z);
+    else
+        tree_sytri_ln(n, A, ip, W, Z);
+}
+
+/* Fronts up to this size keep their inverse (spatial symmetric fronts; larger ones solve with
+ * the factors). */
+#define TREE_ZMAX 64
+
+/* b = Z b for Z = F_s^-1 (n x n, column-major): the solve with a spatial symmetric front; tmp n. */
+static inline void tree_zmv_n(int n, const double *restrict Z, double *restrict b,
+                              double *restrict tmp)
+{
+    for (int i = 0; i < n; i++)
+        tmp[i] = 0;
+    for (int j = 0; j < n; j++) {
+        const double *restrict zj = Z + (size_t)j * n;
+        double bj = b[j];
+        for (int i = 0; i < n; i++)
+            tmp[i] += zj[i] * bj;
+    }
+    for (int i = 0; i < n; i++)
+        b[i] = tmp[i];
+}
+
 /* tree_sytrs_ln for one front; a spatial one-element frame's front (6 own + 2 x 6 pose
  * coordinates) with its size a constant, so that the compiler drops the run-time loop bounds:
  * the same operations in the same order (issue 27). */
@@ -268,6 +389,15 @@ static int tree_front_solve(const tree_ws *t, int s, int nb, int nrhs, double *B
 {
     const double *F = t->F + t->fr_off[s];
     const int *ip = t->ipiv + t->v_off[s];
+    if (t->sym && t->Finv && nrhs == 1 && nb <= TREE_ZMAX) { /* spatial: the inverse's product */
+        double tmp[TREE_ZMAX];
+        const double *Z = t->Finv + t->fr_off[s];
+        if (nb == 18)
+            tree_zmv_n(18, Z, B, tmp);
+        else
+            tree_zmv_n(nb, Z, B, tmp);
+        return SM_OK;
+    }
     if (!t->fixed_bits) {
         for (int j = 0; j < nrhs; j++)
             if (t->sym)
@@ -283,7 +413,7 @@ static int tree_front_solve(const tree_ws *t, int s, int nb, int nrhs, double *B
 
 /* tree_factor with the pose size d a parameter (the constant 6 for a spatial model, as
  * tree_solve_d: the Schur updates' loops of length d unroll, each sum in the same order). */
-static inline int tree_factor_d(const sm_model *m, tree_ws *t, int sym, int d)
+static inline int tree_factor_fronts(const sm_model *m, tree_ws *t, int sym, int d, double *Wz)
 {
     int S = m->n_subs, neg = 0, sign = (d * S) % 2 ? -1 : 1, rc;
     double *W = t->work;
@@ -305,6 +435,8 @@ static inline int tree_factor_d(const sm_model *m, tree_ws *t, int sym, int d)
             if ((rc = dm_lapack_status(info, SM_SINGULAR)) < 0)
                 return rc;
             neg += dm_sytrf_negative(nb, F, ip);
+            if (Wz && nb <= TREE_ZMAX)
+                tree_sytri(nb, F, ip, Wz, t->Finv + t->fr_off[s]);
         } else {
             rc = !t->fixed_bits
                      ? tree_getrf(nb, F, ip)
@@ -319,12 +451,17 @@ static inline int tree_factor_d(const sm_model *m, tree_ws *t, int sym, int d)
                     sign = -sign;
             }
         }
-        /* X_s = F_s^-1 E_w */
-        memset(X, 0, (size_t)d * nb * sizeof(double));
-        for (int i = 0; i < d; i++)
-            X[(size_t)i * nb + mm + d + i] = 1.0;
-        if ((rc = tree_front_solve(t, s, nb, d, X)) < 0)
-            return rc;
+        /* X_s = F_s^-1 E_w: the w columns of the inverse where it is kept, else solved */
+        if (sym && Wz && nb <= TREE_ZMAX) {
+            memcpy(X, t->Finv + t->fr_off[s] + (size_t)(mm + d) * nb,
+                   (size_t)d * nb * sizeof(double));
+        } else {
+            memset(X, 0, (size_t)d * nb * sizeof(double));
+            for (int i = 0; i < d; i++)
+                X[(size_t)i * nb + mm + d + i] = 1.0;
+            if ((rc = tree_front_solve(t, s, nb, d, X)) < 0)
+                return rc;
+        }
         const sm_sub *b = &m->subs[s];
         if (b->parent < 0)
             continue;
@@ -352,6 +489,26 @@ static inline int tree_factor_d(const sm_model *m, tree_ws *t, int sym, int d)
     return SM_OK;
 }
 
+/* tree_factor_fronts with Wz, the scratch of tree_sytri, when a spatial model's symmetric fronts
+ * keep their inverses (t->Finv; without the memory the solves use the factors). */
+static inline int tree_factor_d(const sm_model *m, tree_ws *t, int sym, int d)
+{
+    double *Wz = NULL;
+    if (sym && !t->fixed_bits) {
+        if (!t->Finv)
+            t->Finv = malloc((t->fr_off[m->n_subs] ? t->fr_off[m->n_subs] : 1) * sizeof(double));
+        if (t->Finv)
+            Wz = malloc((size_t)TREE_ZMAX * TREE_ZMAX * sizeof(double));
+    }
+    if (!Wz) {
+        free(t->Finv);
+        t->Finv = NULL;
+    }
+    int rc = tree_factor_fronts(m, t, sym, d, Wz);
+    free(Wz);
+    return rc;
+}
+
 int tree_factor(const sm_model *m, tree_ws *t, int sym)
 {
     if (t->d == 6)
@@ -369,6 +526,37 @@ static const double *tree_solve_coupling(const sm_model *m, tree_ws *t, int s)
         return t->Cc + t->c_off[s];
     tree_coupling(m, t, s, t->work);
     return t->work;
+}
+
+/* tree_solve's coupling steps of one frame (d pose coordinates, a parent front's nc = m_p + d
+ * rows, the child's front nb): zp -= C' yw going up; zs -= X (C zp) coming down.  Inlined with
+ * the sizes of a one-element spatial frame under another (6, 12, 18) as constants, so that the
+ * loops unroll: the same sums in the same order (issue 27). */
+static inline void tree_couple_up(int nc, int d, const double *restrict C,
+                                  const double *restrict yw, double *restrict zp)
+{
+    for (int j = 0; j < nc; j++) {
+        double acc = C[d * j] * yw[0];
+        for (int r = 1; r < d; r++)
+            acc += C[d * j + r] * yw[r];
+        zp[j] -= acc;
+    }
+}
+
+static inline void tree_couple_down(int nc, int nb, int d, const double *restrict C,
+                                    const double *restrict zp, const double *restrict X,
+                                    double *restrict zs)
+{
+    double cz[6] = {0, 0, 0, 0, 0, 0};
+    for (int j = 0; j < nc; j++)
+        for (int i = 0; i < d; i++)
+            cz[i] += C[d * j + i] * zp[j];
+    for (int r = 0; r < nb; r++) {
+        double acc = X[r] * cz[0];
+        for (int i = 1; i < d; i++)
+            acc += X[(size_t)i * nb + r] * cz[i];
+        zs[r] -= acc;
+    }
 }
 
 /* tree_solve with the pose size d a parameter: tree_solve passes the constant 6 for a spatial
@@ -394,12 +582,10 @@ static inline int tree_solve_d(const sm_model *m, tree_ws *t, double *x, int d)
         int nc = m->subs[b->parent].m + d;
         double *zp = t->z + t->v_off[b->parent], *yw = zs + mm + d;
         const double *C = tree_solve_coupling(m, t, s);
-        for (int j = 0; j < nc; j++) {
-            double acc = C[d * j] * yw[0];
-            for (int r = 1; r < d; r++)
-                acc += C[d * j + r] * yw[r];
-            zp[j] -= acc;
-        }
+        if (d == 6 && nc == 12)
+            tree_couple_up(12, 6, C, yw, zp);
+        else
+            tree_couple_up(nc, d, C, yw, zp);
     }
     for (int s = 0; s < S; s++) { /* back: z_s = y_s - X_s (C z_p) */
         const sm_sub *b = &m->subs[s];
@@ -409,16 +595,10 @@ static inline int tree_solve_d(const sm_model *m, tree_ws *t, double *x, int d)
             int nc = m->subs[b->parent].m + d;
             const double *zp = t->z + t->v_off[b->parent], *X = t->X + (size_t)d * t->v_off[s];
             const double *C = tree_solve_coupling(m, t, s);
-            double cz[6] = {0, 0, 0, 0, 0, 0};
-            for (int j = 0; j < nc; j++)
-                for (int i = 0; i < d; i++)
-                    cz[i] += C[d * j + i] * zp[j];
-            for (int r = 0; r < nb; r++) {
-                double acc = X[r] * cz[0];
-                for (int i = 1; i < d; i++)
-                    acc += X[(size_t)i * nb + r] * cz[i];
-                zs[r] -= acc;
-            }
+            if (d == 6 && nc == 12 && nb == 18)
+                tree_couple_down(12, 18, 6, C, zp, X, zs);
+            else
+                tree_couple_down(nc, nb, d, C, zp, X, zs);
         }
         memcpy(x + b->q0, zs, (size_t)mm * sizeof(double));
     }
