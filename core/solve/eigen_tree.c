@@ -3,7 +3,9 @@
  * form (tree.c): shift-invert Arnoldi at zero on the companion form with
  * O(n) operator applications, then the small projected quadratic problem
  * (DESIGN.md 1.4, "Large models").  The dense eigen-analysis is eigen.c;
- * eig_solve_tree falls back to it when K* is indefinite or Arnoldi stalls.
+ * eig_solve_tree falls back to it when K* is indefinite or Arnoldi stalls.  In a spatial sweep a
+ * speed after the first of its chunk starts from the previous speed's modes (smi_lin_warm,
+ * sweep_pool.h; DESIGN.md 2.1, solver 0.8.3).
  */
 #include "internal.h"
 
