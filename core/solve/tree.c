@@ -297,20 +297,19 @@ static void tree_sytri(int n, const double *A, const int *ip, double *W, double 
  * the factors). */
 #define TREE_ZMAX 64
 
-/* b = Z b for Z = F_s^-1 (n x n, column-major): the solve with a spatial symmetric front; tmp n. */
-static inline void tree_zmv_n(int n, const double *restrict Z, double *restrict b,
-                              double *restrict tmp)
+/* y = A x for A n x n (column-major), each y[i] the sum over j in order: a spatial front's
+ * solve with its inverse (tree_front_solve) and tree_apply's local product. */
+static inline void tree_matvec(int n, const double *restrict A, const double *restrict x,
+                               double *restrict y)
 {
     for (int i = 0; i < n; i++)
-        tmp[i] = 0;
+        y[i] = 0;
     for (int j = 0; j < n; j++) {
-        const double *restrict zj = Z + (size_t)j * n;
-        double bj = b[j];
+        const double *restrict aj = A + (size_t)j * n;
+        double xj = x[j];
         for (int i = 0; i < n; i++)
-            tmp[i] += zj[i] * bj;
+            y[i] += aj[i] * xj;
     }
-    for (int i = 0; i < n; i++)
-        b[i] = tmp[i];
 }
 
 /* tree_sytrs_ln for one front; a spatial one-element frame's front (6 own + 2 x 6 pose
@@ -393,9 +392,10 @@ static int tree_front_solve(const tree_ws *t, int s, int nb, int nrhs, double *B
         double tmp[TREE_ZMAX];
         const double *Z = t->Finv + t->fr_off[s];
         if (nb == 18)
-            tree_zmv_n(18, Z, B, tmp);
+            tree_matvec(18, Z, B, tmp);
         else
-            tree_zmv_n(nb, Z, B, tmp);
+            tree_matvec(nb, Z, B, tmp);
+        memcpy(B, tmp, (size_t)nb * sizeof(double));
         return SM_OK;
     }
     if (!t->fixed_bits) {
@@ -664,14 +664,7 @@ void tree_apply(const sm_model *m, tree_ws *t, int which, const double *x, doubl
         }
         memcpy(in, t->u + (size_t)d * s, (size_t)d * sizeof(double));
         memcpy(in + d, x + b->q0, (size_t)b->m * sizeof(double));
-        for (int i = 0; i < l; i++)
-            out[i] = 0;
-        for (int j = 0; j < l; j++) {
-            const double *restrict Lj = Ls + (size_t)j * l;
-            double xj = in[j];
-            for (int i = 0; i < l; i++)
-                out[i] += Lj[i] * xj;
-        }
+        tree_matvec(l, Ls, in, out);
         for (int i = 0; i < d; i++)
             t->v[(size_t)d * s + i] = scale * out[i];
         for (int i = 0; i < b->m; i++)
