@@ -52,8 +52,9 @@
  * previous speed's modes, each normalised, plus this fraction of the generic start, which keeps
  * every direction in the Krylov space (a mode that was not among the previous speed's lowest
  * costs a few more vectors: its start component is 1e-3 instead of O(1)).  On the 288-coordinate
- * blade every speed is accepted at 24 vectors where cold starts needed 32 at 10 of 21 speeds:
- * -9 % instructions for 21 speeds, -11 % for 101 (issue 27, DESIGN.md 2.1). */
+ * blade, with the projections of a cold start, every warm speed was accepted at 24 vectors where
+ * cold starts needed 32 at 10 of 21 speeds: -9 % instructions for 21 speeds, -11 % for 101
+ * (issue 27, DESIGN.md 2.1). */
 #define EIG_TREE_WARM_COLD 1e-3
 
 /* ||x|| (n): a spatial model's plain sum of squares (no division per entry: dm_norm's scaling

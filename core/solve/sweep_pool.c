@@ -4,9 +4,9 @@
  * sweep_run (sweep.c) queues each speed's case once its equilibrium is found; threads - 1
  * workers, each with its own smi_lin, take the chunks of SWEEP_WARM_CHUNK cases in queue order
  * and finish a chunk's cases one after the other as they are queued (warm starts), and the
- * calling thread takes its share once the continuation is done.  A case is written by one thread only after it
- * is queued, under the pool's lock, so the hand-over orders the calling thread's writes (speed,
- * equilibrium status) before the worker's.  The model is read only.  Stopping: an atomic flag
+ * calling thread takes its share once the continuation is done.  A case is written by one
+ * thread only after it is queued, under the pool's lock, so the hand-over orders the calling
+ * thread's writes (speed, equilibrium status) before the worker's.  The model is read only.  Stopping: an atomic flag
  * the workers' progress callback returns (the tree path's Krylov iteration asks it), checked
  * again before each case.
  */
@@ -57,9 +57,27 @@ static int pool_take(sweep_pool *p, int *start)
     return 1;
 }
 
+/* The calling thread's progress callback with the cases finished (lock held; released while
+ * the callback runs: it may take its time); a stop asked before the last case stops the pool. */
+static void pool_ask(sweep_pool *p, sm_progress *pr)
+{
+    int done = p->finished, total = pr->total;
+    if (!pr->cb || atomic_load(&p->stop))
+        return;
+    pthread_mutex_unlock(&p->mu);
+    pr->done = done;
+    int stop = pr->cb(pr->user, done, total) && done < total;
+    pthread_mutex_lock(&p->mu);
+    if (stop && p->rc == SM_OK) {
+        p->rc = SM_CANCELED;
+        atomic_store(&p->stop, 1);
+    }
+}
+
 /* Finish the chunk from case start on L, each case once it is queued (takes the lock to wait
- * and to record each end; not held on entry). */
-static void pool_run(sweep_pool *p, int start, smi_lin *L, const sm_progress *pr)
+ * and to record each end; not held on entry).  caller: the calling thread, whose callback
+ * (pool_ask) is asked after each case; a worker's pr is the stop flag's. */
+static void pool_run(sweep_pool *p, int start, smi_lin *L, sm_progress *pr, int caller)
 {
     int end = start + SWEEP_WARM_CHUNK < p->n_cases ? start + SWEEP_WARM_CHUNK : p->n_cases;
     pthread_mutex_lock(&p->mu);
@@ -81,6 +99,8 @@ static void pool_run(sweep_pool *p, int start, smi_lin *L, const sm_progress *pr
             atomic_store(&p->stop, 1);
         }
         pthread_cond_broadcast(&p->ended);
+        if (caller && j + 1 < end)
+            pool_ask(p, pr);
     }
     p->running--;
     pthread_cond_broadcast(&p->ended);
@@ -104,7 +124,7 @@ static void *pool_worker(void *arg)
         if (!pool_take(p, &start))
             break; /* closing, nothing left */
         pthread_mutex_unlock(&p->mu);
-        pool_run(p, start, L, &pr);
+        pool_run(p, start, L, &pr, 0);
         pthread_mutex_lock(&p->mu);
     }
     pthread_mutex_unlock(&p->mu);
@@ -189,24 +209,14 @@ int sweep_pool_finish(sweep_pool *p, smi_lin *L, sm_progress *pr)
     for (;;) {
         if (pool_take(p, &start)) {
             pthread_mutex_unlock(&p->mu);
-            pool_run(p, start, L, pr);
+            pool_run(p, start, L, pr, 1);
             pthread_mutex_lock(&p->mu);
         } else if (p->running > 0) {
             pool_wait(p);
         } else {
             break;
         }
-        int done = p->finished, total = pr->total;
-        if (pr->cb && !atomic_load(&p->stop)) { /* asked without the lock: it may take its time */
-            pthread_mutex_unlock(&p->mu);
-            pr->done = done;
-            int stop = pr->cb(pr->user, done, total) && done < total;
-            pthread_mutex_lock(&p->mu);
-            if (stop && p->rc == SM_OK) {
-                p->rc = SM_CANCELED;
-                atomic_store(&p->stop, 1);
-            }
-        }
+        pool_ask(p, pr);
     }
     int rc = p->rc;
     pthread_mutex_unlock(&p->mu);
