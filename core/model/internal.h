@@ -406,6 +406,10 @@ int tree_factor(const sm_model *m, tree_ws *t, int sym);
 int tree_solve(const sm_model *m, tree_ws *t, double *x);
 /** y = A x for A = K (TREE_K), M* (TREE_M) or C* (TREE_C) of the last tree_assemble; x, y: n. */
 void tree_apply(const sm_model *m, tree_ws *t, int which, const double *x, double *y);
+/** y[i] = A_i x for the n_ops operators which[i] (TREE_K, TREE_M, TREE_C): one forward recursion
+ *  for all of them, each y[i] the bits of tree_apply's (issue 27). */
+void tree_apply_n(const sm_model *m, tree_ws *t, int n_ops, const int *which, const double *x,
+                  double *const *y);
 /** u (d S) = the frame pose increments dy/dq x (forward recursion along the tree, links of the
  *  last assembly). */
 void tree_forward(const sm_model *m, const tree_ws *t, const double *x, double *u);

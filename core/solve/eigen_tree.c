@@ -140,16 +140,12 @@ static double eig_tree_residual(const sm_model *m, tree_ws *t, int coriolis, dou
 {
     int n = m->n;
     double *Mr = s, *Mi = s + n, *Cr = s + 2 * n, *Ci = s + 3 * n, *Kr = s + 4 * n, *Ki = s + 5 * n;
-    tree_apply(m, t, TREE_M, xr, Mr);
-    tree_apply(m, t, TREE_M, xi, Mi);
-    tree_apply(m, t, TREE_K, xr, Kr);
-    tree_apply(m, t, TREE_K, xi, Ki);
-    if (coriolis) {
-        tree_apply(m, t, TREE_C, xr, Cr);
-        tree_apply(m, t, TREE_C, xi, Ci);
-    } else {
+    const int ops[3] = {TREE_M, TREE_K, TREE_C};
+    double *const yr[3] = {Mr, Kr, Cr}, *const yi[3] = {Mi, Ki, Ci};
+    tree_apply_n(m, t, coriolis ? 3 : 2, ops, xr, yr); /* one forward recursion a vector */
+    tree_apply_n(m, t, coriolis ? 3 : 2, ops, xi, yi);
+    if (!coriolis)
         memset(Cr, 0, 2 * (size_t)n * sizeof(double));
-    }
     return eig_residual_terms(n, lr, li, s);
 }
 
@@ -398,10 +394,10 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const
                 continue;
             for (int i = 0; i < n; i++)
                 v[i] /= vn;
-            tree_apply(m, t, TREE_M, v, MV + (size_t)nv * n);
-            tree_apply(m, t, TREE_K, v, KV + (size_t)nv * n);
-            if (coriolis)
-                tree_apply(m, t, TREE_C, v, CV + (size_t)nv * n);
+            /* one forward recursion for the three products (issue 27: -2 of 5 a vector) */
+            const int ops[3] = {TREE_M, TREE_K, TREE_C};
+            double *const ys[3] = {MV + (size_t)nv * n, KV + (size_t)nv * n, CV + (size_t)nv * n};
+            tree_apply_n(m, t, coriolis ? 3 : 2, ops, v, ys);
             nv++;
         }
         double res, moved = INFINITY;

@@ -644,7 +644,9 @@ static void tree_local12(const double *restrict Ls, const double *restrict us,
         ys[i] = scale * out[6 + i];
 }
 
-void tree_apply(const sm_model *m, tree_ws *t, int which, const double *x, double *y)
+/* y = A x for the operator `which` from the pose increments t->u of x (tree_forward's, read only
+ * here: several operators share them, tree_apply_n). */
+static void tree_apply_u(const sm_model *m, tree_ws *t, int which, const double *x, double *y)
 {
     const double *L = which == TREE_K ? t->Kl : which == TREE_M ? t->Ml : t->Cl;
     double scale = which == TREE_C ? 2.0 * t->omega : 1.0;
@@ -652,7 +654,6 @@ void tree_apply(const sm_model *m, tree_ws *t, int which, const double *x, doubl
     /* disjoint halves of the scratch: restrict lets the compiler keep out[] in vector registers
      * (each out[i] is the same sum in the same order: the same bits) */
     double *restrict in = t->work, *restrict out = t->work + d + t->max_m;
-    tree_forward(m, t, x, t->u);
     for (int s = 0; s < m->n_subs; s++) {
         const sm_sub *b = &m->subs[s];
         int l = d + b->m;
@@ -671,4 +672,18 @@ void tree_apply(const sm_model *m, tree_ws *t, int which, const double *x, doubl
             y[b->q0 + i] = scale * out[d + i];
     }
     tree_adjoint(m, t, t->v, y);
+}
+
+void tree_apply(const sm_model *m, tree_ws *t, int which, const double *x, double *y)
+{
+    tree_forward(m, t, x, t->u);
+    tree_apply_u(m, t, which, x, y);
+}
+
+void tree_apply_n(const sm_model *m, tree_ws *t, int n_ops, const int *which, const double *x,
+                  double *const *y)
+{
+    tree_forward(m, t, x, t->u);
+    for (int i = 0; i < n_ops; i++)
+        tree_apply_u(m, t, which[i], x, y[i]);
 }
