@@ -423,6 +423,32 @@ static void dtangent_check(void)
           "dT of rot3_dtangent = complex step of rot3_exp's T, |psi| 0 .. 2.5 rad (max rel.)");
 }
 
+/* rot3_exp at a real psi (its real-arithmetic path, issue 27) against the real parts of its complex
+ * path at psi + i 1e-300 d (products of two imaginary parts underflow to zero, so the real parts
+ * are the same operations on the same numbers): the same bits, on both sides of the series
+ * switch and at psi = 0. */
+static void real_path_check(void)
+{
+    const double mags[8] = {0.0, 1e-9, 0.01, 0.0999, 0.1001, 0.3, 1.0, 2.5};
+    int same = 1;
+    for (int a = 0; a < 8; a++) {
+        double u[3] = {0.6, -0.48, 0.64}, d[3] = {-0.3, 0.9, 0.2};
+        sp_cx pr[3], pc[3], Lr[9], Tr[9], Lc[9], Tc[9];
+        for (int i = 0; i < 3; i++) {
+            pr[i] = mags[a] * u[i];
+            pc[i] = mags[a] * u[i] + _Complex_I * 1e-300 * d[i];
+        }
+        rot3_exp(pr, Lr, Tr);
+        rot3_exp(pc, Lc, Tc);
+        for (int i = 0; i < 9; i++)
+            same &= creal(Lr[i]) == creal(Lc[i]) && creal(Tr[i]) == creal(Tc[i]) &&
+                    cimag(Lr[i]) == 0 && cimag(Tr[i]) == 0;
+    }
+    snprintf(tag, sizeof tag, "rot3");
+    check_true(same, "rot3_exp at a real psi = the real parts of its complex path, bit for bit, "
+                     "|psi| 0 .. 2.5 rad");
+}
+
 /* ------------------------------------------------------------------ rigid-motion responses */
 
 /* Gown and Psi of sp_hessian_base (hessian3.c: in closed form) against complex steps of each
@@ -805,6 +831,7 @@ done:
 int main(void)
 {
     dtangent_check();
+    real_path_check();
     double pc = 15 * PI / 180;
     const spec cases[5] = {
         {"a: R2 mast parallel to the spin axis", 15, 3, {{0.5, 0, 0}, {3.5, 0, 0}, {3.5, 0, 2}}, 2,
