@@ -486,11 +486,16 @@ int track_assign(int nr, int nc, const double *mac, int *match);
 /** Tracking of the sweep r (ord: the n case indices in ascending speed; shapes present):
  *  mac_to_previous, previous_index, tracked_index, track_flag, track_partner.  SM_OK or SM_NOMEM. */
 int track_sweep(sm_result *r, const int *ord, int n);
+/** What a caller of sweep_run does to each case with modes once its modes and nodal shapes are
+ *  in, on the thread that finished the case (post/labels.c's lab_case: a higher layer's, passed
+ *  down).  SM_OK or a negative status, which stops the sweep. */
+typedef int (*sweep_case_fn)(const sm_model *m, sm_case *c);
 /** Every speed of omegas (n_omegas >= 1, finite, >= 0; else SM_INVALID_INPUT in diag): the
- *  equilibrium, modes and nodal shapes of each, kept; no labels, tracking or refinements
- *  (solve/sweep.c; sm_solve adds them).  *out owned by the caller.  Returns as sm_solve. */
+ *  equilibrium, modes and nodal shapes of each, kept, and after(m, case) on each case with modes
+ *  (after may be NULL); no tracking or refinements (solve/sweep.c; sm_solve adds them).  *out
+ *  owned by the caller.  Returns as sm_solve. */
 int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress_fn cb, void *user,
-              sm_result **out, sm_diag *diag);
+              sweep_case_fn after, sm_result **out, sm_diag *diag);
 /** ord (n case indices) = the speeds of omegas in ascending order, ties in input order.
  *  SM_OK or SM_NOMEM. */
 int sweep_order(const double *omegas, int n, int *ord);

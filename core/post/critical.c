@@ -40,12 +40,7 @@ typedef struct crit_ctx {
 /* Solve at one speed with shapes kept and labels (no tracking); *out owned by the caller. */
 static int crit_single(const sm_model *m, double omega, sm_progress_fn cb, void *user, sm_result **out)
 {
-    int rc = sweep_run(m, &omega, 1, cb, user, out, NULL);
-    if (rc == SM_OK && (rc = lab_case(m, &(*out)->cases[0])) < 0) {
-        sm_result_free(*out);
-        *out = NULL;
-    }
-    return rc;
+    return sweep_run(m, &omega, 1, cb, user, lab_case, out, NULL);
 }
 
 static int crit_cb(void *user, int done, int total)

@@ -13,16 +13,14 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* DESIGN.md 9.1 on a solved sweep: labels, tracking, critical speeds (shapes still present). */
+/* DESIGN.md 9.1 on a solved sweep whose cases have their labels (sweep_run called lab_case on
+ * each, on the thread that finished it): tracking, critical speeds (shapes still present). */
 static int sweep_trust(const sm_model *m, sm_result *r, const double *omegas, int n,
                        sm_progress_fn cb, void *user)
 {
     int *ord = malloc((size_t)(n ? n : 1) * sizeof(int)), rc = SM_NOMEM;
     if (!ord || sweep_order(omegas, n, ord) < 0)
         goto done;
-    for (int i = 0; i < n; i++)
-        if ((rc = lab_case(m, &r->cases[i])) < 0)
-            goto done;
     if ((rc = track_sweep(r, ord, n)) < 0)
         goto done;
     /* the refinements are extra solves: a stop (cancel, time limit, shutdown) ends them and keeps
@@ -42,7 +40,7 @@ int sm_solve(const sm_model *m, const double *omegas, int n_omegas, sm_progress_
              sm_result **out, sm_diag *diag)
 {
     sm_result *r = NULL;
-    int rc = sweep_run(m, omegas, n_omegas, cb, user, &r, diag);
+    int rc = sweep_run(m, omegas, n_omegas, cb, user, lab_case, &r, diag);
     if (rc < 0)
         return rc;
     if ((rc = sweep_trust(m, r, omegas, n_omegas, cb, user)) < 0) {

@@ -85,9 +85,10 @@ int sweep_order(const double *omegas, int n, int *ord)
     return SM_OK;
 }
 
-/* Every speed of omegas: equilibrium, modes and nodal shapes (kept), no tracking. */
+/* Every speed of omegas: equilibrium, modes and nodal shapes (kept), after on each case with
+ * modes, no tracking. */
 int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress_fn cb, void *user,
-                     sm_result **out, sm_diag *diag)
+              sweep_case_fn after, sm_result **out, sm_diag *diag)
 {
     sm_diag scratch;
     sm_diag *d = diag ? diag : &scratch;
@@ -154,7 +155,7 @@ int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress
     }
     qsort(key, (size_t)n_omegas, sizeof *key, sweep_key_cmp);
     if (m->opt.threads > 1 && n_omegas > 1 &&
-        (rc = sweep_pool_new(m, m->opt.threads, n_omegas, &pool)) < 0)
+        (rc = sweep_pool_new(m, m->opt.threads, n_omegas, after, &pool)) < 0)
         goto fail;
     sm_progress pr = {cb, user, 0, n_omegas};
     double s_prev = 0;
@@ -193,7 +194,7 @@ int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress
         if (!pool)
             smi_lin_warm(L, t % SWEEP_WARM_CHUNK != 0);
         if (pool ? (rc = sweep_pool_add(pool, c, q)) < 0
-                 : (rc = sweep_case_finish(m, q, L, &pr, c)) < 0)
+                 : (rc = sweep_case_finish(m, q, L, &pr, after, c)) < 0)
             goto fail;
         pr.done = pool ? sweep_pool_finished(pool) : t + 1;
         /* after the last speed a stop request leaves the finished cases alone */

@@ -214,11 +214,13 @@ static int sweep_modes(const sm_model *m, const double *q, smi_lin *L, const sm_
 }
 
 int sweep_case_finish(const sm_model *m, const double *q, smi_lin *L, const sm_progress *pr,
-                      sm_case *c)
+                      sweep_case_fn after, sm_case *c)
 {
     smi_lin_eval(m, q, L);
     int rc = sweep_equilibrium_out(m, q, L, c);
     if (rc < 0 || !c->converged)
         return rc;
-    return sweep_modes(m, q, L, pr, c);
+    if ((rc = sweep_modes(m, q, L, pr, c)) < 0 || !after || c->n_modes <= 0)
+        return rc;
+    return after(m, c); /* on this thread: the labels of a sweep on threads are parallel too */
 }

@@ -25,6 +25,7 @@ typedef struct pool_job {
 
 struct sweep_pool {
     const sm_model *m;
+    sweep_case_fn after;
     int n_workers, started;
     pthread_t *th;
     pthread_mutex_t mu;
@@ -90,7 +91,8 @@ static void pool_run(sweep_pool *p, int start, smi_lin *L, sm_progress *pr, int 
         p->jobs[j].q = NULL;
         pthread_mutex_unlock(&p->mu);
         smi_lin_warm(L, j > start);
-        int rc = atomic_load(&p->stop) ? SM_CANCELED : sweep_case_finish(p->m, job.q, L, pr, job.c);
+        int rc = atomic_load(&p->stop) ? SM_CANCELED
+                                       : sweep_case_finish(p->m, job.q, L, pr, p->after, job.c);
         free(job.q);
         pthread_mutex_lock(&p->mu);
         p->finished++;
@@ -132,13 +134,15 @@ static void *pool_worker(void *arg)
     return NULL;
 }
 
-int sweep_pool_new(const sm_model *m, int threads, int n_cases, sweep_pool **out)
+int sweep_pool_new(const sm_model *m, int threads, int n_cases, sweep_case_fn after,
+                   sweep_pool **out)
 {
     sweep_pool *p = calloc(1, sizeof *p);
     *out = NULL;
     if (!p)
         return SM_NOMEM;
     p->m = m;
+    p->after = after;
     p->n_cases = n_cases;
     p->n_workers = threads - 1 < n_cases ? threads - 1 : n_cases;
     p->jobs = calloc((size_t)(n_cases > 0 ? n_cases : 1), sizeof *p->jobs);

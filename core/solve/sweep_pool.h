@@ -26,18 +26,20 @@
 #define SWEEP_WARM_CHUNK 8
 
 /** Steady-state outputs of case c at its equilibrium q (c->converged set by the caller), and with
- *  c->converged its modes and shapes, on L (SMI_USE_MODES, this thread's own).  pr: the stop
- *  callback the tree path asks.  Returns SM_OK (an eigen-analysis failure is reported on the
- *  case), SM_NOMEM or SM_CANCELED. */
+ *  c->converged its modes and shapes, on L (SMI_USE_MODES, this thread's own), then after(m, c)
+ *  when c has modes (after may be NULL).  pr: the stop callback the tree path asks.  Returns
+ *  SM_OK (an eigen-analysis failure is reported on the case), SM_NOMEM, SM_CANCELED or after's
+ *  negative status. */
 int sweep_case_finish(const sm_model *m, const double *q, smi_lin *L, const sm_progress *pr,
-                      sm_case *c);
+                      sweep_case_fn after, sm_case *c);
 
 typedef struct sweep_pool sweep_pool;
 
 /** A pool for n_cases cases of m (queued in ascending speed order) on threads - 1 workers
- *  (threads >= 2) besides the calling thread.  SM_OK or SM_NOMEM (*out NULL: finish the cases on
- *  the calling thread). */
-int sweep_pool_new(const sm_model *m, int threads, int n_cases, sweep_pool **out);
+ *  (threads >= 2) besides the calling thread; after: sweep_case_finish's.  SM_OK or SM_NOMEM
+ *  (*out NULL: finish the cases on the calling thread). */
+int sweep_pool_new(const sm_model *m, int threads, int n_cases, sweep_case_fn after,
+                   sweep_pool **out);
 /** Queue case c at its equilibrium q (n values, copied).  SM_OK or SM_NOMEM (nothing queued). */
 int sweep_pool_add(sweep_pool *p, sm_case *c, const double *q);
 /** Cases finished so far (any thread). */
