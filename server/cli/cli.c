@@ -345,6 +345,10 @@ static int cli_output(const cli_args *a, const codec_run_out *out)
             fwrite(csv, 1, n, stdout) != n || fflush(stdout))
             rc = CLI_FAILED;
         free(csv);
+    } else if (out->result_text) { /* compact: the daemon's bytes, written case by case */
+        if (fwrite(out->result_text, 1, out->result_len, stdout) != out->result_len ||
+            fputc('\n', stdout) == EOF || fflush(stdout))
+            rc = CLI_FAILED;
     } else if (cli_print_json(stdout, out->result, a->pretty)) {
         rc = CLI_FAILED;
     }
@@ -396,7 +400,12 @@ static int cli_solve(const cli_args *a, codec_request *req, codec_errors *errs)
     int rc;
 
     cli_threads(a, req);
-    switch (codec_run(req, a->csv ? CODEC_RUN_CSV : CODEC_RUN_JSON, NULL, NULL, errs, &out)) {
+    /* the compact document as text (codec_result_text: no tree of the whole document, and its
+     * cases written on the sweep's threads, issue 27); the table and --pretty read the tree */
+    unsigned want = a->csv                                     ? CODEC_RUN_CSV
+                    : a->table || a->critical_csv || a->pretty ? CODEC_RUN_JSON
+                                                               : CODEC_RUN_TEXT;
+    switch (codec_run(req, want, NULL, NULL, errs, &out)) {
     case CODEC_RUN_DONE:
     case CODEC_RUN_PARTIAL:
         rc = cli_output(a, &out);
