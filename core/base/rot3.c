@@ -16,32 +16,38 @@
  * series in t2 = t^2 (terms through t^10: truncation below 1e-22 relative). */
 #define ROT3_SERIES 1e-2
 
-/* c1 = sin t / t, c2 = (1 - cos t)/t^2, c3 = (t - sin t)/t^3 as functions of t2 = t^2. */
-static void rot3_coeffs(sp_cx t2, sp_cx *c1, sp_cx *c2, sp_cx *c3)
-{
-    if (cabs(t2) < ROT3_SERIES) {
-        /* alternating series: sum (-t2)^k / (2k+1)!, / (2k+2)!, / (2k+3)! */
-        sp_cx p = 1, a = 0, b = 0, c = 0;
-        double f1 = 1, f2 = 2, f3 = 6; /* (2k+1)!, (2k+2)!, (2k+3)! */
-        for (int k = 0; k < 6; k++) {
-            a += p / f1;
-            b += p / f2;
-            c += p / f3;
-            p *= -t2;
-            f1 *= (2 * k + 2) * (2 * k + 3);
-            f2 *= (2 * k + 3) * (2 * k + 4);
-            f3 *= (2 * k + 4) * (2 * k + 5);
-        }
-        *c1 = a;
-        *c2 = b;
-        *c3 = c;
-        return;
+/* c1 = sin t / t, c2 = (1 - cos t)/t^2, c3 = (t - sin t)/t^3 as functions of t2 = t^2: one body for
+ * the complex t2 of complex steps (rot3_coeffs) and the real one of real states (rot3_coeffs_real,
+ * the same operations on the real parts: a complex step's imaginary parts are zeros there, which
+ * add nothing to a real part that is not zero). */
+#define ROT3_COEFFS(NAME, T, ABS, SQRT, SIN, COS)                                 \
+    static void NAME(T t2, T *c1, T *c2, T *c3)                                   \
+    {                                                                             \
+        if (ABS(t2) < ROT3_SERIES) {                                              \
+            /* alternating series: sum (-t2)^k / (2k+1)!, / (2k+2)!, / (2k+3)! */ \
+            T p = 1, a = 0, b = 0, c = 0;                                         \
+            double f1 = 1, f2 = 2, f3 = 6; /* (2k+1)!, (2k+2)!, (2k+3)! */        \
+            for (int k = 0; k < 6; k++) {                                         \
+                a += p / f1;                                                      \
+                b += p / f2;                                                      \
+                c += p / f3;                                                      \
+                p *= -t2;                                                         \
+                f1 *= (2 * k + 2) * (2 * k + 3);                                  \
+                f2 *= (2 * k + 3) * (2 * k + 4);                                  \
+                f3 *= (2 * k + 4) * (2 * k + 5);                                  \
+            }                                                                     \
+            *c1 = a;                                                              \
+            *c2 = b;                                                              \
+            *c3 = c;                                                              \
+            return;                                                               \
+        }                                                                         \
+        T t = SQRT(t2), s = SIN(t), co = COS(t);                                  \
+        *c1 = s / t;                                                              \
+        *c2 = (1 - co) / t2;                                                      \
+        *c3 = (t - s) / (t2 * t);                                                 \
     }
-    sp_cx t = csqrt(t2), s = csin(t), co = ccos(t);
-    *c1 = s / t;
-    *c2 = (1 - co) / t2;
-    *c3 = (t - s) / (t2 * t);
-}
+ROT3_COEFFS(rot3_coeffs, sp_cx, cabs, csqrt, csin, ccos)
+ROT3_COEFFS(rot3_coeffs_real, double, fabs, sqrt, sin, cos)
 
 /* K = skew(p) and K2 = skew(p)^2 (column-major). */
 static void rot3_skew2(const sp_cx p[3], sp_cx K[9], sp_cx K2[9])
@@ -54,33 +60,6 @@ static void rot3_skew2(const sp_cx p[3], sp_cx K[9], sp_cx K2[9])
     for (int j = 0; j < 3; j++)
         for (int i = 0; i < 3; i++)
             K2[i + 3 * j] = p[i] * p[j] - (i == j ? pp : 0);
-}
-
-/* rot3_coeffs for a real t2, with the same operations on the real parts (a real step of the complex
- * code: its imaginary parts are zeros, which add nothing to a real part that is not zero). */
-static void rot3_coeffs_real(double t2, double *c1, double *c2, double *c3)
-{
-    if (fabs(t2) < ROT3_SERIES) {
-        double p = 1, a = 0, b = 0, c = 0;
-        double f1 = 1, f2 = 2, f3 = 6;
-        for (int k = 0; k < 6; k++) {
-            a += p / f1;
-            b += p / f2;
-            c += p / f3;
-            p *= -t2;
-            f1 *= (2 * k + 2) * (2 * k + 3);
-            f2 *= (2 * k + 3) * (2 * k + 4);
-            f3 *= (2 * k + 4) * (2 * k + 5);
-        }
-        *c1 = a;
-        *c2 = b;
-        *c3 = c;
-        return;
-    }
-    double t = sqrt(t2), s = sin(t), co = cos(t);
-    *c1 = s / t;
-    *c2 = (1 - co) / t2;
-    *c3 = (t - s) / (t2 * t);
 }
 
 /* rot3_exp at a real psi (every evaluation outside the complex-step tests): the complex code's
