@@ -623,7 +623,7 @@ typedef struct res_par {
     const sm_result *res;
     int per, n_blocks, limit; /* cases a block, blocks, blocks taken ahead at most */
     codec_text *blk;
-    int *state; /* 0 not taken, 1 taken, 2 written, 3 out of memory */
+    int *state; /* 0 not written yet, 2 written, 3 out of memory */
     int next, appended, failed;
     pthread_mutex_t mu;
     pthread_cond_t cv;
@@ -634,7 +634,6 @@ static int res_par_take(res_par *p)
 {
     if (p->failed || p->next >= p->n_blocks || p->next >= p->appended + p->limit)
         return -1;
-    p->state[p->next] = 1;
     return p->next++;
 }
 
@@ -674,19 +673,13 @@ static int res_text_cases_par(codec_text *t, const codec_request *r, const sm_mo
                               const sm_result *res, int threads)
 {
     int n = res->n_cases, want = threads * RES_BLOCKS_PER_THREAD, started = 0, rc = 0, b;
-    res_par p = {r,
-                 m,
-                 res,
-                 (n + want - 1) / want,
-                 0,
-                 threads * RES_WINDOW,
-                 NULL,
-                 NULL,
-                 0,
-                 0,
-                 0,
-                 PTHREAD_MUTEX_INITIALIZER,
-                 PTHREAD_COND_INITIALIZER};
+    res_par p = {.r = r,
+                 .m = m,
+                 .res = res,
+                 .per = (n + want - 1) / want,
+                 .limit = threads * RES_WINDOW,
+                 .mu = PTHREAD_MUTEX_INITIALIZER,
+                 .cv = PTHREAD_COND_INITIALIZER};
     pthread_t *th = calloc((size_t)threads, sizeof *th);
 
     p.n_blocks = (n + p.per - 1) / p.per;
