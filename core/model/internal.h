@@ -322,7 +322,8 @@ void eq_carry_free(eq_carry *c);
 
 /**
  * Continuation in s = Omega^2 from the equilibrium q at s_from (q = 0 with
- * from_rest: at least min_increments steps) to s_to, Newton-Raphson at each
+ * from_rest: at least min_increments steps; a kind with stiffened_start first
+ * tries one step from s_from = 0, DESIGN.md 7.3) to s_to, Newton-Raphson at each
  * step (DESIGN.md 1.3).  q (n, in/out): the equilibrium at s_to when
  * out->converged, else the last converged state (at out->last_s).  carry:
  * NULL, or the workspace of the continuation that ended at (q, s_from).  pr

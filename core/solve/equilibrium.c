@@ -38,8 +38,10 @@
  * than this fraction of the target s (the step is halved down to it first). */
 #define EQ_CROSS_STEP 1e-4
 /* Newton iterations of the one-step trial from Omega = 0 (eq_solve) before the increments from
- * rest take over. */
-#define EQ_TRIAL_ITERATIONS 8
+ * rest take over: a trial that diverges or leaves the branch stops earlier (eq_newton); 8 cut
+ * off a converging one (chord steps contracting 11-fold each, 9 iterations in all) on the
+ * out-of-plane case R2F at 20 rad/s. */
+#define EQ_TRIAL_ITERATIONS 12
 
 typedef struct eq_ws {
     smi_lin *L;              /* kinematics and the tangent: dense or tree (linsys.h) */
@@ -116,6 +118,20 @@ static int eq_progress(sm_progress *pr)
     return pr && pr->cb && pr->cb(pr->user, pr->done, pr->total);
 }
 
+/* The branch check of a continuation step: whether the corrector q has moved from the predictor
+ * w->qp by more than half the predicted step w->qp - w->q0 (and more than 1e-6 max(1, |q|)). */
+static int eq_off_branch(const double *q, const eq_ws *w, int n)
+{
+    double step = 0, corr = 0;
+    for (int i = 0; i < n; i++) {
+        step += (w->qp[i] - w->q0[i]) * (w->qp[i] - w->q0[i]);
+        corr += (q[i] - w->qp[i]) * (q[i] - w->qp[i]);
+    }
+    step = sqrt(step);
+    corr = sqrt(corr);
+    return corr > fmax(0.5 * step, 1e-6 * fmax(1.0, dm_norm(q, n)));
+}
+
 /*
  * Newton-Raphson at fixed s from q (in/out).  Returns 1 converged, 0 not
  * (including an exactly singular tangent), SM_CANCELED, or SM_LAPACK_FAILED
@@ -130,10 +146,17 @@ static int eq_progress(sm_progress *pr)
  * and LU, about 1/15 of the cost); the step is kept when it converges, or
  * when it cuts the residual at least tenfold, and is otherwise redone as a
  * full, damped Newton step with a fresh tangent.
+ *
+ * A trial (the one step from Omega = 0, eq_solve) gives up early, returning 0, when it cannot
+ * pass: at a damped step (a good trial converges in full steps) and, from its second iteration
+ * on, once the iterate is off the predicted branch (eq_off_branch, the check a converged step
+ * must pass): a failed trial took its EQ_TRIAL_ITERATIONS in full in solver 0.8.4.
  */
-static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progress *pr, int max_it)
+static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progress *pr, int trial)
 {
     int n = m->n, have_lu = 0, rc;
+    int max_it = trial && m->opt.max_iterations > EQ_TRIAL_ITERATIONS ? EQ_TRIAL_ITERATIONS
+                                                                      : m->opt.max_iterations;
     double tol = m->opt.tolerance;
     double r = eq_residual(m, q, s, w), prev_step = INFINITY;
     for (int it = 0; it < max_it; it++) {
@@ -187,6 +210,8 @@ static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progre
             return 1;
         if (fresh)
             prev_step = step;
+        if (trial && (alpha < 1.0 || (it >= 1 && eq_off_branch(q, w, n))))
+            return 0;
         r = rt;
     }
     return 0;
@@ -222,13 +247,15 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
     w->iterations = 0;
     w->residual = 0;
     double range = s_to - s_from;
-    /* A kind with stiffened_start going on from Omega = 0 (a sweep's speed after 0) tries one
-     * step, and when that fails takes the increments of a start from rest instead of halving it:
-     * halving, the 2000-element precone blade took 190 Newton iterations from 0 to 10 rad/s
-     * (4 s); from rest it takes 35 (0.3 s), while one step is best for a small first speed
-     * (3 iterations to 1 rad/s on the 48-element blade, 20 from rest).  Issue 27, solver 0.8.4;
-     * the planar kind keeps its continuation and its bytes. */
-    int rest = from_rest, may_rest = !from_rest && m->kind->stiffened_start && s_from == 0.0;
+    /* A kind with stiffened_start going on from Omega = 0 (a sweep's speed after 0, and since
+     * solver 0.8.5 a start from rest) tries one step, and when that fails takes the increments of
+     * a start from rest instead of halving it: halving, the 2000-element precone blade took 190
+     * Newton iterations from 0 to 10 rad/s (4 s); from rest it takes 35 (0.3 s), while one step
+     * is best for a small first speed (3 iterations to 1 rad/s on the 48-element blade, 20 from
+     * rest; BModes' Test01 blade at 60 rpm 2, from rest 14).  A failed trial gives up at its
+     * first damped or off-branch iterate (eq_newton), one or two iterations.  Issue 27, solvers
+     * 0.8.4 and 0.8.5; the planar kind keeps its continuation and its bytes. */
+    int may_rest = m->kind->stiffened_start && s_from == 0.0, rest = from_rest && !may_rest;
     double incs = m->opt.min_increments > 0 ? m->opt.min_increments : 1;
     double hmax = rest ? range / incs : range;
     double h = hmax, hmin = 1e-7 * fmax(s_to, 1e-12), s = s_from;
@@ -288,10 +315,7 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
         int it0 = w->iterations;
         /* the one step from Omega = 0 (may_rest) is a trial: a good one converges in 2 to 4 */
         int trial = may_rest && !rest && s == s_from;
-        int ok =
-            eq_newton(m, q, sn, w, pr,
-                      trial && m->opt.max_iterations > EQ_TRIAL_ITERATIONS ? EQ_TRIAL_ITERATIONS
-                                                                           : m->opt.max_iterations);
+        int ok = eq_newton(m, q, sn, w, pr, trial);
         if (ok == SM_CANCELED) {
             memcpy(q, w->q0, (size_t)n * sizeof(double));
             out->canceled = 1;
@@ -304,14 +328,7 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
         }
         if (ok) {
             /* branch check: the corrector must stay within the predicted step */
-            double step = 0, corr = 0;
-            for (int i = 0; i < n; i++) {
-                step += (w->qp[i] - w->q0[i]) * (w->qp[i] - w->q0[i]);
-                corr += (q[i] - w->qp[i]) * (q[i] - w->qp[i]);
-            }
-            step = sqrt(step);
-            corr = sqrt(corr);
-            if (have_lu && corr > fmax(0.5 * step, 1e-6 * fmax(1.0, dm_norm(q, n)))) {
+            if (have_lu && eq_off_branch(q, w, n)) {
                 ok = 0;
                 why = "the solution jumped to another branch";
             } else if (eq_max_strain(m, q, w->P) > EQ_MAX_STRAIN) {
