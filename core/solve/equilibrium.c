@@ -46,6 +46,7 @@
 typedef struct eq_ws {
     smi_lin *L;              /* kinematics and the tangent: dense or tree (linsys.h) */
     double *F, *g, *dq, *qt, *q0, *qp;
+    double *d0;              /* a trial's predictor direction Kt^-1 g at (q, s_from) */
     double *P;               /* n_elems axial forces */
     int iterations;          /* total Newton iterations */
     double residual;
@@ -67,6 +68,7 @@ static void eq_ws_free(eq_ws *w)
     free(w->qt);
     free(w->q0);
     free(w->qp);
+    free(w->d0);
     free(w->P);
 }
 
@@ -80,8 +82,9 @@ static int eq_ws_alloc(const sm_model *m, eq_ws *w)
     w->qt = dm_vec((size_t)n);
     w->q0 = dm_vec((size_t)n);
     w->qp = dm_vec((size_t)n);
+    w->d0 = dm_vec((size_t)n);
     w->P = dm_vec((size_t)m->n_elems);
-    if (!w->P || !w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp ||
+    if (!w->P || !w->F || !w->g || !w->dq || !w->qt || !w->q0 || !w->qp || !w->d0 ||
         smi_lin_new(m, SMI_USE_NEWTON, tree_use(m), &w->L) != SM_OK) {
         eq_ws_free(w);
         return SM_NOMEM;
@@ -262,6 +265,7 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
     if (m->kind->stiffened_start && rest)
         h = hmax / EQ_STIFFENED_FIRST;
     const char *why = "";
+    int d0_ok = 0; /* w->d0 stands for the solve of the next predictor (after a failed trial) */
     /* tangent at the start for the first predictor: at (q, s_from), or the one carried over */
     int sign = 1;
     if (carry && carry->valid && !from_rest && !m->kind->fixed_bits && carry->s == s_from) {
@@ -285,10 +289,19 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
          * evaluation at q (issue 27: one of a speed's five evaluations of g, same values) */
         memcpy(w->q0, q, (size_t)n * sizeof(double));
         memcpy(w->qp, q, (size_t)n * sizeof(double));
+        /* the one step from Omega = 0 (may_rest) is a trial: a good one converges in 2 to 4 */
+        int trial = may_rest && !rest && s == s_from;
         if (have_lu) {
-            memcpy(w->dq, w->g, (size_t)n * sizeof(double));
-            if ((rc = smi_lin_solve(m, w->L, w->dq)) < 0)
-                goto fail;
+            if (d0_ok) {
+                memcpy(w->dq, w->d0, (size_t)n * sizeof(double));
+                d0_ok = 0;
+            } else {
+                memcpy(w->dq, w->g, (size_t)n * sizeof(double));
+                if ((rc = smi_lin_solve(m, w->L, w->dq)) < 0)
+                    goto fail;
+                if (trial)
+                    memcpy(w->d0, w->dq, (size_t)n * sizeof(double));
+            }
             for (int i = 0; i < n; i++)
                 w->qp[i] += (sn - s) * w->dq[i];
             /* the stiffened predictor: from rest, and on a sweep's step that at least doubles s
@@ -313,8 +326,6 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
         }
         memcpy(q, w->qp, (size_t)n * sizeof(double));
         int it0 = w->iterations;
-        /* the one step from Omega = 0 (may_rest) is a trial: a good one converges in 2 to 4 */
-        int trial = may_rest && !rest && s == s_from;
         int ok = eq_newton(m, q, sn, w, pr, trial);
         if (ok == SM_CANCELED) {
             memcpy(q, w->q0, (size_t)n * sizeof(double));
@@ -368,9 +379,15 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
                 h = fmin(2.0 * h, hmax);
         } else {
             memcpy(q, w->q0, (size_t)n * sizeof(double));
-            if ((rc = eq_restart(m, q, s, w, &have_lu)) < 0)
+            if (trial && have_lu) {
+                /* the tangent at s_from is not factored again: its one use, the first
+                 * predictor from rest, is the trial's direction d0 (the same bits) */
+                eq_residual(m, q, s, w);
+                d0_ok = 1;
+            } else if ((rc = eq_restart(m, q, s, w, &have_lu)) < 0) {
                 goto fail;
-            if (may_rest && !rest && s == s_from) { /* the increments from rest (above) */
+            }
+            if (trial) { /* the increments from rest (above) */
                 rest = 1;
                 hmax = range / incs;
                 h = hmax / EQ_STIFFENED_FIRST;
