@@ -69,6 +69,19 @@ static void blade_init(blade *b, int ne)
  * single speed take the same path (65 iterations each); the single speed 1 rad/s takes 3
  * iterations (the increments from rest 20), and a trial that fails gives up at once: 10 rad/s in
  * at most 40 (37; the increments alone 36; a trial run to its end cost 8 more). */
+/* Solves speeds w[0..n) on m; the last speed must converge in at most max_it Newton iterations. */
+static void last_speed_iterations(sm_model *m, const double *w, int n, int max_it, const char *what)
+{
+    sm_result *r = NULL;
+    sm_diag d;
+    if (sm_solve(m, w, n, NULL, NULL, &r, &d) == SM_OK)
+        TU_CHECK(r->cases[n - 1].converged && r->cases[n - 1].iterations <= max_it,
+                 "%s: %d Newton iterations (at most %d)", what, r->cases[n - 1].iterations, max_it);
+    else
+        TU_CHECK(0, "%s: %s", what, d.message);
+    sm_result_free(r);
+}
+
 static void sweep_after_rest(void)
 {
     blade b;
@@ -95,30 +108,9 @@ static void sweep_after_rest(void)
         df = fmax(df, fabs(a->frequency[j] - r->frequency[j]) / r->frequency[j]);
     TU_CHECK(a->n_modes == 3 && r->n_modes == 3 && df <= 1e-10,
              "sweep {0, 20} = the single speed 20 rad/s: frequencies to %.1e (1e-10)", df);
-    sm_result_free(sw);
-    sw = NULL;
-    if (sm_solve(m, small, 2, NULL, NULL, &sw, &d) == SM_OK)
-        TU_CHECK(sw->cases[1].converged && sw->cases[1].iterations <= 4,
-                 "sweep {0, 1}: one step, %d Newton iterations (at most 4)",
-                 sw->cases[1].iterations);
-    else
-        TU_CHECK(0, "sweep {0, 1}: %s", d.message);
-    sm_result_free(sw);
-    sw = NULL;
-    if (sm_solve(m, &small[1], 1, NULL, NULL, &sw, &d) == SM_OK)
-        TU_CHECK(sw->cases[0].converged && sw->cases[0].iterations <= 4,
-                 "1 rad/s from rest: one step, %d Newton iterations (at most 4)",
-                 sw->cases[0].iterations);
-    else
-        TU_CHECK(0, "1 rad/s from rest: %s", d.message);
-    sm_result_free(sw);
-    sw = NULL;
-    if (sm_solve(m, &ten, 1, NULL, NULL, &sw, &d) == SM_OK)
-        TU_CHECK(sw->cases[0].converged && sw->cases[0].iterations <= 40,
-                 "10 rad/s from rest: the trial gives up early, %d Newton iterations (at most 40)",
-                 sw->cases[0].iterations);
-    else
-        TU_CHECK(0, "10 rad/s from rest: %s", d.message);
+    last_speed_iterations(m, small, 2, 4, "sweep {0, 1}: one step");
+    last_speed_iterations(m, &small[1], 1, 4, "1 rad/s from rest: one step");
+    last_speed_iterations(m, &ten, 1, 40, "10 rad/s from rest: the trial gives up early");
 done:
     sm_result_free(sw);
     sm_result_free(one);
