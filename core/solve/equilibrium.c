@@ -151,9 +151,13 @@ static int eq_off_branch(const double *q, const eq_ws *w, int n)
  * full, damped Newton step with a fresh tangent.
  *
  * A trial (the one step from Omega = 0, eq_solve) gives up early, returning 0, when it cannot
- * pass: at a damped step (a good trial converges in full steps) and, from its second iteration
- * on, once the iterate is off the predicted branch (eq_off_branch, the check a converged step
- * must pass): a failed trial took its EQ_TRIAL_ITERATIONS in full in solver 0.8.4.
+ * pass: before its first tangent when the residual at the predictor is no smaller than the load
+ * s |g| there (the linearisation has no grip on the step), at a damped step (a good trial
+ * converges in full steps) and, from its second iteration on, once the iterate is off the
+ * predicted branch (eq_off_branch, the check a converged step must pass).  A failed trial took
+ * its EQ_TRIAL_ITERATIONS in full in solver 0.8.4.  On 122 spatial requests the ratio of the two
+ * norms was below 0.4 for every trial that passed but one (1.04, the arm MA at 75 rad/s), and
+ * above 0.43 for all but one that failed; 40 of the 59 failures were above 1.
  */
 static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progress *pr, int trial)
 {
@@ -162,6 +166,8 @@ static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progre
                                                                       : m->opt.max_iterations;
     double tol = m->opt.tolerance;
     double r = eq_residual(m, q, s, w), prev_step = INFINITY;
+    if (trial && !(r <= s * dm_norm(w->g, n)))
+        return 0;
     for (int it = 0; it < max_it; it++) {
         if (!isfinite(r))
             return 0;
@@ -255,9 +261,10 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
      * a start from rest instead of halving it: halving, the 2000-element precone blade took 190
      * Newton iterations from 0 to 10 rad/s (4 s); from rest it takes 35 (0.3 s), while one step
      * is best for a small first speed (3 iterations to 1 rad/s on the 48-element blade, 20 from
-     * rest; BModes' Test01 blade at 60 rpm 2, from rest 14).  A failed trial gives up at its
-     * first damped or off-branch iterate (eq_newton), one or two iterations.  Issue 27, solvers
-     * 0.8.4 and 0.8.5; the planar kind keeps its continuation and its bytes. */
+     * rest; BModes' Test01 blade at 60 rpm 2, from rest 14).  A failed trial gives up before its
+     * first tangent when the predictor leaves a residual as large as the load, else at its first
+     * damped or off-branch iterate (eq_newton): 0 to 2 iterations.  Issue 27, solvers 0.8.4 and
+     * 0.8.5; the planar kind keeps its continuation and its bytes. */
     int may_rest = m->kind->stiffened_start && s_from == 0.0, rest = from_rest && !may_rest;
     double incs = m->opt.min_increments > 0 ? m->opt.min_increments : 1;
     double hmax = rest ? range / incs : range;

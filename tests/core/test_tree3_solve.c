@@ -68,7 +68,8 @@ static void blade_init(blade *b, int ne)
  * Since solver 0.8.5 a start from rest tries the one step too, so the sweep {0, 20} and the
  * single speed take the same path (65 iterations each); the single speed 1 rad/s takes 3
  * iterations (the increments from rest 20), and a trial that fails gives up at once: 10 rad/s in
- * at most 40 (37; the increments alone 36; a trial run to its end cost 8 more). */
+ * at most 40 (36, as the increments alone: the trial gives up before its first tangent; run to
+ * its end it cost 8 more). */
 /* Solves speeds w[0..n) on m; the last speed must converge in at most max_it Newton iterations. */
 static void last_speed_iterations(sm_model *m, const double *w, int n, int max_it, const char *what)
 {
