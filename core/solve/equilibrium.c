@@ -42,6 +42,16 @@
  * off a converging one (chord steps contracting 11-fold each, 9 iterations in all) on the
  * out-of-plane case R2F at 20 rad/s. */
 #define EQ_TRIAL_ITERATIONS 12
+/* A trial is tried only where the step from rest is weakly nonlinear: the residual at its
+ * stiffened predictor at most this fraction of the load s |g| there (eq_newton).  A one-step
+ * trial can converge to an equilibrium the continuation from rest never reaches: a random frame
+ * with a pendulous member and a tip mass (rho 0.23) swung out to the other side of the one a
+ * fine sweep from rest follows (its first frequency 2.55 instead of 3.05 rad/s), and a frame with
+ * an inward member (rho 0.59) landed on an unstable equilibrium with two negative eigenvalues
+ * (which the determinant's sign cannot see) where the increments find none.  Of 907 trials
+ * (the 144 requests of tests/bench/compare_starts.py and 800 random frames), 369 of the 451
+ * that converged were below 0.05; every trial that gave a different answer was above 0.2. */
+#define EQ_TRIAL_RHO 0.05
 
 typedef struct eq_ws {
     smi_lin *L;              /* kinematics and the tangent: dense or tree (linsys.h) */
@@ -151,13 +161,12 @@ static int eq_off_branch(const double *q, const eq_ws *w, int n)
  * full, damped Newton step with a fresh tangent.
  *
  * A trial (the one step from Omega = 0, eq_solve) gives up early, returning 0, when it cannot
- * pass: before its first tangent when the residual at the predictor is no smaller than the load
- * s |g| there (the linearisation has no grip on the step), at a damped step (a good trial
- * converges in full steps) and, from its second iteration on, once the iterate is off the
- * predicted branch (eq_off_branch, the check a converged step must pass).  A failed trial took
- * its EQ_TRIAL_ITERATIONS in full in solver 0.8.4.  On 122 spatial requests the ratio of the two
- * norms was below 0.4 for every trial that passed but one (1.04, the arm MA at 75 rad/s), and
- * above 0.43 for all but one that failed; 40 of the 59 failures were above 1.
+ * pass or should not: before its first tangent when the residual at the predictor exceeds
+ * EQ_TRIAL_RHO times the load s |g| there (a strongly nonlinear step, where one step may reach
+ * another equilibrium), at a damped step (a good trial converges in full steps) and, from its
+ * second iteration on, once the iterate is off the predicted branch (eq_off_branch, the check a
+ * converged step must pass).  A failed trial took its EQ_TRIAL_ITERATIONS in full in solver
+ * 0.8.4, and solver 0.8.4 tried every step from Omega = 0 (a sweep's speed after 0).
  */
 static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progress *pr, int trial)
 {
@@ -166,7 +175,7 @@ static int eq_newton(const sm_model *m, double *q, double s, eq_ws *w, sm_progre
                                                                       : m->opt.max_iterations;
     double tol = m->opt.tolerance;
     double r = eq_residual(m, q, s, w), prev_step = INFINITY;
-    if (trial && !(r <= s * dm_norm(w->g, n)))
+    if (trial && !(r <= EQ_TRIAL_RHO * s * dm_norm(w->g, n)))
         return 0;
     for (int it = 0; it < max_it; it++) {
         if (!isfinite(r))
@@ -261,9 +270,10 @@ int eq_solve(const sm_model *m, double *q, double s_from, double s_to, int from_
      * a start from rest instead of halving it: halving, the 2000-element precone blade took 190
      * Newton iterations from 0 to 10 rad/s (4 s); from rest it takes 35 (0.3 s), while one step
      * is best for a small first speed (3 iterations to 1 rad/s on the 48-element blade, 20 from
-     * rest; BModes' Test01 blade at 60 rpm 2, from rest 14).  A failed trial gives up before its
-     * first tangent when the predictor leaves a residual as large as the load, else at its first
-     * damped or off-branch iterate (eq_newton): 0 to 2 iterations.  Issue 27, solvers 0.8.4 and
+     * rest; BModes' Test01 blade at 60 rpm 2, from rest 14).  A trial gives up before its first
+     * tangent when the predictor leaves more than EQ_TRIAL_RHO of the load unbalanced (there
+     * one step may reach an equilibrium the increments never do), else at its first damped or
+     * off-branch iterate (eq_newton): 0 to 2 iterations.  Issue 27, solvers 0.8.4 and
      * 0.8.5; the planar kind keeps its continuation and its bytes. */
     int may_rest = m->kind->stiffened_start && s_from == 0.0, rest = from_rest && !may_rest;
     double incs = m->opt.min_increments > 0 ? m->opt.min_increments : 1;

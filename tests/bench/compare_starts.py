@@ -3,13 +3,16 @@
 of single-speed requests (issue 27, solver 0.8.5: a spatial start from rest tries one step).
 A tool, not a test: it prints.
 
-    python3 tests/bench/compare_starts.py OLD_CLI NEW_CLI
+    python3 tests/bench/compare_starts.py OLD_CLI NEW_CLI [--random N [SEED]]
 
 The requests, one speed each: every example and every reference case of tests/reference/3d
 (cases.json, cases_oop.json) at each of its listed speeds (at most 7 of them) and at 3x it;
 BModes' CertTest files imported with and without `--bmodes-mesh 1` (by NEW_CLI); the precone
 blade of sweep_cases.py at 0.5 to 120 rad/s, and at 192 elements.  Both CLIs solve each with
-OPENBLAS_NUM_THREADS=1.  Per spatial request whose Newton iterations or frequencies differ: the
+OPENBLAS_NUM_THREADS=1.  With --random N, N random spatial frames instead (seeded, default
+seed 1): one to three members from a hub joint at 0 to 2 m, each in a random direction (outward,
+inward, out of the plane, branched from the previous joint or not), random section stiffnesses
+over two decades, a tip mass or none, at a random speed of 0.3 to 60 rad/s.  Per spatial request whose Newton iterations or frequencies differ: the
 iterations of both, the largest relative change of a frequency, and the wall times (one run
 each: indicative only).  Any change of a case's status, stability or number of modes is printed
 as DIFFERENT.  Last lines: how many spatial requests take fewer, more and the same iterations,
@@ -72,6 +75,43 @@ def requests(new_cli):
     return out
 
 
+def random_requests(n, seed):
+    import math
+    import random
+    rnd = random.Random(seed)
+    out = {}
+    for i in range(n):
+        joints = {"H": [rnd.uniform(0, 2), 0.0, 0.0]}
+        members, names = [], ["H"]
+        for j in range(rnd.randint(1, 3)):
+            frm = names[-1] if j == 0 or rnd.random() < 0.7 else rnd.choice(names)
+            th, ph = rnd.uniform(-math.pi, math.pi), rnd.uniform(-math.pi / 2, math.pi / 2)
+            if j == 0 and rnd.random() < 0.6:  # mostly outward first
+                th, ph = rnd.uniform(-0.5, 0.5), rnd.uniform(-0.5, 0.5)
+            ln = rnd.uniform(0.5, 5)
+            x = joints[frm]
+            to = "J%d" % (j + 1)
+            joints[to] = [x[0] + ln * math.cos(ph) * math.cos(th), x[1] + ln * math.cos(ph) * math.sin(th),
+                          x[2] + ln * math.sin(ph)]
+            names.append(to)
+            members.append({"id": "m%d" % j, "from": frm, "to": to, "section": "s%d" % j,
+                            "elements": rnd.randint(4, 16)})
+        sections = {}
+        for j in range(len(members)):
+            ei = 10 ** rnd.uniform(2, 4)
+            sections["s%d" % j] = {"EA": ei * 10 ** rnd.uniform(3.5, 4.5), "EI_flap": ei,
+                                   "EI_edge": ei * rnd.uniform(1, 10), "GJ": ei * rnd.uniform(0.5, 2),
+                                   "mass_per_length": rnd.uniform(0.5, 5), "flap_inertia": 1e-4,
+                                   "edge_inertia": 9e-4}
+        st = {"joints": joints, "sections": sections, "members": members, "clamp": "H"}
+        if rnd.random() < 0.4:
+            st["point_masses"] = [{"joint": names[-1], "mass": rnd.uniform(0.1, 3)}]
+        w = round(10 ** rnd.uniform(math.log10(0.3), math.log10(60)), 3)
+        out["random%03d_omega%g" % (i, w)] = {"structure": st, "frames": "per_element",
+                                              "analysis": {"omega": [w], "modes": 4}}
+    return out
+
+
 def solve(cli, path):
     t = time.time()
     p = subprocess.run([cli, "solve", path, "--threads", "1"], capture_output=True, text=True, env=ENV)
@@ -88,14 +128,15 @@ def solve(cli, path):
 
 
 def main():
-    if len(sys.argv) != 3:
+    if len(sys.argv) not in (3, 5, 6) or (len(sys.argv) > 3 and sys.argv[3] != "--random"):
         sys.exit(__doc__)
-    old, new = (os.path.abspath(x) for x in sys.argv[1:])
+    old, new = (os.path.abspath(x) for x in sys.argv[1:3])
     fewer = more = same = 0
     tot = [0, 0]
     worst, worst_k = 0.0, ""
     with tempfile.TemporaryDirectory() as tmp:
-        reqs = requests(new)
+        reqs = (random_requests(int(sys.argv[4]), int(sys.argv[5]) if len(sys.argv) > 5 else 1)
+                if len(sys.argv) > 3 else requests(new))
         for k in sorted(reqs):
             path = os.path.join(tmp, k + ".json")
             json.dump(reqs[k], open(path, "w"))

@@ -83,6 +83,78 @@ static void last_speed_iterations(sm_model *m, const double *w, int n, int max_i
     sm_result_free(r);
 }
 
+/* A one-step trial must not answer where the continuation from rest would not (solver 0.8.5,
+ * DESIGN.md 7.3): a frame found by tests/bench/compare_starts.py --random 200 3 — an arm out
+ * from the hub and a soft member hanging below it with a 0.89 kg tip mass — swings out by
+ * ~1 rad at 3.281 rad/s.  A sweep from rest in 40 steps reaches the state with the first
+ * frequency 3.0498 rad/s; one step (its stiffened predictor leaves 0.23 of the load unbalanced)
+ * converged to another stable equilibrium, swung out to the other side (2.5542 rad/s), in
+ * solver 0.8.4's sweep {0, W} and 0.8.5's first single speed before the trial's gate.  The single
+ * speed and the sweep {0, W} must give the fine sweep's frequencies (1e-9). */
+static void trial_other_equilibrium(void)
+{
+    double xy[6] = {0.4322269005402204, 0,
+                    2.9857163542290754, -0.9153518304542151,
+                    3.0580491372365888, -0.7123528275530879},
+           z[3] = {0, 0.13759664398278876, -2.714252074155686};
+    sm_section sec[2];
+    sm_member mem[2];
+    sm_point_mass pm;
+    sm_structure st;
+    memset(sec, 0, sizeof sec);
+    memset(mem, 0, sizeof mem);
+    memset(&pm, 0, sizeof pm);
+    memset(&st, 0, sizeof st);
+    sec[0].EA = 86699992.50396189, sec[0].EI_flap = 4859.303380280551,
+    sec[0].EI_edge = 11699.274525177556;
+    sec[0].GJ = 3405.238172675494, sec[0].mu = 3.8554628888628066;
+    sec[1].EA = 524663.4510386935, sec[1].EI_flap = 114.58836661390627,
+    sec[1].EI_edge = 592.0786784277506;
+    sec[1].GJ = 86.66082303790434, sec[1].mu = 4.006522222875934;
+    for (int j = 0; j < 2; j++)
+        sec[j].i_flap = 1e-4, sec[j].i_edge = 9e-4;
+    mem[0].to = 1, mem[0].elements = 7;
+    mem[1].from = 1, mem[1].to = 2, mem[1].section = 1, mem[1].elements = 5;
+    pm.joint = 2, pm.mass = 0.8854763596209999;
+    st.n_joints = 3, st.joint_xy = xy, st.joint_z = z, st.n_sections = 2, st.sections = sec;
+    st.n_members = 2, st.members = mem, st.n_point_masses = 1, st.point_masses = &pm,
+    st.spatial = 1;
+    sm_options o;
+    sm_default_options(&o);
+    o.modes = 2;
+    sm_model *m = NULL;
+    sm_result *fine = NULL, *one = NULL, *two = NULL;
+    sm_diag d;
+    double w = 3.281, fine_w[40], pair[2] = {0, 3.281};
+    for (int i = 0; i < 40; i++)
+        fine_w[i] = w * (i + 1) / 40;
+    if (sm_model_new(&m, &st, &o, &d) != SM_OK ||
+        sm_solve(m, fine_w, 40, NULL, NULL, &fine, &d) != SM_OK ||
+        sm_solve(m, &w, 1, NULL, NULL, &one, &d) != SM_OK ||
+        sm_solve(m, pair, 2, NULL, NULL, &two, &d) != SM_OK) {
+        TU_CHECK(0, "trial, other equilibrium: solve: %s", d.message);
+        goto done;
+    }
+    const sm_case *f = &fine->cases[39], *c[2] = {&one->cases[0], &two->cases[1]};
+    const char *what[2] = {"the single speed", "the sweep {0, W}"};
+    for (int k = 0; k < 2; k++) {
+        double df = 0;
+        for (int j = 0; j < 2 && f->n_modes == 2 && c[k]->n_modes == 2; j++)
+            df = fmax(df, fabs(c[k]->frequency[j] - f->frequency[j]) / f->frequency[j]);
+        TU_CHECK(
+            f->converged && c[k]->converged && f->n_modes == 2 && c[k]->n_modes == 2 && df <= 1e-9,
+            "swung-out frame at 3.281 rad/s: %s gives %.6g rad/s, the fine sweep from rest %.6g "
+            "(frequencies to %.1e, 1e-9)",
+            what[k], c[k]->n_modes ? c[k]->frequency[0] : 0.0, f->n_modes ? f->frequency[0] : 0.0,
+            df);
+    }
+done:
+    sm_result_free(fine);
+    sm_result_free(one);
+    sm_result_free(two);
+    sm_model_free(m);
+}
+
 static void sweep_after_rest(void)
 {
     blade b;
@@ -121,6 +193,7 @@ done:
 int main(void)
 {
     sweep_after_rest();
+    trial_other_equilibrium();
     blade b;
     sm_options o;
     double w10 = 10, sweep[4] = {0, 5, 10, 20};
