@@ -83,55 +83,94 @@ static void last_speed_iterations(sm_model *m, const double *w, int n, int max_i
     sm_result_free(r);
 }
 
-/* A one-step trial must not answer where the continuation from rest would not (solver 0.8.5,
- * DESIGN.md 7.3): a frame found by tests/bench/compare_starts.py --random 200 3 — an arm out
- * from the hub and a soft member hanging below it with a 0.89 kg tip mass — swings out by
- * ~1 rad at 3.281 rad/s.  A sweep from rest in 40 steps reaches the state with the first
- * frequency 3.0498 rad/s; one step (its stiffened predictor leaves 0.23 of the load unbalanced)
- * converged to another stable equilibrium, swung out to the other side (2.5542 rad/s), in
- * solver 0.8.4's sweep {0, W} and 0.8.5's first single speed before the trial's gate.  The single
- * speed and the sweep {0, W} must give the fine sweep's frequencies (1e-9). */
-static void trial_other_equilibrium(void)
-{
-    double xy[6] = {0.4322269005402204, 0,
-                    2.9857163542290754, -0.9153518304542151,
-                    3.0580491372365888, -0.7123528275530879},
-           z[3] = {0, 0.13759664398278876, -2.714252074155686};
+/* Two members from the clamped hub joint H (H-J1, J1-J2, each with its own section: EA, EI_flap,
+ * EI_edge, GJ, mu) and a tip mass at J2 (0: none); xyz: H, J1, J2.  The random frames of
+ * tests/bench/compare_starts.py --random. */
+typedef struct frame2 {
+    double xy[6], z[3];
     sm_section sec[2];
     sm_member mem[2];
     sm_point_mass pm;
     sm_structure st;
-    memset(sec, 0, sizeof sec);
-    memset(mem, 0, sizeof mem);
-    memset(&pm, 0, sizeof pm);
-    memset(&st, 0, sizeof st);
-    sec[0].EA = 86699992.50396189, sec[0].EI_flap = 4859.303380280551,
-    sec[0].EI_edge = 11699.274525177556;
-    sec[0].GJ = 3405.238172675494, sec[0].mu = 3.8554628888628066;
-    sec[1].EA = 524663.4510386935, sec[1].EI_flap = 114.58836661390627,
-    sec[1].EI_edge = 592.0786784277506;
-    sec[1].GJ = 86.66082303790434, sec[1].mu = 4.006522222875934;
-    for (int j = 0; j < 2; j++)
-        sec[j].i_flap = 1e-4, sec[j].i_edge = 9e-4;
-    mem[0].to = 1, mem[0].elements = 7;
-    mem[1].from = 1, mem[1].to = 2, mem[1].section = 1, mem[1].elements = 5;
-    pm.joint = 2, pm.mass = 0.8854763596209999;
-    st.n_joints = 3, st.joint_xy = xy, st.joint_z = z, st.n_sections = 2, st.sections = sec;
-    st.n_members = 2, st.members = mem, st.n_point_masses = 1, st.point_masses = &pm,
-    st.spatial = 1;
+} frame2;
+
+static void frame2_init(frame2 *f, const double xyz[9], const double sec[2][5], int e0, int e1,
+                        double tip)
+{
+    memset(f, 0, sizeof *f);
+    for (int j = 0; j < 3; j++)
+        f->xy[2 * j] = xyz[3 * j], f->xy[2 * j + 1] = xyz[3 * j + 1], f->z[j] = xyz[3 * j + 2];
+    for (int j = 0; j < 2; j++) {
+        f->sec[j].EA = sec[j][0], f->sec[j].EI_flap = sec[j][1], f->sec[j].EI_edge = sec[j][2];
+        f->sec[j].GJ = sec[j][3], f->sec[j].mu = sec[j][4], f->sec[j].i_flap = 1e-4,
+        f->sec[j].i_edge = 9e-4;
+    }
+    f->mem[0].to = 1, f->mem[0].elements = e0;
+    f->mem[1].from = 1, f->mem[1].to = 2, f->mem[1].section = 1, f->mem[1].elements = e1;
+    f->pm.joint = 2, f->pm.mass = tip;
+    f->st.n_joints = 3, f->st.joint_xy = f->xy, f->st.joint_z = f->z, f->st.n_sections = 2;
+    f->st.sections = f->sec, f->st.n_members = 2, f->st.members = f->mem, f->st.spatial = 1;
+    f->st.n_point_masses = tip > 0, f->st.point_masses = &f->pm;
+}
+
+/* A one-step trial must not answer where the continuation from rest would not (solver 0.8.5,
+ * DESIGN.md 7.3); frames found by tests/bench/compare_starts.py --random 200 SEED.
+ * Seed 3: an arm out from the hub and a soft member hanging below it with a 0.89 kg tip mass
+ * swing out by ~1 rad at 3.281 rad/s.  A sweep from rest in 40 steps reaches the state with the
+ * first frequency 3.0498 rad/s; one step (its stiffened predictor leaves 0.23 of the load
+ * unbalanced) converged to another stable equilibrium, swung out to the other side (2.5542
+ * rad/s): solver 0.8.4's sweep {0, W}, and 0.8.5's single speed before the trial's gate.  The
+ * single speed and the sweep {0, W} must give the fine sweep's frequencies (1e-9).
+ * Seed 5: a member inward from the hub and one down from its end; a sweep from rest swings it
+ * out and finds no equilibrium beyond ~15 rad/s (60 steps to 22.976 rad/s).  One step (0.59)
+ * converged at 22.976 rad/s to a nearly straight, unstable equilibrium with two negative
+ * eigenvalues (the determinant's sign does not change): the single speed must find none. */
+static void trial_other_equilibrium(void)
+{
+    static const double xyz3[9] = {0.4322269005402204,
+                                   0,
+                                   0,
+                                   2.9857163542290754,
+                                   -0.9153518304542151,
+                                   0.13759664398278876,
+                                   3.0580491372365888,
+                                   -0.7123528275530879,
+                                   -2.714252074155686},
+                        sec3[2][5] = {{86699992.50396189, 4859.303380280551, 11699.274525177556,
+                                       3405.238172675494, 3.8554628888628066},
+                                      {524663.4510386935, 114.58836661390627, 592.0786784277506,
+                                       86.66082303790434, 4.006522222875934}},
+                        xyz5[9] = {0.5175273025191245,
+                                   0,
+                                   0,
+                                   0.13770708190741626,
+                                   0.35353147075059776,
+                                   -0.34022782392281065,
+                                   -0.181122659205756,
+                                   -0.1567509743852722,
+                                   -2.567263735802978},
+                        sec5[2][5] = {{7810546.459677536, 1889.9994035945306, 18377.563031129088,
+                                       1553.008412858053, 2.516650149193036},
+                                      {46238656.56798056, 1558.1551831344154, 13786.627591543385,
+                                       1586.7669329807973, 4.817231371857877}};
+    frame2 f3, f5;
+    frame2_init(&f3, xyz3, sec3, 7, 5, 0.8854763596209999);
+    frame2_init(&f5, xyz5, sec5, 8, 10, 0);
     sm_options o;
     sm_default_options(&o);
     o.modes = 2;
-    sm_model *m = NULL;
-    sm_result *fine = NULL, *one = NULL, *two = NULL;
+    sm_model *m = NULL, *m5 = NULL;
+    sm_result *fine = NULL, *one = NULL, *two = NULL, *in5 = NULL;
     sm_diag d;
-    double w = 3.281, fine_w[40], pair[2] = {0, 3.281};
+    double w = 3.281, fine_w[40], pair[2] = {0, 3.281}, w5 = 22.976;
     for (int i = 0; i < 40; i++)
         fine_w[i] = w * (i + 1) / 40;
-    if (sm_model_new(&m, &st, &o, &d) != SM_OK ||
+    if (sm_model_new(&m, &f3.st, &o, &d) != SM_OK ||
         sm_solve(m, fine_w, 40, NULL, NULL, &fine, &d) != SM_OK ||
         sm_solve(m, &w, 1, NULL, NULL, &one, &d) != SM_OK ||
-        sm_solve(m, pair, 2, NULL, NULL, &two, &d) != SM_OK) {
+        sm_solve(m, pair, 2, NULL, NULL, &two, &d) != SM_OK ||
+        sm_model_new(&m5, &f5.st, &o, &d) != SM_OK ||
+        sm_solve(m5, &w5, 1, NULL, NULL, &in5, &d) != SM_OK) {
         TU_CHECK(0, "trial, other equilibrium: solve: %s", d.message);
         goto done;
     }
@@ -148,11 +187,17 @@ static void trial_other_equilibrium(void)
             what[k], c[k]->n_modes ? c[k]->frequency[0] : 0.0, f->n_modes ? f->frequency[0] : 0.0,
             df);
     }
+    TU_CHECK(
+        !in5->cases[0].converged,
+        "inward frame at 22.976 rad/s: no equilibrium from rest, not one with %d negative eigenvalues",
+        in5->cases[0].negative_eigenvalues);
 done:
     sm_result_free(fine);
     sm_result_free(one);
     sm_result_free(two);
+    sm_result_free(in5);
     sm_model_free(m);
+    sm_model_free(m5);
 }
 
 static void sweep_after_rest(void)
