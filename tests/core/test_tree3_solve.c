@@ -66,10 +66,10 @@ static void blade_init(blade *b, int ne)
  * step that was halved took 336; the trial of 8 and the increments from rest 71, from rest alone
  * 63) and the single-speed solve's frequencies (1e-10); the sweep {0, 1} takes one step (3).
  * Since solver 0.8.5 a start from rest tries the one step too, so the sweep {0, 20} and the
- * single speed take the same path (65 iterations each); the single speed 1 rad/s takes 3
- * iterations (the increments from rest 20), and a trial that fails gives up at once: 10 rad/s in
- * at most 40 (36, as the increments alone: the trial gives up before its first tangent; run to
- * its end it cost 8 more). */
+ * single speed take the same path (63 iterations each: the trial's gate leaves 20 rad/s to the
+ * increments); the single speed 1 rad/s takes 3 iterations (the increments from rest 20), and a
+ * trial that fails gives up at once: 10 rad/s in at most 40 (36, as the increments alone: the
+ * trial gives up before its first tangent; run to its end it cost 8 more). */
 /* Solves speeds w[0..n) on m; the last speed must converge in at most max_it Newton iterations. */
 static void last_speed_iterations(sm_model *m, const double *w, int n, int max_it, const char *what)
 {
