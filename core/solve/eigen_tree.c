@@ -70,24 +70,13 @@ static double eig_norm(int fixed_bits, const double *x, int n)
     return s > 1e-280 && s < 1e280 ? sqrt(s) : dm_norm(x, n);
 }
 
-/* w (2n) = A v for A = [-K^-1 C, -K^-1 M; I, 0] (tree.c header); tmp: 2n scratch.  *refine: 1
- * while the solves are refined (cleared here for a spatial model, see EIG_TREE_REFINE_SKIP). */
-static int eig_tree_op(const sm_model *m, tree_ws *t, int coriolis, const double *v, double *w,
-                       double *tmp, int *refine)
+/* w (n) = -K^-1 b for b = w on entry, with one step of iterative refinement: the block solve is
+ * backward stable, but K* is graded (cond ~1e7 at 1536 elements) and the refined solution keeps
+ * the Ritz frequencies steady to ~1e-12 instead of ~1e-9.  tmp: 2n scratch.  *refine: 1 while
+ * the solves are refined (cleared here for a spatial model, see EIG_TREE_REFINE_SKIP). */
+static int eig_tree_solve(const sm_model *m, tree_ws *t, double *w, double *tmp, int *refine)
 {
     int n = m->n;
-    tree_apply(m, t, TREE_M, v + n, w); /* w = M y */
-    if (coriolis) {
-        tree_apply(m, t, TREE_C, v, tmp);
-        for (int i = 0; i < n; i++)
-            w[i] += tmp[i];
-    }
-    for (int i = 0; i < n; i++)
-        w[i] = -w[i];
-    memcpy(w + n, v, (size_t)n * sizeof(double));
-    /* w_x = -K^-1 (C x + M y), with one step of iterative refinement: the block solve is
-     * backward stable, but K* is graded (cond ~1e7 at 1536 elements) and the refined solution
-     * keeps the Ritz frequencies steady to ~1e-12 instead of ~1e-9 */
     double *b = tmp + n;
     memcpy(b, w, (size_t)n * sizeof(double));
     int rc = tree_solve(m, t, w);
@@ -103,6 +92,44 @@ static int eig_tree_op(const sm_model *m, tree_ws *t, int coriolis, const double
     for (int i = 0; i < n; i++)
         w[i] += tmp[i];
     return SM_OK;
+}
+
+/* w (2n) = A v for A = [-K^-1 C, -K^-1 M; I, 0] (tree.c header); tmp: 2n scratch. */
+static int eig_tree_op(const sm_model *m, tree_ws *t, int coriolis, const double *v, double *w,
+                       double *tmp, int *refine)
+{
+    int n = m->n;
+    tree_apply(m, t, TREE_M, v + n, w); /* w = M y */
+    if (coriolis) {
+        tree_apply(m, t, TREE_C, v, tmp);
+        for (int i = 0; i < n; i++)
+            w[i] += tmp[i];
+    }
+    for (int i = 0; i < n; i++)
+        w[i] = -w[i];
+    memcpy(w + n, v, (size_t)n * sizeof(double));
+    return eig_tree_solve(m, t, w, tmp, refine);
+}
+
+/* w (2n) = A v as eig_tree_op, for a spatial model whose basis V (n x nv, orthonormal) holds the
+ * x-part of v and, within 1e-10 of it (eig_tree_extend skips a dependent x-part), its y-part,
+ * which is a combination of earlier x-parts: M y + C x from the products MV, CV with the
+ * coordinates of y and x in V (cf: 2 nv), four products of n x nv instead of two operator
+ * applications (a forward recursion, the local blocks and the adjoint each: 7 % of a spatial
+ * sweep, issue 27). */
+static int eig_tree_op_basis(const sm_model *m, tree_ws *t, int coriolis, int nv, const double *V,
+                             const double *MV, const double *CV, const double *v, double *w,
+                             double *tmp, double *cf, int *refine)
+{
+    int n = m->n;
+    cblas_dgemv(CblasColMajor, CblasTrans, n, nv, 1.0, V, n, v + n, 1, 0.0, cf, 1);
+    cblas_dgemv(CblasColMajor, CblasNoTrans, n, nv, -1.0, MV, n, cf, 1, 0.0, w, 1);
+    if (coriolis) {
+        cblas_dgemv(CblasColMajor, CblasTrans, n, nv, 1.0, V, n, v, 1, 0.0, cf + nv, 1);
+        cblas_dgemv(CblasColMajor, CblasNoTrans, n, nv, -1.0, CV, n, cf + nv, 1, 1.0, w, 1);
+    }
+    memcpy(w + n, v, (size_t)n * sizeof(double));
+    return eig_tree_solve(m, t, w, tmp, refine);
 }
 
 /* Orthogonalise w (len) against the nq columns of Q (ld len) twice (CGS2); returns ||w|| after. */
@@ -239,6 +266,30 @@ done:
     return rc;
 }
 
+/* Extend V (n x *nv, orthonormal) by the x-parts of the Arnoldi vectors *done_x..p of Q (ld 2n),
+ * orthonormalised, with their products MV, KV, CV (CV with Coriolis); an x-part within 1e-10 of
+ * the basis adds nothing.  h: scratch of the basis size. */
+static void eig_tree_extend(const sm_model *m, tree_ws *t, int coriolis, int p, const double *Q,
+                            double *V, double *MV, double *KV, double *CV, double *h, int *nv,
+                            int *done_x)
+{
+    int n = m->n;
+    for (; *done_x <= p; (*done_x)++) {
+        double *v = V + (size_t)*nv * n;
+        memcpy(v, Q + (size_t)*done_x * 2 * n, (size_t)n * sizeof(double));
+        double v0 = eig_norm(t->fixed_bits, v, n), vn = eig_cgs2(t->fixed_bits, n, *nv, V, v, h);
+        if (!(vn > 1e-10 * v0))
+            continue;
+        for (int i = 0; i < n; i++)
+            v[i] /= vn;
+        /* one forward recursion for the three products (issue 27: -2 of 5 a vector) */
+        const int ops[3] = {TREE_M, TREE_K, TREE_C};
+        double *const ys[3] = {MV + (size_t)*nv * n, KV + (size_t)*nv * n, CV + (size_t)*nv * n};
+        tree_apply_n(m, t, coriolis ? 3 : 2, ops, v, ys);
+        (*nv)++;
+    }
+}
+
 /* The projected problem on the nv orthonormal columns of V (n x nv, with MV, CV, KV = the
  * products): dense eig_solve, then x = V a into out and the largest residual into *res. */
 static int eig_tree_project(const sm_model *m, tree_ws *t, int coriolis, int modes, int nv, const double *V,
@@ -337,9 +388,9 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const
            *CV = malloc((size_t)n * cols * sizeof(double));
     double *KV = malloc((size_t)n * cols * sizeof(double)), *tmp = dm_vec(6 * (size_t)n),
            *h = dm_vec((size_t)pmax + 2);
-    double *prev = dm_vec((size_t)modes);
+    double *prev = dm_vec((size_t)modes), *cf = dm_vec(2 * cols);
     int have_prev = 0, prev_p = 0;
-    if (!Q || !V || !MV || !CV || !KV || !tmp || !h || !prev)
+    if (!Q || !V || !MV || !CV || !KV || !tmp || !h || !prev || !cf)
         goto done;
     for (int i = 0; i < n; i++) /* a start vector with every component of x, and y = 0 */
         Q[i] = 1.0 + 0.5 * sin(0.37 * i + 0.1);
@@ -372,7 +423,14 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const
             goto done;
         }
         double *w = Q + (size_t)(p + 1) * N2;
-        if ((rc = eig_tree_op(m, t, coriolis, Q + (size_t)p * N2, w, tmp, &refine)) < 0)
+        if (!t->fixed_bits) { /* the basis holds the vector's x-part before its product */
+            eig_tree_extend(m, t, coriolis, p, Q, V, MV, KV, CV, h, &nv, &done_x);
+            rc = eig_tree_op_basis(m, t, coriolis, nv, V, MV, CV, Q + (size_t)p * N2, w, tmp, cf,
+                                   &refine);
+        } else {
+            rc = eig_tree_op(m, t, coriolis, Q + (size_t)p * N2, w, tmp, &refine);
+        }
+        if (rc < 0)
             goto done;
         double w0 = eig_norm(t->fixed_bits, w, N2),
                wn = eig_cgs2(t->fixed_bits, N2, p + 1, Q, w, h);
@@ -385,21 +443,7 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const
         }
         if (p + 1 < next && !breakdown && p < pmax)
             continue;
-        /* extend V by the x-parts of the new Arnoldi vectors, orthonormalised */
-        for (; done_x <= p; done_x++) {
-            double *v = V + (size_t)nv * n;
-            memcpy(v, Q + (size_t)done_x * N2, (size_t)n * sizeof(double));
-            double v0 = eig_norm(t->fixed_bits, v, n), vn = eig_cgs2(t->fixed_bits, n, nv, V, v, h);
-            if (!(vn > 1e-10 * v0))
-                continue;
-            for (int i = 0; i < n; i++)
-                v[i] /= vn;
-            /* one forward recursion for the three products (issue 27: -2 of 5 a vector) */
-            const int ops[3] = {TREE_M, TREE_K, TREE_C};
-            double *const ys[3] = {MV + (size_t)nv * n, KV + (size_t)nv * n, CV + (size_t)nv * n};
-            tree_apply_n(m, t, coriolis ? 3 : 2, ops, v, ys);
-            nv++;
-        }
+        eig_tree_extend(m, t, coriolis, p, Q, V, MV, KV, CV, h, &nv, &done_x);
         double res, moved = INFINITY;
         if ((rc = eig_tree_project(m, t, coriolis, modes, nv, V, MV, CV, KV, tmp, out, &res)) < 0)
             goto done;
@@ -465,5 +509,6 @@ done:
     free(tmp);
     free(h);
     free(prev);
+    free(cf);
     return rc;
 }
