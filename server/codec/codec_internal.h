@@ -627,6 +627,21 @@ int codec_memstream_done(FILE *f, char **buf, size_t *n, char **out, size_t *len
  *  chars.  Returns the length. */
 int codec_numtext(char *buf, double x, int json);
 
+/** A placeholder for codec_json_dump_rows: the empty array `at` of a tree stands for the n rows
+ *  of dof reals each at v (row-major), written [[v0, ..., v(dof-1)], ...] as the array of
+ *  arrays of reals would be (a value that is not finite as null, result.c's res_real). */
+typedef struct codec_rows {
+    const json_t *at;
+    const double *v;
+    int n, dof;
+} codec_rows;
+
+/** codec_json_dump of x with the n_rows placeholders of rows written as their rows: the bytes of
+ *  the tree with those arrays filled in, without a json_t a number (issue 27: building, writing
+ *  and freeing them was half of a result's text).  0 or -1. */
+int codec_json_dump_rows(const json_t *x, json_dump_callback_t cb, void *data,
+                         const codec_rows *rows, int n_rows);
+
 /** json_dumps(x, JSON_SORT_KEYS | JSON_COMPACT | JSON_REAL_PRECISION(17)): the same bytes,
  *  written by jsontext.c (keys sorted by strcmp as jansson does).  x: an object or an array.
  *  Returns the malloc'd text, or NULL (out of memory, a string not valid UTF-8). */

@@ -13,6 +13,7 @@
  */
 #include "codec_internal.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,6 +25,8 @@ typedef struct jt_out {
     void *data;
     int err;
     int sort; /* JSON_SORT_KEYS: an object's keys in strcmp order (jansson's compare_keys) */
+    const codec_rows *rows; /* placeholders (codec_json_dump_rows) */
+    int n_rows;
 } jt_out;
 
 static void jt_flush(jt_out *o)
@@ -75,6 +78,43 @@ static void jt_string(jt_out *o, const char *s, size_t n)
 }
 
 static void jt_value(jt_out *o, const json_t *x);
+
+/* The real x as jt_value writes a json_real (null when not finite: result.c's res_real), into
+ * the buffer itself. */
+static void jt_real(jt_out *o, double x)
+{
+    if (!isfinite(x)) {
+        jt_put(o, "null", 4);
+        return;
+    }
+    if (sizeof o->b - o->n < CODEC_NUMTEXT_MAX)
+        jt_flush(o);
+    o->n += (size_t)codec_numtext(o->b + o->n, x, 1);
+}
+
+/* The rows of placeholder x when it is one (1), else 0. */
+static int jt_rows(jt_out *o, const json_t *x)
+{
+    const codec_rows *r = NULL;
+    for (int i = 0; i < o->n_rows && !r; i++)
+        if (o->rows[i].at == x)
+            r = &o->rows[i];
+    if (!r)
+        return 0;
+    jt_put(o, "[", 1);
+    for (int k = 0; k < r->n; k++) {
+        const double *v = r->v + (size_t)r->dof * (size_t)k;
+        jt_put(o, k > 0 ? ",[" : "[", k > 0 ? 2 : 1);
+        for (int j = 0; j < r->dof; j++) {
+            if (j > 0)
+                jt_put(o, ",", 1);
+            jt_real(o, v[j]);
+        }
+        jt_put(o, "]", 1);
+    }
+    jt_put(o, "]", 1);
+    return 1;
+}
 
 static int jt_key_cmp(const void *a, const void *b)
 {
@@ -132,6 +172,8 @@ static void jt_value(jt_out *o, const json_t *x)
         break;
     }
     case JSON_ARRAY:
+        if (o->n_rows && json_array_size(x) == 0 && jt_rows(o, x))
+            break;
         jt_put(o, "[", 1);
         for (size_t i = 0; i < json_array_size(x); i++) {
             if (i > 0)
@@ -163,8 +205,9 @@ static void jt_value(jt_out *o, const json_t *x)
     }
 }
 
-/* The dump of x (object or array) with keys sorted or not. */
-static int jt_dump(const json_t *x, int sort, json_dump_callback_t cb, void *data)
+/* The dump of x (object or array) with keys sorted or not, and n_rows placeholders. */
+static int jt_dump(const json_t *x, int sort, json_dump_callback_t cb, void *data,
+                   const codec_rows *rows, int n_rows)
 {
     jt_out o;
     if (!json_is_object(x) && !json_is_array(x))
@@ -174,6 +217,8 @@ static int jt_dump(const json_t *x, int sort, json_dump_callback_t cb, void *dat
     o.data = data;
     o.err = 0;
     o.sort = sort;
+    o.rows = rows;
+    o.n_rows = n_rows;
     jt_value(&o, x);
     jt_flush(&o);
     return o.err ? -1 : 0;
@@ -181,7 +226,13 @@ static int jt_dump(const json_t *x, int sort, json_dump_callback_t cb, void *dat
 
 int codec_json_dump(const json_t *x, json_dump_callback_t cb, void *data)
 {
-    return jt_dump(x, 0, cb, data);
+    return jt_dump(x, 0, cb, data, NULL, 0);
+}
+
+int codec_json_dump_rows(const json_t *x, json_dump_callback_t cb, void *data,
+                         const codec_rows *rows, int n_rows)
+{
+    return jt_dump(x, 0, cb, data, rows, n_rows);
 }
 
 /* json_dump_callback into a codec_text; -1 when out of memory. */
@@ -195,7 +246,7 @@ static int jt_text(const char *buffer, size_t size, void *data)
 char *codec_json_dumps_sorted(const json_t *x)
 {
     codec_text t = {NULL, 0, 0, 0};
-    if (jt_dump(x, 1, jt_text, &t) || t.nomem || !t.p) {
+    if (jt_dump(x, 1, jt_text, &t, NULL, 0) || t.nomem || !t.p) {
         free(t.p);
         return NULL;
     }

@@ -82,14 +82,29 @@ static int res_node_dof(const sm_case *c)
     return c->node_dof == 6 ? 6 : 3; /* only 3 and 6 exist: never read past the arrays */
 }
 
-/* [[x, y, phi], ...] from n rows of dof reals each. */
-static json_t *res_rows(const double *v, int n, int dof)
+/* The placeholders of a case written as text (codec_rows): NULL in a tree. */
+typedef struct res_rx {
+    codec_rows *rows;
+    int n, cap;
+} res_rx;
+
+/* [[x, y, phi], ...] from n rows of dof reals each; with rx, an empty array that stands for
+ * them in the text (codec_json_dump_rows). */
+static json_t *res_rows(const double *v, int n, int dof, res_rx *rx)
 {
     json_t *a = json_array();
     int k;
 
     if (!a)
         return NULL;
+    if (rx) {
+        if (rx->n >= rx->cap) { /* cannot happen: res_case_text counts them */
+            json_decref(a);
+            return NULL;
+        }
+        rx->rows[rx->n++] = (codec_rows){a, v, n, dof};
+        return a;
+    }
     for (k = 0; k < n; k++)
         if (json_array_append_new(a, res_reals(v + (size_t)dof * (size_t)k, dof)))
             goto fail;
@@ -100,7 +115,8 @@ fail:
 }
 
 /* case.equilibrium */
-static json_t *res_equilibrium(const codec_request *r, const sm_model *m, const sm_case *c)
+static json_t *res_equilibrium(const codec_request *r, const sm_model *m, const sm_case *c,
+                               res_rx *rx)
 {
     json_t *e = json_object(), *joints = NULL;
     int j, nj = codec_request_structure(r)->n_joints, dof = res_node_dof(c);
@@ -126,7 +142,7 @@ static json_t *res_equilibrium(const codec_request *r, const sm_model *m, const 
         if (json_object_set_new(e, "joints", joints))
             goto fail_set;
         joints = NULL;
-        if (json_object_set_new(e, "nodes", res_rows(c->nodes, c->n_nodes, dof)))
+        if (json_object_set_new(e, "nodes", res_rows(c->nodes, c->n_nodes, dof, rx)))
             goto fail;
     }
     if (c->axial_force && c->n_elements > 0 &&
@@ -221,7 +237,7 @@ static int res_trust(const codec_request *r, json_t *md, const sm_case *c, int k
 }
 
 /* One mode of a case. */
-static json_t *res_mode(const codec_request *r, const sm_case *c, int k, int shapes)
+static json_t *res_mode(const codec_request *r, const sm_case *c, int k, int shapes, res_rx *rx)
 {
     int dof = res_node_dof(c);
     size_t stride = (size_t)dof * (size_t)c->n_nodes;
@@ -243,10 +259,11 @@ static json_t *res_mode(const codec_request *r, const sm_case *c, int k, int sha
         if (json_object_set_new(md, "shape", shape))
             goto fail;
         if (json_object_set_new(shape, "re",
-                                res_rows(c->shape_re + k * stride, c->n_nodes, dof)))
+                                res_rows(c->shape_re + k * stride, c->n_nodes, dof, rx)))
             goto fail;
         if (c->shape_im &&
-            json_object_set_new(shape, "im", res_rows(c->shape_im + k * stride, c->n_nodes, dof)))
+            json_object_set_new(shape, "im",
+                                res_rows(c->shape_im + k * stride, c->n_nodes, dof, rx)))
             goto fail;
     }
     if (json_object_set_new(md, "per_rev", res_per_rev(c->frequency[k], c->omega)) ||
@@ -261,8 +278,9 @@ fail:
     return NULL;
 }
 
-/* One case (speed), rpm its speed in rev/min. */
-static json_t *res_case(const codec_request *r, const sm_model *m, const sm_case *c, double rpm)
+/* One case (speed), rpm its speed in rev/min; rx: res_rows's. */
+static json_t *res_case(const codec_request *r, const sm_model *m, const sm_case *c, double rpm,
+                        res_rx *rx)
 {
     json_t *o = json_object(), *modes;
     int k, shapes = codec_request_options(r)->mode_shapes;
@@ -271,7 +289,7 @@ static json_t *res_case(const codec_request *r, const sm_model *m, const sm_case
         return NULL;
     if (json_object_set_new(o, "omega", res_real(c->omega)) ||
         json_object_set_new(o, "status", json_string(codec_case_status_name(c->status))) ||
-        json_object_set_new(o, "equilibrium", res_equilibrium(r, m, c)))
+        json_object_set_new(o, "equilibrium", res_equilibrium(r, m, c, rx)))
         goto fail;
     if (c->status != SM_CASE_NO_EQUILIBRIUM && c->status != SM_CASE_EIGEN_FAILED &&
         json_object_set_new(o, "stability",
@@ -282,7 +300,7 @@ static json_t *res_case(const codec_request *r, const sm_model *m, const sm_case
     if (json_object_set_new(o, "modes", modes))
         goto fail;
     for (k = 0; k < c->n_modes; k++)
-        if (json_array_append_new(modes, res_mode(r, c, k, shapes)))
+        if (json_array_append_new(modes, res_mode(r, c, k, shapes, rx)))
             goto fail;
     if (c->warning[0] &&
         json_object_set_new(o, "warnings", json_pack("[s]", c->warning)))
@@ -508,14 +526,14 @@ static int res_tail(json_t *doc, const codec_request *r, const sm_result *res)
     return res_critical_speeds(doc, r, res) || res_divergence_speeds(doc, res) ? -1 : 0;
 }
 
-/* Case i of res, with its rpm (as the request gave it, else from omega). */
-static json_t *res_case_at(const codec_request *r, const sm_model *m, const sm_result *res,
-                           int i)
+/* Case i of res, with its rpm (as the request gave it, else from omega); rx: res_rows's. */
+static json_t *res_case_at(const codec_request *r, const sm_model *m, const sm_result *res, int i,
+                           res_rx *rx)
 {
     int n_rpm;
     const double *rpm = codec_request_rpm(r, &n_rpm);
 
-    return res_case(r, m, &res->cases[i], i < n_rpm ? rpm[i] : NAN);
+    return res_case(r, m, &res->cases[i], i < n_rpm ? rpm[i] : NAN, rx);
 }
 
 int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
@@ -529,7 +547,7 @@ int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
     if (!doc || json_object_set_new(doc, "cases", cases))
         goto fail;
     for (i = 0; i < res->n_cases; i++)
-        if (json_array_append_new(cases, res_case_at(r, m, res, i)))
+        if (json_array_append_new(cases, res_case_at(r, m, res, i, NULL)))
             goto fail;
     if (res_tail(doc, r, res))
         goto fail;
@@ -573,6 +591,24 @@ static int res_text_head(codec_text *t, const codec_request *r, const sm_model *
     return t->nomem ? -1 : 0;
 }
 
+/* Case i as text: its tree with placeholders for the node and shape rows (res_rows), dumped
+ * with them written in; 0 or -1. */
+static int res_case_text(codec_text *t, const codec_request *r, const sm_model *m,
+                         const sm_result *res, int i)
+{
+    res_rx rx = {NULL, 0, 1 + 2 * (res->cases[i].n_modes > 0 ? res->cases[i].n_modes : 0)};
+    json_t *x;
+    int rc = -1;
+
+    rx.rows = malloc((size_t)rx.cap * sizeof *rx.rows);
+    x = rx.rows ? res_case_at(r, m, res, i, &rx) : NULL;
+    if (x)
+        rc = codec_json_dump_rows(x, res_put, t, rx.rows, rx.n);
+    json_decref(x);
+    free(rx.rows);
+    return rc || t->nomem ? -1 : 0;
+}
+
 /* Cases [from, to) (each after the first of the document with its ","); 0 or -1. */
 static int res_text_cases(codec_text *t, const codec_request *r, const sm_model *m,
                           const sm_result *res, int from, int to)
@@ -580,7 +616,7 @@ static int res_text_cases(codec_text *t, const codec_request *r, const sm_model 
     for (int i = from; i < to; i++) {
         if (i > 0)
             codec_text_puts(t, ",");
-        if (res_dump(t, res_case_at(r, m, res, i)))
+        if (res_case_text(t, r, m, res, i))
             return -1;
     }
     return 0;
