@@ -52,14 +52,27 @@ static int numtext_scale(double x, int p, long double *N)
     return 0;
 }
 
+/* "00" to "99": two digits a step (numtext_digits). */
+static const char numtext_pairs[201] = "00010203040506070809101112131415161718192021222324"
+                                       "25262728293031323334353637383940414243444546474849"
+                                       "50515253545556575859606162636465666768697071727374"
+                                       "75767778798081828384858687888990919293949596979899";
+
 /* The 17 significant digits of x > 0 (normal) into dig and its decimal exponent into *X
- * (x ~ d.dddd 10^X after rounding); 0 when the rounding is not sure (the caller asks glibc). */
+ * (x ~ d.dddd 10^X after rounding); 0 when the rounding is not sure (the caller asks glibc).
+ * The exponents come from the bits and the floor of N from its integer part instead of frexp,
+ * frexpl, ldexpl and floorl (the same values), and the digits two at a time (issue 27). */
 static int numtext_digits(double x, char dig[17], int *X)
 {
-    int e2, X0, ulps = 0, found = 0;
+    int X0, ulps = 0, found = 0;
     long double N = 0;
-    (void)frexp(x, &e2); /* 2^(e2-1) <= x < 2^e2 */
-    X0 = (int)floor((e2 - 1) * 0.30102999566398120);
+    uint64_t bits;
+    memcpy(&bits, &x, sizeof bits);
+    int e2 = (int)((bits >> 52) & 0x7ff) - 1022; /* frexp's: 2^(e2-1) <= x < 2^e2 (normal x) */
+    /* floor((e2 - 1) log10 2), the first guess of the decimal exponent (the search below
+     * settles it): ((e2 - 1) 78913) >> 18 is floor((e2 - 1) 0.30102999566398120) for every
+     * double's exponent (checked for |e2| <= 1100) */
+    X0 = (int)(((int64_t)(e2 - 1) * 78913) >> 18);
     for (int X1 = X0 + 1; X1 >= X0 - 1 && !found; X1--) { /* the largest X with N >= 1e16 */
         if (!(ulps = numtext_scale(x, 16 - X1, &N)))
             return 0;
@@ -71,19 +84,26 @@ static int numtext_digits(double x, char dig[17], int *X)
     /* near either end of [1e16, 1e17) the exponent itself is not sure */
     if (!found || !(N >= 1e16L + 4 && N < 1e17L - 4))
         return 0;
-    int e;
-    (void)frexpl(N, &e);                                 /* 2^(e-1) <= N < 2^e */
-    long double err = ldexpl((long double)ulps, e - 64); /* ulps of N */
-    long double fl = floorl(N), frac = N - fl;           /* both exact */
+    /* an ulp of N: 2^(e-64) for 2^(e-1) <= N < 2^e, e = 54..57 in [1e16, 1e17) */
+    long double ulp = N < 0x1p54L   ? 0x1p-10L
+                      : N < 0x1p55L ? 0x1p-9L
+                      : N < 0x1p56L ? 0x1p-8L
+                                    : 0x1p-7L;
+    long double err = (long double)ulps * ulp;
+    uint64_t fl = (uint64_t)N;              /* floor: 0 < N < 2^57 */
+    long double frac = N - (long double)fl; /* exact */
     if (fabsl(frac - 0.5L) <= err)
         return 0; /* too close to a tie to round here */
-    uint64_t D = (uint64_t)fl + (frac > 0.5L);
+    uint64_t D = fl + (frac > 0.5L);
     if (D >= 100000000000000000ULL) /* cannot happen below 1e17 - 4, kept for safety */
         return 0;
-    for (int i = 16; i >= 0; i--) {
-        dig[i] = (char)('0' + D % 10);
-        D /= 10;
+    for (int i = 15; i > 0; i -= 2) {
+        unsigned r = (unsigned)(D % 100);
+        D /= 100;
+        dig[i] = numtext_pairs[2 * r];
+        dig[i + 1] = numtext_pairs[2 * r + 1];
     }
+    dig[0] = (char)('0' + D);
     return 1;
 }
 

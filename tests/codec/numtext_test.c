@@ -4,7 +4,8 @@
  *  1. random bit patterns (every finite double: subnormals, huge, tiny);
  *  2. random doubles spread evenly in log10 over 1e-45..1e75, either sign (the fast path's range
  *     and beyond it);
- *  3. values near ties and edges: m 2^k for small odd m and k = -200..200 (finite binary
+ *  3. values near ties and edges: the first, a random and the last double of every binary
+ *     exponent; m 2^k for small odd m and k = -200..200 (finite binary
  *     fractions: their exact decimals end in 5), 10^k and its neighbours, integers around
  *     10^16 and 10^17, numbers whose 17-digit rounding carries into a new decade
  *     (9.99999999999999999e k), 0, -0, the largest and smallest doubles;
@@ -177,6 +178,16 @@ int main(void)
         check(9.99999999999999999 * p, 1);
         check(9.9999999999999995 * p, 1);
         check(1.00000000000000005 * p, 1);
+    }
+    /* every binary exponent: its first double, a random one and its last (the exponent and
+     * the decimal exponent's first guess come from the bits, numtext_digits), either sign */
+    for (int e = -1021; e <= 1024; e++) {
+        double lo = ldexp(1.0, e - 1), hi = nextafter(ldexp(1.0, e), 0);
+        double mid = ldexp(1.0 + (double)(next_u64() >> 12) / 4503599627370496.0, e - 1);
+        check(lo, 1);
+        check(-hi, 1);
+        check(mid, e % 4 == 0);
+        check(hi, 0);
     }
     for (double x = 1e16 - 64; x <= 1e16 + 64; x += 2) /* doubles are 2 apart there */
         check(x, 1);
