@@ -617,6 +617,14 @@ int req_parse_codec_only(codec_request **out, const char *text, size_t len,
  */
 int codec_memstream_done(FILE *f, char **buf, size_t *n, char **out, size_t *len);
 
+/* ------------------------------------------------------------ sha256.c */
+
+/** codec_sha256_hex with accel 0: the portable rounds even where the CPU has the SHA
+ *  extensions (the unit test compares the two). */
+int codec_sha256_hex_with(const void *data, size_t len, char hex[65], int accel);
+/** 1 when codec_sha256_hex uses the CPU's SHA extensions. */
+int codec_sha256_accelerated(void);
+
 /* ------------------------------------------------------------ numtext.c */
 
 /** Room for codec_numtext's text with its NUL. */

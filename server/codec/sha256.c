@@ -60,7 +60,104 @@ static void sha_block(uint32_t h[8], const unsigned char *p)
         h[i] += a[i];
 }
 
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <cpuid.h>
+#include <immintrin.h>
+#define SHA_NI 1
+
+/* 1 when the CPU has the SHA extensions and SSSE3 / SSE4.1 (their shuffles and blends), asked
+ * once (CPUID leaf 7 EBX bit 29, leaf 1 ECX bits 9 and 19).  Valgrind's CPU leaves them out, so
+ * under it the portable rounds run. */
+static int sha_ni_have(void)
+{
+    static int have = -1; /* -1 unknown; every thread finds the same answer */
+    int h = __atomic_load_n(&have, __ATOMIC_RELAXED);
+    if (h < 0) {
+        unsigned a, b, c, d;
+        h = __get_cpuid_count(7, 0, &a, &b, &c, &d) && (b & (1u << 29)) &&
+            __get_cpuid(1, &a, &b, &c, &d) && (c & (1u << 9)) && (c & (1u << 19));
+        __atomic_store_n(&have, h, __ATOMIC_RELAXED);
+    }
+    return h;
+}
+
+/* Four rounds from the message words x (W[4g..4g+3]) and the constants K[4g..]: SHA256RNDS2
+ * does two rounds on the state halves abef, cdgh (Intel's SHA extensions reference). */
+#define SHA_NI_ROUNDS4(x, g)                                                                  \
+    do {                                                                                      \
+        __m128i m_ = _mm_add_epi32((x), _mm_loadu_si128((const __m128i *)(sha_k + 4 * (g)))); \
+        cdgh = _mm_sha256rnds2_epu32(cdgh, abef, m_);                                         \
+        abef = _mm_sha256rnds2_epu32(abef, cdgh, _mm_shuffle_epi32(m_, 0x0E));                \
+    } while (0)
+
+/* sha_block's fold for n blocks at p with the SHA extensions: the same state, ~4 instructions a
+ * byte instead of ~80 (issue 27: the request's hash was 4 % of a small solve). */
+__attribute__((target("sha,sse4.1,ssse3"))) static void
+sha_blocks_ni(uint32_t h[8], const unsigned char *p, size_t n)
+{
+    const __m128i bswap = _mm_set_epi64x(0x0c0d0e0f08090a0bLL, 0x0405060700010203LL);
+    __m128i t = _mm_shuffle_epi32(_mm_loadu_si128((const __m128i *)h), 0xB1);          /* cdab */
+    __m128i cdgh = _mm_shuffle_epi32(_mm_loadu_si128((const __m128i *)(h + 4)), 0x1B); /* efgh */
+    __m128i abef = _mm_alignr_epi8(t, cdgh, 8);
+    cdgh = _mm_blend_epi16(cdgh, t, 0xF0);
+    for (; n > 0; n--, p += 64) {
+        __m128i abef0 = abef, cdgh0 = cdgh, w[4];
+        for (int i = 0; i < 4; i++)
+            w[i] = _mm_shuffle_epi8(_mm_loadu_si128((const __m128i *)(p + 16 * i)), bswap);
+        /* group g uses w[g % 4]; the schedule makes w[(g + 1) % 4] for group g + 1 (from group
+         * 3 on) and starts w[(g - 1) % 4] for group g + 3 (groups 1 to 12) */
+        for (int g = 0; g < 16; g++) {
+            __m128i x = w[g & 3];
+            if (g >= 3 && g <= 14) {
+                __m128i nx = _mm_add_epi32(w[(g + 1) & 3], _mm_alignr_epi8(x, w[(g + 3) & 3], 4));
+                w[(g + 1) & 3] = _mm_sha256msg2_epu32(nx, x);
+            }
+            SHA_NI_ROUNDS4(x, g);
+            if (g >= 1 && g <= 12)
+                w[(g + 3) & 3] = _mm_sha256msg1_epu32(w[(g + 3) & 3], x);
+        }
+        abef = _mm_add_epi32(abef, abef0);
+        cdgh = _mm_add_epi32(cdgh, cdgh0);
+    }
+    t = _mm_shuffle_epi32(abef, 0x1B);    /* feba */
+    cdgh = _mm_shuffle_epi32(cdgh, 0xB1); /* dchg */
+    _mm_storeu_si128((__m128i *)h, _mm_blend_epi16(t, cdgh, 0xF0));
+    _mm_storeu_si128((__m128i *)(h + 4), _mm_alignr_epi8(cdgh, t, 8));
+}
+#else
+#define SHA_NI 0
+#endif
+
+int codec_sha256_accelerated(void)
+{
+#if SHA_NI
+    return sha_ni_have();
+#else
+    return 0;
+#endif
+}
+
+/* n blocks at p into h: the SHA extensions where the CPU has them and accel, else sha_block. */
+static void sha_blocks(uint32_t h[8], const unsigned char *p, size_t n, int accel)
+{
+#if SHA_NI
+    if (accel && n > 0 && sha_ni_have()) {
+        sha_blocks_ni(h, p, n);
+        return;
+    }
+#else
+    (void)accel;
+#endif
+    for (size_t i = 0; i < n; i++)
+        sha_block(h, p + 64 * i);
+}
+
 int codec_sha256_hex(const void *data, size_t len, char hex[65])
+{
+    return codec_sha256_hex_with(data, len, hex, 1);
+}
+
+int codec_sha256_hex_with(const void *data, size_t len, char hex[65], int accel)
 {
     static const char digits[] = "0123456789abcdef";
     uint32_t h[8] = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
@@ -70,16 +167,14 @@ int codec_sha256_hex(const void *data, size_t len, char hex[65])
     uint64_t bits = (uint64_t)len * 8;
     size_t rest = len % 64, n_tail = rest < 56 ? 64 : 128, i;
 
-    for (i = 0; i + 64 <= len; i += 64)
-        sha_block(h, p + i);
+    sha_blocks(h, p, len / 64, accel);
     memset(tail, 0, sizeof tail);
     if (rest)
         memcpy(tail, p + len - rest, rest);
     tail[rest] = 0x80;
     for (i = 0; i < 8; i++)
         tail[n_tail - 1 - i] = (unsigned char)(bits >> (8 * i));
-    for (i = 0; i < n_tail; i += 64)
-        sha_block(h, tail + i);
+    sha_blocks(h, tail, n_tail / 64, accel);
     for (i = 0; i < 32; i++) {
         unsigned char b = (unsigned char)(h[i / 4] >> (24 - 8 * (i % 4)));
         hex[2 * i] = digits[b >> 4];
