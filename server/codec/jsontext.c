@@ -191,7 +191,7 @@ static void jt_value(jt_out *o, const json_t *x)
         break;
     }
     case JSON_REAL:
-        jt_put(o, num, (size_t)codec_numtext(num, json_real_value(x), 1));
+        jt_real(o, json_real_value(x)); /* always finite: jansson refuses the others */
         break;
     case JSON_TRUE:
         jt_put(o, "true", 4);
