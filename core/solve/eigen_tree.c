@@ -31,6 +31,14 @@
  * carries ~cond(K*) eps and the frequencies wander by ~2e-9 between bases), the noise-limited
  * acceptance: residual below 1e-7 and frequencies steady to 1e-8. */
 #define EIG_TREE_LATE 48
+/* Past EIG_TREE_LATE vectors, also (spatial models, solver 0.8.7): frequencies steady to
+ * EIG_TREE_STALL with a residual below EIG_TREE_LATE_STEADY.  Many modes of a stiff blade reach
+ * that and then lose it as the basis grows: 40 modes of a 250-element precone blade (EA 8.4e8) at
+ * 20 rad/s had a residual of 2.0e-7 with frequencies steady to 6e-12 at 138 vectors, and from
+ * there frequencies that flickered by 2.2e-7 between bases and residuals of 2e-4 up to the largest
+ * basis (eigen_failed in 0.8.6; 1500 coordinates, beyond the dense path).  Where a basis met this
+ * before one of the tests above, the modes are now that basis's (another basis than 0.8.6's). */
+#define EIG_TREE_LATE_STEADY 1e-6
 /* From ~40 modes on, the Ritz vectors of the highest modes stall at relative residuals of 1e-7 to
  * 3e-5 (their error lies along stiff directions that shift-invert at zero resolves last, and the
  * residual weighs it by K) while every frequency is steady to 1e-11: 48, 64 and 100 modes of a
@@ -40,6 +48,16 @@
  * frequencies are steady to EIG_TREE_STALL between the last two bases, instead of the dense path
  * (only there: what the other tests accept stays bit for bit as it was). */
 #define EIG_TREE_SHAPE_FLOOR 1e-4
+/* The residuals need not fall as the basis grows (spatial models, solver 0.8.7): 40 modes of a 400-element precone blade at
+ * 20 rad/s (2400 coordinates) reached 2.0e-7 at 130 vectors, where the frequencies had moved by
+ * 7e-10, and then rose to 2e-4 for two modes by the largest basis (the Ritz vectors' error along
+ * the stiff directions grows with the basis), which failed the case (eigen_failed; the dense path
+ * is limited to 1000 coordinates).  So from EIG_TREE_LATE vectors on, the basis with the smallest
+ * residual is kept; when the largest basis meets no test above, its modes are accepted if that
+ * residual is below EIG_TREE_SHAPE_FLOOR and their frequencies agree with the largest basis's to
+ * EIG_TREE_BEST_AGREE (relative): two bases give the frequencies, the better one the shapes.  Only
+ * where the other tests fail: what they accept stays as it was. */
+#define EIG_TREE_BEST_AGREE 1e-8
 #define EIG_TREE_MAX_BASIS 240
 #define EIG_TREE_STEP 8
 
@@ -362,6 +380,38 @@ done:
     return rc;
 }
 
+/* 1 when the kept basis (best, its residual best_res) may give the modes at the end of the
+ * Krylov steps (EIG_TREE_BEST_AGREE): a residual below EIG_TREE_SHAPE_FLOOR and frequencies
+ * within EIG_TREE_BEST_AGREE of those of the largest basis (out). */
+static int eig_tree_best_agrees(int modes, const sm_eig_out *out, const sm_eig_out *best,
+                                double best_res)
+{
+    if (!best->wim || !out->wim || !(best_res <= EIG_TREE_SHAPE_FLOOR))
+        return 0;
+    for (int j = 0; j < modes; j++)
+        if (!(fabs(best->wim[j] - out->wim[j]) <= EIG_TREE_BEST_AGREE * fabs(out->wim[j])))
+            return 0;
+    return 1;
+}
+
+/* *dst = a copy of src's modes (dst freed first); SM_OK or SM_NOMEM. */
+static int eig_out_copy(int n, const sm_eig_out *src, sm_eig_out *dst)
+{
+    eig_out_free(dst);
+    int k = src->n_modes, rc = eig_alloc_out(dst, n, k);
+    if (rc < 0) {
+        eig_out_free(dst);
+        return rc;
+    }
+    memcpy(dst->wre, src->wre, (size_t)k * sizeof(double));
+    memcpy(dst->wim, src->wim, (size_t)k * sizeof(double));
+    memcpy(dst->xre, src->xre, (size_t)n * k * sizeof(double));
+    memcpy(dst->xim, src->xim, (size_t)n * k * sizeof(double));
+    dst->negative = src->negative;
+    dst->max_re = src->max_re;
+    return SM_OK;
+}
+
 int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const sm_progress *pr,
                    sm_eig_out *out, int *fallback)
 {
@@ -388,8 +438,10 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const
            *CV = malloc((size_t)n * cols * sizeof(double));
     double *KV = malloc((size_t)n * cols * sizeof(double)), *tmp = dm_vec(6 * (size_t)n),
            *h = dm_vec((size_t)pmax + 2);
-    double *prev = dm_vec((size_t)modes), *cf = dm_vec(2 * cols);
+    double *prev = dm_vec((size_t)modes), *cf = dm_vec(2 * cols), best_res = INFINITY;
     int have_prev = 0, prev_p = 0;
+    sm_eig_out best; /* the modes of the basis with the smallest residual from EIG_TREE_LATE on */
+    memset(&best, 0, sizeof best);
     if (!Q || !V || !MV || !CV || !KV || !tmp || !h || !prev || !cf)
         goto done;
     for (int i = 0; i < n; i++) /* a start vector with every component of x, and y = 0 */
@@ -463,7 +515,9 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const
             }
         }
         if (res <= EIG_TREE_TOL || (res <= EIG_TREE_FLOOR && moved <= EIG_TREE_STALL) ||
-            (p >= EIG_TREE_LATE && res <= 1e-7 && moved <= 1e-8)) {
+            (p >= EIG_TREE_LATE && res <= 1e-7 && moved <= 1e-8) ||
+            (!t->fixed_bits && p >= EIG_TREE_LATE && res <= EIG_TREE_LATE_STEADY &&
+             moved <= EIG_TREE_STALL)) {
             out->negative = t->neg;
             *fallback = 0;
             keep_warm = 1;
@@ -476,8 +530,23 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const
                 keep_warm = 1;
                 break;
             }
+            if (!t->fixed_bits &&
+                eig_tree_best_agrees(modes, out, &best, best_res)) { /* the better basis's modes */
+                eig_out_free(out);
+                *out = best;
+                memset(&best, 0, sizeof best);
+                out->negative = t->neg;
+                *fallback = 0;
+                keep_warm = 1;
+                break;
+            }
             eig_out_free(out); /* no convergence: the dense path */
             break;
+        }
+        if (!t->fixed_bits && p >= EIG_TREE_LATE && out->wim && res < best_res) {
+            if ((rc = eig_out_copy(n, out, &best)) < 0)
+                goto done;
+            best_res = res;
         }
         next += step;
     }
@@ -510,5 +579,6 @@ done:
     free(h);
     free(prev);
     free(cf);
+    eig_out_free(&best);
     return rc;
 }
