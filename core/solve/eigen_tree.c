@@ -48,16 +48,24 @@
  * frequencies are steady to EIG_TREE_STALL between the last two bases, instead of the dense path
  * (only there: what the other tests accept stays bit for bit as it was). */
 #define EIG_TREE_SHAPE_FLOOR 1e-4
-/* The residuals need not fall as the basis grows (spatial models, solver 0.8.7): 40 modes of a 400-element precone blade at
- * 20 rad/s (2400 coordinates) reached 2.0e-7 at 130 vectors, where the frequencies had moved by
- * 7e-10, and then rose to 2e-4 for two modes by the largest basis (the Ritz vectors' error along
- * the stiff directions grows with the basis), which failed the case (eigen_failed; the dense path
- * is limited to 1000 coordinates).  So from EIG_TREE_LATE vectors on, the basis with the smallest
- * residual is kept; when the largest basis meets no test above, its modes are accepted if that
- * residual is below EIG_TREE_SHAPE_FLOOR and their frequencies agree with the largest basis's to
- * EIG_TREE_BEST_AGREE (relative): two bases give the frequencies, the better one the shapes.  Only
- * where the other tests fail: what they accept stays as it was. */
-#define EIG_TREE_BEST_AGREE 1e-8
+/* The residuals need not fall as the basis grows (spatial models, solver 0.8.7): 40 modes of a
+ * 400-element precone blade at 20 rad/s (2400 coordinates) reached 2.0e-7 at 130 vectors, where
+ * the frequencies had moved by 7e-10, and then rose to 2e-4 for two modes by the largest basis
+ * (the Ritz vectors' error along the stiff directions grows with the basis), which failed the case
+ * (eigen_failed; the dense path is limited to 1000 coordinates).  So from EIG_TREE_LATE vectors on,
+ * the basis with the smallest residual is kept; when the largest basis meets no test above, its
+ * modes are accepted if that residual is below EIG_TREE_BEST_FLOOR and their frequencies agree
+ * with the largest basis's to EIG_TREE_BEST_AGREE (relative): two bases vouch for the frequencies,
+ * the better one gives the shapes.  The floor is above EIG_TREE_SHAPE_FLOOR because the worst
+ * residuals are the torsion modes' (a translation error of 1e-8 weighs with the mass, ~3000 times
+ * the polar inertia of their own inertia force: 1.2e-4 at best on the 400-element blade at
+ * 30 rad/s), and the agreement is looser than the steady test's because the highest mode asked
+ * converges last (it moved by 1.1e-8 between the two bases at 600 elements and 30 rad/s).
+ * Against the dense path on such cases (1800 and 2400 coordinates): frequencies within 1.3e-8,
+ * shapes within 1.4e-5 (both the highest mode asked).  Only where the other tests fail: what
+ * they accept stays as it was. */
+#define EIG_TREE_BEST_AGREE 1e-7
+#define EIG_TREE_BEST_FLOOR 1e-3
 #define EIG_TREE_MAX_BASIS 240
 #define EIG_TREE_STEP 8
 
@@ -381,12 +389,12 @@ done:
 }
 
 /* 1 when the kept basis (best, its residual best_res) may give the modes at the end of the
- * Krylov steps (EIG_TREE_BEST_AGREE): a residual below EIG_TREE_SHAPE_FLOOR and frequencies
+ * Krylov steps (EIG_TREE_BEST_AGREE): a residual below EIG_TREE_BEST_FLOOR and frequencies
  * within EIG_TREE_BEST_AGREE of those of the largest basis (out). */
 static int eig_tree_best_agrees(int modes, const sm_eig_out *out, const sm_eig_out *best,
                                 double best_res)
 {
-    if (!best->wim || !out->wim || !(best_res <= EIG_TREE_SHAPE_FLOOR))
+    if (!best->wim || !out->wim || !(best_res <= EIG_TREE_BEST_FLOOR))
         return 0;
     for (int j = 0; j < modes; j++)
         if (!(fabs(best->wim[j] - out->wim[j]) <= EIG_TREE_BEST_AGREE * fabs(out->wim[j])))
