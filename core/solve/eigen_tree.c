@@ -59,12 +59,14 @@
  * the better one gives the shapes.  The floor is above EIG_TREE_SHAPE_FLOOR because the worst
  * residuals are the torsion modes' (a translation error of 1e-8 weighs with the mass, ~3000 times
  * the polar inertia of their own inertia force: 1.2e-4 at best on the 400-element blade at
- * 30 rad/s), and the agreement is looser than the steady test's because the highest mode asked
- * converges last (it moved by 1.1e-8 between the two bases at 600 elements and 30 rad/s).
- * Against the dense path on such cases (1800 and 2400 coordinates): frequencies within 1.3e-8,
- * shapes within 1.4e-5 (both the highest mode asked).  Only where the other tests fail: what
- * they accept stays as it was. */
-#define EIG_TREE_BEST_AGREE 1e-7
+ * 30 rad/s).  The agreement checks that both bases hold the same modes (a mode missing from one
+ * shifts the list by a whole gap); it is not the accuracy: the largest basis drifts, and its
+ * highest mode asked was 1.1e-8 to 1.5e-7 from the kept basis's (600 elements at 30 rad/s; a
+ * sweep at 250 elements with 10 EA and warm starts), while the kept bases' frequencies were within
+ * 1e-10 of the dense path's over that sweep (17 to 22 rad/s).  Against the dense path on such cases
+ * (1500 to 2400 coordinates): frequencies within 1.3e-8, shapes within 1.4e-5 (both the highest
+ * mode asked).  Only where the other tests fail: what they accept stays as it was. */
+#define EIG_TREE_BEST_AGREE 1e-6
 #define EIG_TREE_BEST_FLOOR 1e-3
 #define EIG_TREE_MAX_BASIS 240
 #define EIG_TREE_STEP 8
