@@ -524,36 +524,31 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const
                 have_prev = 1;
             }
         }
-        if (res <= EIG_TREE_TOL || (res <= EIG_TREE_FLOOR && moved <= EIG_TREE_STALL) ||
-            (p >= EIG_TREE_LATE && res <= 1e-7 && moved <= 1e-8) ||
-            (!t->fixed_bits && p >= EIG_TREE_LATE && res <= EIG_TREE_LATE_STEADY &&
-             moved <= EIG_TREE_STALL)) {
+        int spatial = !t->fixed_bits,
+            accept = res <= EIG_TREE_TOL || (res <= EIG_TREE_FLOOR && moved <= EIG_TREE_STALL) ||
+                     (p >= EIG_TREE_LATE && res <= 1e-7 && moved <= 1e-8) ||
+                     (spatial && p >= EIG_TREE_LATE && res <= EIG_TREE_LATE_STEADY &&
+                      moved <= EIG_TREE_STALL);
+        if (!accept && (breakdown || p >= pmax)) {
+            if (res <= EIG_TREE_SHAPE_FLOOR && moved <= EIG_TREE_STALL) { /* steady frequencies */
+                accept = 1;
+            } else if (spatial && eig_tree_best_agrees(modes, out, &best, best_res)) {
+                eig_out_free(out); /* the modes of the basis with the smallest residual */
+                *out = best;
+                memset(&best, 0, sizeof best);
+                accept = 1;
+            } else {
+                eig_out_free(out); /* no convergence: the dense path */
+                break;
+            }
+        }
+        if (accept) {
             out->negative = t->neg;
             *fallback = 0;
             keep_warm = 1;
             break;
         }
-        if (breakdown || p >= pmax) {
-            if (res <= EIG_TREE_SHAPE_FLOOR && moved <= EIG_TREE_STALL) { /* steady frequencies */
-                out->negative = t->neg;
-                *fallback = 0;
-                keep_warm = 1;
-                break;
-            }
-            if (!t->fixed_bits &&
-                eig_tree_best_agrees(modes, out, &best, best_res)) { /* the better basis's modes */
-                eig_out_free(out);
-                *out = best;
-                memset(&best, 0, sizeof best);
-                out->negative = t->neg;
-                *fallback = 0;
-                keep_warm = 1;
-                break;
-            }
-            eig_out_free(out); /* no convergence: the dense path */
-            break;
-        }
-        if (!t->fixed_bits && p >= EIG_TREE_LATE && out->wim && res < best_res) {
+        if (spatial && p >= EIG_TREE_LATE && out->wim && res < best_res) {
             if ((rc = eig_out_copy(n, out, &best)) < 0)
                 goto done;
             best_res = res;
