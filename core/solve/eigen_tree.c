@@ -428,7 +428,8 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const
     int n = m->n, N2 = 2 * n, rc, nv = 0, done_x = 0;
     int pmax = EIG_TREE_MAX_BASIS < N2 - 1 ? EIG_TREE_MAX_BASIS : N2 - 1;
     /* the previous modes on this workspace start the basis when the sweep chains the speeds */
-    int warm = !t->fixed_bits && t->warm_next && t->warm_ok && t->warm, keep_warm = 0;
+    int spatial = !t->fixed_bits; /* planar models keep their bits (issue 27) */
+    int warm = spatial && t->warm_next && t->warm_ok && t->warm, keep_warm = 0;
     t->warm_next = 0;
     t->warm_ok = 0; /* until this analysis gives modes */
     memset(out, 0, sizeof *out);
@@ -485,7 +486,7 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const
             goto done;
         }
         double *w = Q + (size_t)(p + 1) * N2;
-        if (!t->fixed_bits) { /* the basis holds the vector's x-part before its product */
+        if (spatial) { /* the basis holds the vector's x-part before its product */
             eig_tree_extend(m, t, coriolis, p, Q, V, MV, KV, CV, h, &nv, &done_x);
             rc = eig_tree_op_basis(m, t, coriolis, nv, V, MV, CV, Q + (size_t)p * N2, w, tmp, cf,
                                    &refine);
@@ -524,8 +525,7 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const
                 have_prev = 1;
             }
         }
-        int spatial = !t->fixed_bits,
-            accept = res <= EIG_TREE_TOL || (res <= EIG_TREE_FLOOR && moved <= EIG_TREE_STALL) ||
+        int accept = res <= EIG_TREE_TOL || (res <= EIG_TREE_FLOOR && moved <= EIG_TREE_STALL) ||
                      (p >= EIG_TREE_LATE && res <= 1e-7 && moved <= 1e-8) ||
                      (spatial && p >= EIG_TREE_LATE && res <= EIG_TREE_LATE_STEADY &&
                       moved <= EIG_TREE_STALL);
@@ -556,7 +556,7 @@ int eig_solve_tree(const sm_model *m, tree_ws *t, int coriolis, int modes, const
         next += step;
     }
     rc = SM_OK;
-    if (keep_warm && !t->fixed_bits) { /* the next speed's start: the modes, each normalised */
+    if (keep_warm && spatial) { /* the next speed's start: the modes, each normalised */
         if (!t->warm)
             t->warm = malloc((size_t)n * sizeof(double));
         if (t->warm) {
