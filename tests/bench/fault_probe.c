@@ -33,7 +33,8 @@ int main(void)
         printf("first touch, anonymous mmap: %.3f us a page\n", (b - a) / (double)pages);
         munmap(p, n);
         a = now_us();
-        p = mmap(NULL, n, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1, 0);
+        p = mmap(NULL, n, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS | MAP_POPULATE, -1,
+                 0);
         if (p == MAP_FAILED)
             return 1;
         for (size_t i = 0; i < n; i += 4096)

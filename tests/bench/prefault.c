@@ -29,7 +29,8 @@ __attribute__((constructor(101))) static void prefault(void)
     if ((how && *how == 'n') || hi <= lo)
         return;
     uintptr_t a = ((uintptr_t)lo + 4095) & ~(uintptr_t)4095;
-    if ((how && *how == 't') || madvise((void *)a, (size_t)(hi - (char *)a), MADV_POPULATE_WRITE) != 0)
+    if ((how && *how == 't') ||
+        madvise((void *)a, (size_t)(hi - (char *)a), MADV_POPULATE_WRITE) != 0)
         for (char *q = (char *)a; q < hi; q += 4096)
             *(volatile char *)q = 0;
 }
