@@ -192,7 +192,7 @@ int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress
         /* the case's steady-state outputs and modes: here, or on a worker (sweep_pool.h); a case
          * after the first of its chunk starts its eigen-analysis from the case before */
         if (!pool)
-            smi_lin_warm(L, t % SWEEP_WARM_CHUNK != 0);
+            smi_lin_warm(L, t % sweep_chunk(m) != 0);
         if (pool ? (rc = sweep_pool_add(pool, c, q)) < 0
                  : (rc = sweep_case_finish(m, q, L, &pr, after, c)) < 0)
             goto fail;

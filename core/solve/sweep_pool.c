@@ -2,7 +2,7 @@
  * sweep_pool.c — worker threads that finish a sweep's cases at their equilibria (sweep_pool.h).
  *
  * sweep_run (sweep.c) queues each speed's case once its equilibrium is found; threads - 1
- * workers, each with its own smi_lin, take the chunks of SWEEP_WARM_CHUNK cases in queue order
+ * workers, each with its own smi_lin, take the chunks of sweep_chunk cases in queue order
  * and finish a chunk's cases one after the other as they are queued (warm starts), and the
  * calling thread takes its share once the continuation is done.  A case is written by one
  * thread only after it is queued, under the pool's lock, so the hand-over orders the calling
@@ -33,6 +33,7 @@ struct sweep_pool {
     pthread_cond_t ended; /* a case was finished */
     pool_job *jobs;       /* queue: jobs[0 .. tail) queued; chunks from head on not taken */
     int head, tail, n_cases;
+    int chunk; /* sweep_chunk */
     int running, finished, closing;
     int rc; /* first SM_NOMEM / SM_CANCELED of a thread */
     atomic_int stop;
@@ -53,7 +54,7 @@ static int pool_take(sweep_pool *p, int *start)
     if (p->head >= p->tail)
         return 0;
     *start = p->head;
-    p->head += SWEEP_WARM_CHUNK;
+    p->head += p->chunk;
     p->running++;
     return 1;
 }
@@ -80,7 +81,7 @@ static void pool_ask(sweep_pool *p, sm_progress *pr)
  * (pool_ask) is asked after each case; a worker's pr is the stop flag's. */
 static void pool_run(sweep_pool *p, int start, smi_lin *L, sm_progress *pr, int caller)
 {
-    int end = start + SWEEP_WARM_CHUNK < p->n_cases ? start + SWEEP_WARM_CHUNK : p->n_cases;
+    int end = start + p->chunk < p->n_cases ? start + p->chunk : p->n_cases;
     pthread_mutex_lock(&p->mu);
     for (int j = start; j < end; j++) {
         while (j >= p->tail && !p->closing)
@@ -134,6 +135,11 @@ static void *pool_worker(void *arg)
     return NULL;
 }
 
+int sweep_chunk(const sm_model *m)
+{
+    return tree_use(m) && !m->kind->fixed_bits ? SWEEP_WARM_CHUNK : 1;
+}
+
 int sweep_pool_new(const sm_model *m, int threads, int n_cases, sweep_case_fn after,
                    sweep_pool **out)
 {
@@ -144,6 +150,7 @@ int sweep_pool_new(const sm_model *m, int threads, int n_cases, sweep_case_fn af
     p->m = m;
     p->after = after;
     p->n_cases = n_cases;
+    p->chunk = sweep_chunk(m);
     p->n_workers = threads - 1 < n_cases ? threads - 1 : n_cases;
     p->jobs = calloc((size_t)(n_cases > 0 ? n_cases : 1), sizeof *p->jobs);
     p->th = calloc((size_t)(p->n_workers > 0 ? p->n_workers : 1), sizeof *p->th);

@@ -10,7 +10,8 @@
  * progress callback is only ever called from the calling thread (spinmodal.h); workers stop
  * when the pool is told to.
  *
- * Warm starts (issue 27): the speeds, in ascending order, form chunks of SWEEP_WARM_CHUNK; the
+ * Warm starts (issue 27): the speeds, in ascending order, form chunks of SWEEP_WARM_CHUNK (a
+ * spatial model on the tree path; chunks of one case otherwise, sweep_chunk); the
  * eigen-analysis of a chunk's first speed starts cold, each of the others from the modes of the
  * speed before it (smi_lin_warm).  One thread finishes a whole chunk in order, on its own
  * smi_lin, so a speed's start, and its bits, do not depend on the number of threads.
@@ -24,6 +25,12 @@
  * (−11 % instructions for a 101-speed spatial sweep at 8) and the fewer chunks to share among
  * threads (13 for 101 speeds). */
 #define SWEEP_WARM_CHUNK 8
+
+/** The cases one thread finishes in a row (a chunk): SWEEP_WARM_CHUNK where the eigen-analysis
+ *  chains its starts (a spatial model on the tree path), else 1: there a case's bits do not depend
+ *  on the case before, and any free thread takes the next case.  A planar sweep's last chunk of 8
+ *  kept one thread busy for 8 cases after the continuation ended (issue 27 goal 3). */
+int sweep_chunk(const sm_model *m);
 
 /** Steady-state outputs of case c at its equilibrium q (c->converged set by the caller), and with
  *  c->converged its modes and shapes, on L (SMI_USE_MODES, this thread's own), then after(m, c)
