@@ -159,7 +159,7 @@ int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress
         goto fail;
     sm_progress pr = {cb, user, 0, n_omegas};
     double s_prev = 0;
-    int from_rest = 1;
+    int from_rest = 1, chunk = sweep_chunk(m);
     for (int t = 0; t < n_omegas; t++) {
         sm_case *c = &r->cases[key[t].index];
         double s = smi_load(m, c->omega), t0 = sweep_ms();
@@ -192,7 +192,7 @@ int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress
         /* the case's steady-state outputs and modes: here, or on a worker (sweep_pool.h); a case
          * after the first of its chunk starts its eigen-analysis from the case before */
         if (!pool)
-            smi_lin_warm(L, t % sweep_chunk(m) != 0);
+            smi_lin_warm(L, t % chunk != 0);
         if (pool ? (rc = sweep_pool_add(pool, c, q)) < 0
                  : (rc = sweep_case_finish(m, q, L, &pr, after, c)) < 0)
             goto fail;

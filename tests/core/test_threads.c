@@ -15,8 +15,13 @@
  *     messages and last iterates;
  *  5. the progress callback (only ever called from the calling thread) sees done rise to the
  *     total; a stop asked in the middle of the sweep ends it with SM_CANCELED and no result
- *     (the workers end, their cases are freed: ASan and valgrind runs check that).
+ *     (the workers end, their cases are freed: ASan and valgrind runs check that);
+ *  6. the unit a thread takes (sweep_chunk): chunks of SWEEP_WARM_CHUNK only where the
+ *     eigen-analysis chains its starts (the spatial tree path), one case elsewhere (planar
+ *     dense and tree, spatial dense), so that a planar sweep's last cases spread over the
+ *     threads instead of waiting for one (issue 27 goal 3); items 1 to 4 run with these.
  */
+#include "sweep_pool.h"
 #include "testutil.h"
 
 #include <pthread.h>
@@ -231,6 +236,20 @@ static void arm3_init(arm3 *b)
     tu_one_member3(&b->st, b->xy, b->z, &b->sec, &b->mem);
 }
 
+/* The unit of work a thread takes for the model of st under o (item 6). */
+static void check_chunk(const sm_structure *st, sm_options o, int want, const char *what)
+{
+    sm_model *m = NULL;
+    sm_diag d;
+    TU_CHECK(sm_model_new(&m, st, &o, &d) == SM_OK && m, "chunk, %s: model (%s)", what, d.message);
+    if (!m)
+        return;
+    int got = sweep_chunk(m);
+    printf("%s: a thread takes %d case%s at a time\n", what, got, got == 1 ? "" : "s");
+    TU_CHECK(got == want, "%s: chunks of %d cases, not %d", what, want, got);
+    sm_model_free(m);
+}
+
 int main(void)
 {
     tu_angled a;
@@ -259,5 +278,14 @@ int main(void)
     t.min_increments = 1;
     check_threads(&a.st, t, "planar, Newton limited to 1 iteration");
     check_cancel(&a.st, o);
+    t = o;
+    check_chunk(&a.st, t, 1, "planar dense");
+    t.solver = SM_SOLVER_TREE;
+    check_chunk(&a.st, t, 1, "planar tree");
+    t = o;
+    t.modes = 6;
+    check_chunk(&b.st, t, 1, "spatial dense");
+    t.solver = SM_SOLVER_TREE;
+    check_chunk(&b.st, t, SWEEP_WARM_CHUNK, "spatial tree (warm starts)");
     return tu_finish("test_threads");
 }
