@@ -29,7 +29,7 @@
 /** The cases one thread finishes in a row (a chunk): SWEEP_WARM_CHUNK where the eigen-analysis
  *  chains its starts (a spatial model on the tree path), else 1: there a case's bits do not depend
  *  on the case before, and any free thread takes the next case.  A planar sweep's last chunk of 8
- *  kept one thread busy for 8 cases after the continuation ended (issue 27 goal 3). */
+ *  kept one thread busy for up to 8 cases after the continuation ended (issue 27 goal 3). */
 int sweep_chunk(const sm_model *m);
 
 /** Steady-state outputs of case c at its equilibrium q (c->converged set by the caller), and with
