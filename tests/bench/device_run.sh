@@ -23,8 +23,8 @@
 #                 --jobs 40 (bench_replicas.py: one daemon on SQLite, replicas on one PostgreSQL)
 #   steps.txt     each step's exit status and elapsed seconds (also printed on stdout)
 # NEW is HEAD's spinmodal from the devpack, BASE the carried release build of 93b3ea5 (the base
-# of the earlier device measurements, DESIGN.md 2.1).  LD_LIBRARY_PATH is the devpack's lib/ (and
-# CARRY/lib/ when present) for every binary, OPENBLAS_NUM_THREADS=1 as the benches set it.
+# of the earlier device measurements, DESIGN.md 2.1).  LD_LIBRARY_PATH is the devpack's lib/ for every
+# binary, OPENBLAS_NUM_THREADS=1 as the benches set it.
 # The whole run stops starting steps at DEVRUN_DEADLINE seconds (default 360) and cuts a running
 # step there (SIGINT, so bench_replicas.py stops its daemons and PostgreSQL; KILL 20 s later).
 # Expected on the 16-core device, from the earlier device timings (DESIGN.md 2.1): env 5 s,
@@ -37,13 +37,13 @@
 #   DEVRUN_REPLICAS="--workers 1,8,16 --replicas 1,4,8 --workers-per-replica 2 --jobs 40"
 #   DEVRUN_STEPS="env sweeps small bmodes replicas bmodes-late" (a subset, in this order)
 # CARRY holds (about 35 MB; made by --prepare, which runs the commands below):
-#   devpack.tar.xz   `bash tests/bench/pack_device.sh devpack` (HEAD as committed), copied; after
-#                    new commits re-running that and the copy (or --prepare) is all it takes
+#   devpack.tar.xz   `bash tests/bench/pack_device.sh devpack` (HEAD as committed; its lib/ also
+#                    holds what the three programs below need, PACK_EXTRA_ELFS), copied; after
+#                    new commits --prepare again (only the pack is rebuilt)
 #   spinmodal-base   the CLI at 93b3ea5, release, stripped: git archive 93b3ea5 into
 #                    /tmp/src-base, meson setup /tmp/build-base --buildtype=release, ninja
 #                    server/spinmodal (no git worktree)
 #   bmodes           BModes v3.00 built by bench_bmodes.sh (BMODES_KEEP), gfortran -O2, stripped
-#   lib/             only if BASE or bmodes need a library that the devpack's lib/ lacks
 #   time             GNU time (/usr/bin/time, bench_bmodes.sh's peak memory): copied to
 #                    /usr/bin/time for the run when the device lacks it, and removed after
 #   fault_probe, prefault.so  bench_faults.sh's probe and LD_PRELOAD (gcc -O2, glibc only)
@@ -64,8 +64,6 @@ if [ "${1:-}" = --prepare ]; then
     set -eo pipefail
     carry=$(mkdir -p "${2:?usage: device_run.sh --prepare CARRY}" && cd "$2" && pwd)
     pack=${DEVRUN_PACK:-$ROOT/devpack}
-    bash "$ROOT/tests/bench/pack_device.sh" "$pack"
-    cp "$pack/devpack.tar.xz" "$carry/devpack.tar.xz"
     want=$(git -C "$ROOT" rev-parse "$BASE_COMMIT")
     if [ ! -x "$carry/spinmodal-base" ] || [ "$(cat "$carry/spinmodal-base.commit" 2>/dev/null)" != "$want" ]; then
         rm -rf /tmp/src-base /tmp/build-base
@@ -78,29 +76,23 @@ if [ "${1:-}" = --prepare ]; then
     fi
     if [ ! -x "$carry/bmodes" ]; then
         BMODES_KEEP="$carry/bmodes" BMODES_ELEMENTS=12 BMODES_SWEEP=0 \
-            bash "$ROOT/tests/bench/bench_bmodes.sh" "$pack/bin/spinmodal" 1
+            bash "$ROOT/tests/bench/bench_bmodes.sh" "$carry/spinmodal-base" 1
         strip --strip-unneeded "$carry/bmodes"
     fi
     [ -x "$carry/time" ] || cp /usr/bin/time "$carry/time"
     # bench_faults.sh's probe and preload (glibc only)
     gcc -O2 -Wall -o "$carry/fault_probe" "$ROOT/tests/bench/fault_probe.c"
     gcc -O2 -Wall -shared -fPIC -o "$carry/prefault.so" "$ROOT/tests/bench/prefault.c"
-    # libraries BASE or bmodes need that the pack does not hold (glibc's own excepted)
-    glibc='^(linux-vdso|libc|libm|libpthread|libdl|librt|libresolv|libutil|libanl|ld-linux[^ ]*)\.so'
-    rm -rf "$carry/lib"
-    ldd "$carry/spinmodal-base" "$carry/bmodes" "$carry/time" | awk '$2 == "=>" && $3 ~ /^\// {print $1, $3}' |
-        sort -u | while read -r soname path; do
-        if [[ ! $soname =~ $glibc ]] && [ ! -e "$pack/lib/$soname" ]; then
-            mkdir -p "$carry/lib"; cp -L "$path" "$carry/lib/$soname"; echo "carried beside the pack: $soname"
-        fi
-    done
+    # the pack, its lib/ holding what BASE, bmodes and time need too (pack_device.sh's collection)
+    PACK_EXTRA_ELFS="$carry/spinmodal-base $carry/bmodes $carry/time" \
+        bash "$ROOT/tests/bench/pack_device.sh" "$pack"
+    cp "$pack/devpack.tar.xz" "$carry/devpack.tar.xz"
     {
         echo "prepared $(date -u +%FT%TZ) on $(uname -n) by tests/bench/device_run.sh --prepare"
         echo "devpack.tar.xz: $(head -1 "$pack/COMMIT" | cut -c1-100)"
         echo "spinmodal-base: $(git -C "$ROOT" log -1 --format='%H %s' "$BASE_COMMIT" | cut -c1-100) (release, stripped)"
         echo "bmodes: BModes v3.00, $(git --git-dir=/work/.mirror/old-NWTC+BModes/repo rev-parse --short HEAD 2>/dev/null || echo '?'), gfortran -O2, NMAX 4000, stripped"
         echo "time: $(/usr/bin/time --version 2>&1 | head -1)"
-        [ -d "$carry/lib" ] && echo "lib/: $(ls "$carry/lib" | tr '\n' ' ')"
     } > "$carry/MANIFEST"
     cat "$carry/MANIFEST"
     du -sh "$carry"
@@ -186,7 +178,6 @@ BMODES=$WORK/bin/bmodes
 log "devpack unpacked to $DP: $(elapsed) s"
 
 LIBS=$DP/lib
-[ -d "$CARRY/lib" ] && LIBS=$LIBS:$CARRY/lib
 export LD_LIBRARY_PATH=$LIBS OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 LC_ALL=C PYTHONUNBUFFERED=1
 # GNU time for bench_bmodes.sh's peak memory column (it runs /usr/bin/time); put back afterwards
 TIME_ADDED=

@@ -12,6 +12,8 @@
 #   OUTDIR     the tree (emptied first), e.g. devpack/ (listed in .git/info/exclude); it also
 #              gets OUTDIR/devpack.tar.xz, the same tree as one file (what a device run carries)
 #   BUILD_DIR  default build-devpack (meson setup -Dbuildtype=release when absent)
+#   PACK_EXTRA_ELFS  more programs (space-separated paths) whose libraries lib/ must hold too,
+#              though they travel beside the tree (device_run.sh: the base CLI, BModes, GNU time)
 # On the device machine (the tree lands under the repository copy, which `nobody` may not be
 # able to reach; run.sh copies it to /tmp when run as root for that reason):
 #   python3 -c "import tarfile; tarfile.open('devpack/devpack.tar.xz').extractall('/tmp/dp')"
@@ -68,6 +70,8 @@ cp -r "$PGSHARE" "$OUT/pg/share/postgresql/"
 # shared libraries: everything ldd resolves outside glibc, under its soname
 glibc='^(linux-vdso|libc|libm|libpthread|libdl|librt|libresolv|libutil|libanl|ld-linux[^ ]*)\.so'
 elfs=("$OUT"/bin/* "$OUT"/pg/lib/postgresql/$PGVER/bin/* "$OUT"/pg/lib/postgresql/$PGVER/lib/*.so)
+read -r -a extra <<< "${PACK_EXTRA_ELFS:-}"
+elfs+=("${extra[@]}")
 ldd "${elfs[@]}" 2>/dev/null | awk '$2 == "=>" && $3 ~ /^\// {print $1, $3}' | sort -u |
 while read -r soname path; do
     if [[ ! $soname =~ $glibc ]] && [ ! -e "$OUT/lib/$soname" ]; then
