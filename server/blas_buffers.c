@@ -68,8 +68,7 @@ static int blas_may_keep(void)
 {
     if (blas_tl.registered == 0) {
         pthread_once(&blas_once, blas_make_key);
-        blas_tl.registered =
-            blas_key_made && pthread_setspecific(blas_key, &blas_tl) == 0 ? 1 : -1;
+        blas_tl.registered = blas_key_made && pthread_setspecific(blas_key, &blas_tl) == 0 ? 1 : -1;
     }
     return blas_tl.registered == 1;
 }

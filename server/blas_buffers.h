@@ -14,4 +14,3 @@ int blas_buffers_held(void);
 int blas_buffers_out(void);
 
 #endif
-

@@ -23,13 +23,13 @@
 extern void openblas_set_num_threads(int n);
 /* Fortran BLAS (its interface takes a work buffer: the calls dsyevr's reduction makes). */
 extern void dsymv_(const char *uplo, const int *n, const double *alpha, const double *a,
-                   const int *lda, const double *x, const int *incx, const double *beta,
-                   double *y, const int *incy);
+                   const int *lda, const double *x, const int *incx, const double *beta, double *y,
+                   const int *incy);
 
-#define N 120         /* matrix order: large enough for OpenBLAS's packed paths */
-#define THREADS 8     /* concurrent threads of check 2 */
-#define ROUNDS 200    /* calls of each kind per thread in check 2 */
-#define SHORT 1000    /* short-lived threads of check 3 */
+#define N 120      /* matrix order: large enough for OpenBLAS's packed paths */
+#define THREADS 8  /* concurrent threads of check 2 */
+#define ROUNDS 200 /* calls of each kind per thread in check 2 */
+#define SHORT 1000 /* short-lived threads of check 3 */
 
 static int failures;
 
@@ -139,8 +139,9 @@ int main(void)
         pthread_join(t1, NULL);
     }
     char msg[160];
-    snprintf(msg, sizeof msg, "after %d short-lived threads %d buffers are out (the main thread's %d)",
-             SHORT, blas_buffers_out(), out0);
+    snprintf(msg, sizeof msg,
+             "after %d short-lived threads %d buffers are out (the main thread's %d)", SHORT,
+             blas_buffers_out(), out0);
     check(blas_buffers_out() == out0, msg);
 
     printf("%s: %d failure(s)\n", failures ? "FAIL" : "ok", failures);
