@@ -141,7 +141,9 @@ if [ "${1:-}" = procs ]; then
     # processes (no daemon, no store, no shared process), default malloc and TUN
     lscpu 2>/dev/null | grep -E "^(CPU\(s\)|Thread|Core|Socket|Model name|L3)"
     python3 -c 'import json; r = json.load(open("bench/angled-beam-90.json")); r["analysis"]["omega"] = {"from": 1.0, "to": 11.0, "steps": 10}; r["analysis"]["mode_shapes"] = False; json.dump(r, open("/tmp/spinmodal-req11.json", "w"))'
-    one() { for _ in $(seq "$1"); do bin/spinmodal solve /tmp/spinmodal-req11.json >/dev/null; done; }
+    # --threads 1: a daemon worker solves on one thread (--solve-threads 1); the CLI would
+    # otherwise take a thread per core for each of the P processes
+    one() { for _ in $(seq "$1"); do bin/spinmodal solve --threads 1 /tmp/spinmodal-req11.json >/dev/null; done; }
     N=20
     for P in 1 2 4 8 12 16; do for t in "" "$TUN"; do
         s=$(date +%s%N)
