@@ -24,16 +24,7 @@ trap 'rm -rf "$tmp"' EXIT
 echo "A = $A ($("$A/spinmodal" --version 2>&1))"
 echo "B = $B ($("$B/spinmodal" --version 2>&1))"
 echo "$(nproc --all) cores, load $(cut -d' ' -f1-3 /proc/loadavg)"
-python3 - "$tmp" <<'PY'
-import json, sys
-sys.path.insert(0, "tests/bench")
-from sweep_cases import precone_blade
-d = sys.argv[1]
-r = json.load(open("examples/angled-beam-90.json"))
-r["analysis"]["omega"] = [20 * i / 100 for i in range(101)]
-json.dump(r, open(d + "/planar101.json", "w"))
-json.dump(precone_blade(omegas=[20 * i / 100 for i in range(101)]), open(d + "/blade101.json", "w"))
-PY
+python3 tests/bench/sweep_cases.py "$tmp"   # planar101, blade21, blade101 .json
 echo "== 1. CLI sweeps, median of 5 alternating runs (wall ms / CPU ms)"
 python3 - "$A/spinmodal" "$B/spinmodal" "$tmp" "$threads" <<'PY'
 import resource, statistics, subprocess, sys, time

@@ -19,17 +19,7 @@ n=${3:-5}
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-python3 - "$tmp" <<'PY'
-import json, sys
-sys.path.insert(0, "tests/bench")
-from sweep_cases import precone_blade
-d = sys.argv[1]
-r = json.load(open("examples/angled-beam-90.json"))
-r["analysis"]["omega"] = [20 * i / 100 for i in range(101)]
-json.dump(r, open(d + "/planar101.json", "w"))
-json.dump(precone_blade(), open(d + "/blade21.json", "w"))
-json.dump(precone_blade(omegas=[20 * i / 100 for i in range(101)]), open(d + "/blade101.json", "w"))
-PY
+python3 tests/bench/sweep_cases.py "$tmp"   # planar101, blade21, blade101 .json
 ms() {
   local s e
   s=$(date +%s%N)

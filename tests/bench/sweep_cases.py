@@ -1,7 +1,10 @@
-"""tests/bench/sweep_cases.py — the spatial sweep case of issue 27's benchmarks, written once
-(bench_sweeps.sh, compare_outputs.py): the R3-style precone blade of bench_spatial.c, hub radius
-1 m, 10 m at 10 degrees precone, per-element frames (6 coordinates each), clamped at the hub."""
+"""tests/bench/sweep_cases.py — the sweep cases of issue 27's benchmarks, written once
+(bench_sweeps.sh, bench_ab.sh, compare_outputs.py): the R3-style precone blade of bench_spatial.c,
+hub radius 1 m, 10 m at 10 degrees precone, per-element frames (6 coordinates each), clamped at
+the hub; and the benchmark files (write_bench_files)."""
+import json
 import math
+import os
 
 
 def precone_blade(elements=48, omegas=None, modes=3, **analysis):
@@ -18,3 +21,22 @@ def precone_blade(elements=48, omegas=None, modes=3, **analysis):
                                        "elements": elements}],
                           "clamp": "H"},
             "frames": "per_element", "analysis": a}
+
+
+def write_bench_files(folder, root="."):
+    """The benchmark sweeps as request files in folder: planar101.json (examples/angled-beam-90.json
+    at 101 speeds, 0 to 20 rad/s), blade21.json (precone_blade()) and blade101.json (the blade at
+    the same 101 speeds).  root: the repository."""
+    speeds = [20 * i / 100 for i in range(101)]
+    with open(os.path.join(root, "examples", "angled-beam-90.json")) as f:
+        r = json.load(f)
+    r["analysis"]["omega"] = speeds
+    for name, req in (("planar101", r), ("blade21", precone_blade()),
+                      ("blade101", precone_blade(omegas=speeds))):
+        with open(os.path.join(folder, name + ".json"), "w") as f:
+            json.dump(req, f)
+
+
+if __name__ == "__main__":
+    import sys
+    write_bench_files(sys.argv[1])
