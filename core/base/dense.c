@@ -88,3 +88,128 @@ int dm_sytrf_negative(int n, const double *A, const int *ipiv)
     }
     return neg;
 }
+
+/* The unreduced blocks of the tridiagonal (d, e): split where e_j^2 <= |d_j d_j+1| ulp^2 + safmin,
+ * LAPACK dstebz's test, so that dstein sees the blocks dsyevr's bisection saw.  isplit[b] is the
+ * last row (1-based) of block b; returns the number of blocks. */
+static int dm_tri_split(int n, const double *d, const double *e, int *isplit)
+{
+    const double ulp = LAPACKE_dlamch('P'), safmin = LAPACKE_dlamch('S');
+    int nb = 0;
+    for (int j = 1; j < n; j++)
+        if (fabs(d[j] * d[j - 1]) * ulp * ulp + safmin > e[j - 1] * e[j - 1])
+            isplit[nb++] = j;
+    isplit[nb++] = n;
+    return nb;
+}
+
+typedef struct dm_eigval {
+    double w;  /* an eigenvalue of the tridiagonal */
+    int block; /* its unreduced block, 1-based (dstein's iblock) */
+} dm_eigval;
+
+static int dm_eigval_cmp(const void *a, const void *b)
+{
+    const dm_eigval *x = a, *y = b;
+    return x->w < y->w ? -1 : x->w > y->w ? 1 : x->block - y->block;
+}
+
+static int dm_eigval_block_cmp(const void *a, const void *b)
+{
+    const dm_eigval *x = a, *y = b;
+    return x->block != y->block ? x->block - y->block : dm_eigval_cmp(a, b);
+}
+
+/* dm_syev_range's route without bisection (dense.h). */
+static int dm_syev_tri(int n, double *A, int il, int iu, double *w, double *Z, int ldz)
+{
+    int m = iu - il + 1, info = LAPACK_WORK_MEMORY_ERROR;
+    double *d = malloc(4 * (size_t)n * sizeof(double)), *e = d + n, *tau = e + n, *dd = tau + n;
+    /* wsel and iblock hold m values, but LAPACKE_dstein's NaN check reads n of wsel */
+    double *ee = malloc((size_t)n * sizeof(double)), *wsel = calloc((size_t)n, sizeof(double));
+    dm_eigval *ev = malloc((size_t)n * sizeof(dm_eigval));
+    int *isplit = malloc((size_t)n * sizeof(int)), *iblock = malloc((size_t)n * sizeof(int));
+    int *ifail = malloc((size_t)m * sizeof(int)), *perm = malloc((size_t)m * sizeof(int));
+    if (!d || !ee || !wsel || !ev || !isplit || !iblock || !ifail || !perm)
+        goto done;
+    /* A = Q T Q' (Householder; the reduction dsyevr makes) */
+    if ((info = LAPACKE_dsytrd(LAPACK_COL_MAJOR, 'L', n, A, n, d, e, tau)) != 0)
+        goto done;
+    /* the eigenvalues of each unreduced block of T: root-free QL/QR (dsterf), O(n^2) */
+    int nb = dm_tri_split(n, d, e, isplit), ne = 0;
+    for (int b = 0, b0 = 0; b < nb; b0 = isplit[b++]) {
+        int len = isplit[b] - b0;
+        memcpy(dd, d + b0, (size_t)len * sizeof(double));
+        if (len > 1)
+            memcpy(ee, e + b0, (size_t)(len - 1) * sizeof(double));
+        if ((info = LAPACKE_dsterf(len, dd, ee)) != 0)
+            goto done;
+        for (int j = 0; j < len; j++)
+            ev[ne++] = (dm_eigval){dd[j], b + 1};
+    }
+    /* the il-th to iu-th smallest, grouped by block for dstein */
+    qsort(ev, (size_t)n, sizeof *ev, dm_eigval_cmp);
+    qsort(ev + il - 1, (size_t)m, sizeof *ev, dm_eigval_block_cmp);
+    for (int j = 0; j < m; j++) {
+        wsel[j] = ev[il - 1 + j].w;
+        iblock[j] = ev[il - 1 + j].block;
+    }
+    /* ascending order, as dsyevr returns them: column j of Z is wsel[perm[j]]'s vector */
+    int sorted = 1;
+    for (int j = 0; j < m; j++)
+        perm[j] = j;
+    for (int j = 1; j < m; j++) /* insertion sort: the blocks are few, the order nearly right */
+        for (int i = j; i > 0 && wsel[perm[i]] < wsel[perm[i - 1]]; i--) {
+            int t = perm[i];
+            perm[i] = perm[i - 1];
+            perm[i - 1] = t;
+            sorted = 0;
+        }
+    double *V = sorted ? Z : malloc((size_t)n * m * sizeof(double));
+    int ldv = sorted ? ldz : n;
+    if (!V) {
+        info = LAPACK_WORK_MEMORY_ERROR;
+        goto done;
+    }
+    /* the vectors of T by inverse iteration (dstein), then V = Q V */
+    info = LAPACKE_dstein(LAPACK_COL_MAJOR, n, d, e, m, wsel, iblock, isplit, V, ldv, ifail);
+    if (info == 0)
+        info = LAPACKE_dormtr(LAPACK_COL_MAJOR, 'L', 'L', 'N', n, m, A, n, tau, V, ldv);
+    for (int j = 0; j < m; j++) {
+        w[j] = wsel[perm[j]];
+        if (!sorted && info == 0)
+            memcpy(Z + (size_t)j * ldz, V + (size_t)perm[j] * n, (size_t)n * sizeof(double));
+    }
+    if (!sorted)
+        free(V);
+done:
+    free(d);
+    free(ee);
+    free(wsel);
+    free(ev);
+    free(isplit);
+    free(iblock);
+    free(ifail);
+    free(perm);
+    return info;
+}
+
+int dm_syev_range(int dsyevr_bits, int n, double *A, int il, int iu, double *w, double *Z, int ldz)
+{
+    if (!dsyevr_bits)
+        return dm_syev_tri(n, A, il, iu, w, Z, ldz);
+    /* dsyevr's w takes n values (its bisection may find more at a tie, then discards them) */
+    int m = iu - il + 1, found = 0, info = LAPACK_WORK_MEMORY_ERROR;
+    int *sup = malloc(2 * (size_t)m * sizeof(int));
+    double *wf = malloc((size_t)n * sizeof(double));
+    if (sup && wf)
+        info = LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', n, A, n, 0, 0, il, iu, 0.0, &found,
+                              wf, Z, ldz, sup);
+    if (info == 0 && found != m)
+        info = 1;
+    if (info == 0)
+        memcpy(w, wf, (size_t)m * sizeof(double));
+    free(sup);
+    free(wf);
+    return info;
+}

@@ -44,4 +44,20 @@ int dm_lapack_status(int info, int on_positive);
  *  its determinant.  The one inertia count of the core (eigen.c, tree.c). */
 int dm_sytrf_negative(int n, const double *A, const int *ipiv);
 
+/**
+ * The il-th to iu-th smallest eigenvalues (1 <= il <= iu <= n) of the symmetric n x n matrix A
+ * (lower triangle, column-major, leading dimension n; overwritten) in w[0..iu-il], ascending, and
+ * their orthonormal vectors in the columns of Z (ld ldz).  dsyevr_bits = 1: LAPACKE_dsyevr('V',
+ * 'I', 'L') itself (the bits of a kind with fixed_bits, the planar one).  dsyevr_bits = 0: the
+ * same reduction T = Q' A Q, but where dsyevr finds a subset of T's eigenvalues by bisection
+ * (dstebz: chains of dependent divisions, ~65 % of the time of a 50-150 sized problem, issue 27),
+ * dsterf finds all of them by root-free QL/QR, block by unreduced block (dstebz's split test), and
+ * dstein computes the vectors as dsyevr's subset route does: the same accuracy (eigenvalues within
+ * O(eps |A|), vectors by the same inverse iteration), other last bits, ~45 % less time.  Returns a
+ * LAPACK info: 0; negative for an argument, or LAPACK_WORK_MEMORY_ERROR; positive when an
+ * iteration did not converge or dsyevr found fewer eigenvalues than asked (SM_LAPACK_FAILED
+ * through dm_lapack_status).
+ */
+int dm_syev_range(int dsyevr_bits, int n, double *A, int il, int iu, double *w, double *Z, int ldz);
+
 #endif

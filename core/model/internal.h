@@ -438,10 +438,12 @@ typedef struct sm_eig_out {
  * owns its arrays (eig_out_free).  Returns SM_OK, SM_NOMEM, SM_SINGULAR (M
  * has no range, or the stiffness on its null space is exactly singular) or
  * SM_LAPACK_FAILED (a LAPACK error, e.g. non-finite input); on failure *out
- * is empty (nothing to free).
+ * is empty (nothing to free).  fixed_bits: the kind's (kind.h); 1 keeps LAPACK's dsyevr for
+ * the symmetric eigenproblems, 0 takes dm_syev_range's route without bisection (the same
+ * accuracy, other last bits; issue 27).
  */
-int eig_solve(int n, const dmat *M, const dmat *C, const dmat *K, int coriolis,
-              int modes, sm_eig_out *out);
+int eig_solve(int n, const dmat *M, const dmat *C, const dmat *K, int coriolis, int modes,
+              int fixed_bits, sm_eig_out *out);
 /**
  * The same analysis on the tree form (tree_assemble with frozen = 1 and gyro = coriolis done):
  * factors K*, and when K* is positive definite finds the lowest modes by shift-invert Arnoldi and

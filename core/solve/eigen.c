@@ -240,23 +240,21 @@ int eig_alloc_out(sm_eig_out *o, int n, int k)
  * at 48 elements).  Returns SM_OK, SM_NOMEM, or SM_LAPACK_FAILED when the
  * caller should use eig_undamped.
  */
-static int eig_undamped_inverse(int n, const eig_split *sp, const double *L, int k, sm_eig_out *o)
+static int eig_undamped_inverse(int fixed_bits, int n, const eig_split *sp, const double *L, int k,
+                                sm_eig_out *o)
 {
-    int r = sp->r, found = 0, rc = SM_NOMEM;
+    int r = sp->r, rc = SM_NOMEM;
     double *B = dm_vec((size_t)r * r), *A = dm_vec((size_t)r * r), *w = dm_vec((size_t)r);
     double *V = dm_vec((size_t)r * k);
-    int *sup = malloc(2 * (size_t)k * sizeof(int));
-    if (!B || !A || !w || !V || !sup || eig_alloc_out(o, n, k))
+    if (!B || !A || !w || !V || eig_alloc_out(o, n, k))
         goto done;
     for (int j = 0; j < r; j++) /* B = U' */
         for (int i = 0; i <= j; i++)
             B[(size_t)i * r + j] = sp->U[(size_t)j * r + i];
     cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasNoTrans, CblasNonUnit, r, r, 1.0, L, r, B, r);
     cblas_dsyrk(CblasColMajor, CblasLower, CblasNoTrans, r, r, 1.0, B, r, 0.0, A, r);
-    rc = dm_lapack_status(LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', r, A, r, 0, 0, r - k + 1, r, 0.0, &found,
-                                         w, V, r, sup),
-                          SM_LAPACK_FAILED);
-    if (rc == SM_OK && (found != k || !(w[0] > 0)))
+    rc = dm_lapack_status(dm_syev_range(fixed_bits, r, A, r - k + 1, r, w, V, r), SM_LAPACK_FAILED);
+    if (rc == SM_OK && !(w[0] > 0))
         rc = SM_LAPACK_FAILED;
     if (rc < 0)
         goto done;
@@ -277,27 +275,21 @@ done:
     free(A);
     free(w);
     free(V);
-    free(sup);
     return rc;
 }
 
 /* K x = w^2 M x on the condensed problem. */
-static int eig_undamped(int n, const eig_split *sp, int k, sm_eig_out *o)
+static int eig_undamped(int fixed_bits, int n, const eig_split *sp, int k, sm_eig_out *o)
 {
-    int r = sp->r, found = 0, rc = SM_NOMEM;
+    int r = sp->r, rc = SM_NOMEM;
     double *A = dm_vec((size_t)r * r), *w = dm_vec((size_t)r), *V = dm_vec((size_t)r * k);
-    int *sup = malloc(2 * (size_t)k * sizeof(int));
-    if (!A || !w || !V || !sup || eig_alloc_out(o, n, k))
+    if (!A || !w || !V || eig_alloc_out(o, n, k))
         goto done;
     /* A = U^-T Kr U^-1 */
     memcpy(A, sp->Kr, (size_t)r * r * sizeof(double));
     cblas_dtrsm(CblasColMajor, CblasLeft, CblasUpper, CblasTrans, CblasNonUnit, r, r, 1.0, sp->U, r, A, r);
     cblas_dtrsm(CblasColMajor, CblasRight, CblasUpper, CblasNoTrans, CblasNonUnit, r, r, 1.0, sp->U, r, A, r);
-    rc = dm_lapack_status(
-        LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', r, A, r, 0, 0, 1, k, 0.0, &found, w, V, r, sup),
-        SM_LAPACK_FAILED);
-    if (rc == SM_OK && found != k)
-        rc = SM_LAPACK_FAILED;
+    rc = dm_lapack_status(dm_syev_range(fixed_bits, r, A, 1, k, w, V, r), SM_LAPACK_FAILED);
     if (rc < 0)
         goto done;
     /* a = U^-1 v */
@@ -319,7 +311,6 @@ done:
     free(A);
     free(w);
     free(V);
-    free(sup);
     return rc;
 }
 
@@ -346,8 +337,8 @@ static double eig_wmax_estimate(const eig_split *sp)
  * moved past a cluster (a pair of nearly equal frequencies comes from one form).  A failure of
  * the direct form keeps the inverse one's modes.  Returns SM_OK or SM_NOMEM.
  */
-static int eig_gyro_direct(const eig_split *sp, const double *L, const double *Cy, int k, double *w,
-                           double complex *Y)
+static int eig_gyro_direct(int fixed_bits, const eig_split *sp, const double *L, const double *Cy,
+                           int k, double *w, double complex *Y)
 {
     int r = sp->r, N2 = 2 * r, j0 = 0, rc = SM_OK;
     double wmax = eig_wmax_estimate(sp);
@@ -371,7 +362,7 @@ static int eig_gyro_direct(const eig_split *sp, const double *L, const double *C
     memcpy(G, Cy, (size_t)r * r * sizeof(double));
     cblas_dtrsm(CblasColMajor, CblasLeft, CblasUpper, CblasTrans, CblasNonUnit, r, r, 1.0, sp->U, r, G, r);
     cblas_dtrsm(CblasColMajor, CblasRight, CblasUpper, CblasNoTrans, CblasNonUnit, r, r, 1.0, sp->U, r, G, r);
-    rc = eig_dir_lowest(r, B, G, k, wd, Yd);
+    rc = eig_dir_lowest(fixed_bits, r, B, G, k, wd, Yd);
     if (rc == SM_LAPACK_FAILED)
         rc = eig_dir_zheevr(r, B, G, k, wd, Yd);
     if (rc == SM_OK) {
@@ -388,8 +379,8 @@ done:
 }
 
 /* Gyroscopic problem with K_red = L L' positive definite: Hermitian form. */
-static int eig_gyro_hermitian(int n, const eig_split *sp, const double *L, const double *Cy, int k,
-                              sm_eig_out *o)
+static int eig_gyro_hermitian(int fixed_bits, int n, const eig_split *sp, const double *L,
+                              const double *Cy, int k, sm_eig_out *o)
 {
     int r = sp->r, N2 = 2 * r, rc = SM_NOMEM;
     double *D = dm_vec((size_t)r * r), *F = dm_vec((size_t)r * r), *w = dm_vec((size_t)k);
@@ -406,12 +397,12 @@ static int eig_gyro_hermitian(int n, const eig_split *sp, const double *L, const
     memcpy(F, Cy, (size_t)r * r * sizeof(double));
     cblas_dtrsm(CblasColMajor, CblasLeft, CblasLower, CblasNoTrans, CblasNonUnit, r, r, 1.0, L, r, F, r);
     cblas_dtrsm(CblasColMajor, CblasRight, CblasLower, CblasTrans, CblasNonUnit, r, r, 1.0, L, r, F, r);
-    rc = eig_skew_lowest(r, D, F, k, w, Y);
+    rc = eig_skew_lowest(fixed_bits, r, D, F, k, w, Y);
     if (rc == SM_LAPACK_FAILED)
         rc = eig_skew_zheevr(r, D, F, k, w, Y);
     if (rc < 0)
         goto done;
-    if ((rc = eig_gyro_direct(sp, L, Cy, k, w, Y)) < 0)
+    if ((rc = eig_gyro_direct(fixed_bits, sp, L, Cy, k, w, Y)) < 0)
         goto done;
     o->max_re = 0;
     for (int j = 0; j < k; j++) {
@@ -527,7 +518,7 @@ done:
  * SM_NOMEM, SM_SINGULAR or SM_LAPACK_FAILED.
  */
 int eig_solve(int n, const dmat *M, const dmat *C, const dmat *K, int coriolis, int modes,
-              sm_eig_out *out)
+              int fixed_bits, sm_eig_out *out)
 {
     eig_split sp;
     memset(out, 0, sizeof *out);
@@ -546,14 +537,15 @@ int eig_solve(int n, const dmat *M, const dmat *C, const dmat *K, int coriolis, 
         goto done;
     out->negative = sp.neg_zz + neg;
     if (!coriolis) {
-        rc = chol ? eig_undamped_inverse(n, &sp, L, k, out) : SM_LAPACK_FAILED;
+        rc = chol ? eig_undamped_inverse(fixed_bits, n, &sp, L, k, out) : SM_LAPACK_FAILED;
         if (rc == SM_LAPACK_FAILED)
-            rc = eig_undamped(n, &sp, k, out);
+            rc = eig_undamped(fixed_bits, n, &sp, k, out);
     } else {
         for (int j = 0; j < r; j++)
             for (int i = 0; i < r; i++)
                 Cy[(size_t)j * r + i] = DM(C, sp.yi[i], sp.yi[j]);
-        rc = chol ? eig_gyro_hermitian(n, &sp, L, Cy, k, out) : eig_gyro_general(n, &sp, Cy, k, out);
+        rc = chol ? eig_gyro_hermitian(fixed_bits, n, &sp, L, Cy, k, out)
+                  : eig_gyro_general(n, &sp, Cy, k, out);
     }
 done:
     if (rc < 0)

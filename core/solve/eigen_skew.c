@@ -79,31 +79,27 @@ static void eig_dir_apply(int r, const double *B, const double *G, int m, const 
  * quarter of the floating-point work of zheevr on -i S.  Returns SM_OK, or
  * SM_LAPACK_FAILED when the caller should fall back to zheevr.
  */
-int eig_dir_lowest(int r, const double *B, const double *G, int k, double *w, double complex *Y)
+int eig_dir_lowest(int fixed_bits, int r, const double *B, const double *G, int k, double *w,
+                   double complex *Y)
 {
-    int N2 = 2 * r, m2 = 2 * k < N2 ? 2 * k : N2, found = 0, acc = 0, rc = SM_NOMEM;
+    int N2 = 2 * r, m2 = 2 * k < N2 ? 2 * k : N2, acc = 0, rc = SM_NOMEM;
     double *A = dm_vec((size_t)N2 * N2), *ev = dm_vec((size_t)N2), *V = dm_vec((size_t)N2 * m2);
     double *SV = dm_vec((size_t)N2 * m2), *Yr = dm_vec((size_t)N2 * k), *Yi = dm_vec((size_t)N2 * k);
     double *SYr = dm_vec((size_t)N2 * k), *SYi = dm_vec((size_t)N2 * k), *th = dm_vec((size_t)k);
     double complex *T = calloc((size_t)k * k, sizeof(double complex));
     double complex *SY = calloc((size_t)N2 * k, sizeof(double complex));
     double complex *Q = calloc((size_t)N2 * k, sizeof(double complex));
-    int *sup = malloc(2 * (size_t)m2 * sizeof(int));
-    if (!A || !ev || !V || !SV || !Yr || !Yi || !SYr || !SYi || !th || !T || !SY || !Q || !sup)
+    if (!A || !ev || !V || !SV || !Yr || !Yi || !SYr || !SYi || !th || !T || !SY || !Q)
         goto done;
     /* lower triangle of S'S */
     cblas_dsyrk(CblasColMajor, CblasLower, CblasNoTrans, r, r, 1.0, B, r, 0.0, A, N2);
     cblas_dgemm(CblasColMajor, CblasNoTrans, CblasTrans, r, r, r, -1.0, G, r, B, r, 0.0, A + r, N2);
     cblas_dsyrk(CblasColMajor, CblasLower, CblasTrans, r, r, 1.0, B, r, 0.0, A + (size_t)r * N2 + r, N2);
     cblas_dsyrk(CblasColMajor, CblasLower, CblasTrans, r, r, 1.0, G, r, 1.0, A + (size_t)r * N2 + r, N2);
-    rc = dm_lapack_status(
-        LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', N2, A, N2, 0, 0, 1, m2, 0.0, &found, ev, V, N2, sup),
-        SM_LAPACK_FAILED);
+    rc = dm_lapack_status(dm_syev_range(fixed_bits, N2, A, 1, m2, ev, V, N2), SM_LAPACK_FAILED);
     if (rc < 0)
         goto done;
     rc = SM_LAPACK_FAILED; /* from here on: the caller falls back to zheevr */
-    if (found != m2)
-        goto done;
     eig_dir_apply(r, B, G, m2, V, SV);
     /* candidates y = v - i S v / w, orthonormalised (twice) against the accepted ones */
     for (int j = 0; j < m2 && acc < k; j++) {
@@ -148,7 +144,6 @@ done:
     free(T);
     free(SY);
     free(Q);
-    free(sup);
     return rc;
 }
 
@@ -243,29 +238,26 @@ static void eig_inv_square(int r, const double *D, const double *F, double *A)
  * floating-point work of zheevr on i E.  Returns SM_OK, or SM_LAPACK_FAILED when the caller
  * should fall back to zheevr.
  */
-int eig_skew_lowest(int r, const double *D, const double *F, int k, double *w, double complex *Y)
+int eig_skew_lowest(int fixed_bits, int r, const double *D, const double *F, int k, double *w,
+                    double complex *Y)
 {
     /* kk = k + EIG_GUARD directions: a frequency just above the k-th (a close pair at the end
      * of the request) is then separated by the Rayleigh-Ritz step, not left out of the basis */
-    int kk = k + EIG_GUARD < r ? k + EIG_GUARD : r, N2 = 2 * r, m2 = 2 * kk, found = 0, acc = 0, rc = SM_NOMEM;
+    int kk = k + EIG_GUARD < r ? k + EIG_GUARD : r, N2 = 2 * r, m2 = 2 * kk, acc = 0, rc = SM_NOMEM;
     double *A = dm_vec((size_t)N2 * N2), *ev = dm_vec((size_t)N2), *V = dm_vec((size_t)N2 * m2);
     double *EV = dm_vec((size_t)N2 * m2), *Yr = dm_vec((size_t)N2 * kk), *Yi = dm_vec((size_t)N2 * kk);
     double *EYr = dm_vec((size_t)N2 * kk), *EYi = dm_vec((size_t)N2 * kk), *th = dm_vec((size_t)kk);
     double complex *T = calloc((size_t)kk * kk, sizeof(double complex));
     double complex *EY = calloc((size_t)N2 * kk, sizeof(double complex));
     double complex *Q = calloc((size_t)N2 * kk, sizeof(double complex));
-    int *sup = malloc(2 * (size_t)m2 * sizeof(int));
-    if (!A || !ev || !V || !EV || !Yr || !Yi || !EYr || !EYi || !th || !T || !EY || !Q || !sup)
+    if (!A || !ev || !V || !EV || !Yr || !Yi || !EYr || !EYi || !th || !T || !EY || !Q)
         goto done;
     eig_inv_square(r, D, F, A);
-    rc = dm_lapack_status(LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', N2, A, N2, 0, 0, N2 - m2 + 1, N2, 0.0,
-                                         &found, ev, V, N2, sup),
+    rc = dm_lapack_status(dm_syev_range(fixed_bits, N2, A, N2 - m2 + 1, N2, ev, V, N2),
                           SM_LAPACK_FAILED);
     if (rc < 0)
         goto done;
     rc = SM_LAPACK_FAILED; /* from here on: the caller falls back to zheevr */
-    if (found != m2)
-        goto done;
     eig_inv_apply(r, D, F, m2, V, EV);
     /* candidates y = v + i E v / mu (mu = 1/w), largest mu first, orthonormalised (twice)
      * against the accepted ones */
@@ -312,7 +304,6 @@ done:
     free(T);
     free(EY);
     free(Q);
-    free(sup);
     return rc;
 }
 

@@ -354,7 +354,7 @@ static int eig_tree_project(const sm_model *m, tree_ws *t, int coriolis, int mod
             goto done;
         }
     } else {
-        rc = eig_solve(nv, &Mp, &Cp, &Kp, coriolis, modes, &e);
+        rc = eig_solve(nv, &Mp, &Cp, &Kp, coriolis, modes, t->fixed_bits, &e);
     }
     if (rc < 0)
         goto done;

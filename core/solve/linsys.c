@@ -179,7 +179,7 @@ static int smi_lin_eigen_base(const sm_model *m, smi_lin *L, sm_eig_out *e)
     double scale = tm > 0 && tk > 0 ? tk / tm : 1.0, sigma = 1e-8 * scale;
     for (size_t i = 0; i < (size_t)n * (size_t)n; i++)
         L->D.K.a[i] += sigma * L->D.M.a[i];
-    rc = eig_solve(n, &L->D.M, &L->D.C, &L->D.K, 0, m->opt.modes, e);
+    rc = eig_solve(n, &L->D.M, &L->D.C, &L->D.K, 0, m->opt.modes, m->kind->fixed_bits, e);
     if (rc < 0)
         return rc;
     e->max_re = 0;
@@ -207,7 +207,8 @@ int smi_lin_eigen(const sm_model *m, smi_lin *L, const sm_progress *pr, sm_eig_o
     if (L->tree)
         return eig_solve_tree(m, &L->t, m->opt.coriolis, m->opt.modes, pr, e, fallback);
     *fallback = 0;
-    return eig_solve(m->n, &L->D.M, &L->D.C, &L->D.K, m->opt.coriolis, m->opt.modes, e);
+    return eig_solve(m->n, &L->D.M, &L->D.C, &L->D.K, m->opt.coriolis, m->opt.modes,
+                     m->kind->fixed_bits, e);
 }
 
 void smi_lin_warm(smi_lin *L, int chain)

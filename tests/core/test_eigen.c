@@ -9,12 +9,17 @@
  * a repeated pair, a nearly repeated pair and a 1e4 spread of frequencies:
  * the real skew route (S'S, then Rayleigh-Ritz) must keep every frequency
  * (to 1e-9 absolute: the rounding of the input allows ~1e-8) and return
- * independent vectors with small residuals.
+ * independent vectors with small residuals.  All of it with fixed_bits 1 and 0 (the symmetric
+ * eigenproblems by dsyevr, and by dm_syev_range's route without bisection).
  */
 #include "internal.h"
 
 #include <complex.h>
 #include "testutil.h"
+
+/* eig_solve's fixed_bits: 1 LAPACK's dsyevr (the planar kind), 0 dm_syev_range's route without
+ * bisection (the spatial kind, solver 0.8.8); main runs every check on both. */
+static int route;
 
 static void roots(double k1, double k2, double g, double *w1, double *w2)
 {
@@ -72,7 +77,8 @@ static void blocks(void)
                 }
     sm_eig_out e;
     int k = N - 1;
-    TU_CHECK(eig_solve(N, &M, &C, &K, 1, k, &e) == SM_OK && e.n_modes == k, "eig_solve %d blocks", NB);
+    TU_CHECK(eig_solve(N, &M, &C, &K, 1, k, route, &e) == SM_OK && e.n_modes == k,
+             "eig_solve %d blocks", NB);
     for (int j = 0; j < e.n_modes; j++) {
         /* K = Q Kd Q' is rounded (entries up to 1e8): that alone moves w by up
          * to ~eps 1e8 / (2 w) ~ 1e-8; zheevr and the skew route both land within 3e-10 */
@@ -117,7 +123,7 @@ static void blocks(void)
     dm_free(&Q);
 }
 
-int main(void)
+static void cases(void)
 {
     double k1 = 4.0, k2 = 9.0, g = 1.5, w1, w2;
     roots(k1, k2, g, &w1, &w2);
@@ -132,12 +138,12 @@ int main(void)
     DM(&K, 1, 1) = k2;
     DM(&C, 0, 1) = -g;
     DM(&C, 1, 0) = g;
-    TU_CHECK(eig_solve(2, &M, &C, &K, 1, 2, &e) == SM_OK, "eig_solve 2x2");
+    TU_CHECK(eig_solve(2, &M, &C, &K, 1, 2, route, &e) == SM_OK, "eig_solve 2x2");
     TU_NEAR(e.wim[0], w1, 1e-12, "gyroscopic w1");
     TU_NEAR(e.wim[1], w2, 1e-12, "gyroscopic w2");
     TU_CHECK(e.negative == 0 && e.max_re == 0, "stable system flagged");
     eig_out_free(&e);
-    TU_CHECK(eig_solve(2, &M, &C, &K, 0, 2, &e) == SM_OK, "eig_solve undamped");
+    TU_CHECK(eig_solve(2, &M, &C, &K, 0, 2, route, &e) == SM_OK, "eig_solve undamped");
     TU_NEAR(e.wim[0], 2.0, 1e-12, "undamped w1 = sqrt(k1)");
     TU_NEAR(e.wim[1], 3.0, 1e-12, "undamped w2 = sqrt(k2)");
     eig_out_free(&e);
@@ -160,7 +166,8 @@ int main(void)
     DM(&K, 0, 2) = DM(&K, 2, 0) = -c;
     DM(&C, 0, 1) = -g;
     DM(&C, 1, 0) = g;
-    TU_CHECK(eig_solve(3, &M, &C, &K, 1, 2, &e) == SM_OK, "eig_solve with a massless coordinate");
+    TU_CHECK(eig_solve(3, &M, &C, &K, 1, 2, route, &e) == SM_OK,
+             "eig_solve with a massless coordinate");
     TU_CHECK(e.n_modes == 2, "two finite roots, got %d", e.n_modes);
     TU_NEAR(e.wim[0], w1, 1e-10, "condensed gyroscopic w1");
     TU_NEAR(e.wim[1], w2, 1e-10, "condensed gyroscopic w2");
@@ -173,7 +180,7 @@ int main(void)
      * unless gyroscopic stabilisation; with small g it diverges */
     DM(&K, 0, 0) = -2.0 + c;
     DM(&K, 2, 2) = c + dd;
-    TU_CHECK(eig_solve(3, &M, &C, &K, 1, 2, &e) == SM_OK, "eig_solve unstable");
+    TU_CHECK(eig_solve(3, &M, &C, &K, 1, 2, route, &e) == SM_OK, "eig_solve unstable");
     TU_CHECK(e.negative == 1, "negative eigenvalues of K: got %d want 1", e.negative);
     /* closed form: lambda^4 + (k1'+k2+g^2) lambda^2 + k1' k2 = 0 */
     double k1u = -2.0 + c - c * c / (c + dd), b = k1u + k2 + g * g;
@@ -197,12 +204,21 @@ int main(void)
     DM(&C, 1, 0) = 0.5;
     roots(1e-16, 1.0, 0.5, &w1, &w2);
     w1 = 1e-8 / w2; /* the small root without cancellation: w1 w2 = sqrt(k1 k2) */
-    TU_CHECK(eig_solve(2, &M, &C, &K, 1, 2, &e) == SM_OK && e.n_modes == 2, "eig_solve, nearly free coordinate");
+    TU_CHECK(eig_solve(2, &M, &C, &K, 1, 2, route, &e) == SM_OK && e.n_modes == 2,
+             "eig_solve, nearly free coordinate");
     TU_NEAR(e.wim[0], w1, 1e-6 * w1, "nearly free coordinate: w1");
     TU_NEAR(e.wim[1], w2, 1e-12, "nearly free coordinate: w2");
     eig_out_free(&e);
     dm_free(&M);
     dm_free(&C);
     dm_free(&K);
+}
+
+int main(void)
+{
+    for (route = 1; route >= 0; route--) {
+        printf("-- fixed_bits %d\n", route);
+        cases();
+    }
     return tu_finish("eigen");
 }

@@ -76,17 +76,21 @@ static void internal_statuses(void)
         DM(&M, i, i) = 1.0;
         DM(&K, i, i) = (double)(i + 1);
     }
-    for (int cor = 0; cor < 2; cor++) {
-        TU_CHECK(eig_solve(N, &M, &C, &K, cor, 2, &e) == SM_OK && e.n_modes == 2, "well-posed problem solves");
+    for (int v = 0; v < 4; v++) { /* with and without Coriolis, both fixed_bits routes */
+        int cor = v & 1, bits = v >> 1;
+        TU_CHECK(eig_solve(N, &M, &C, &K, cor, 2, bits, &e) == SM_OK && e.n_modes == 2,
+                 "well-posed problem solves");
         eig_out_free(&e);
         DM(&K, 1, 1) = NAN;
-        int rc = eig_solve(N, &M, &C, &K, cor, 2, &e);
-        TU_CHECK(rc == SM_LAPACK_FAILED && e.n_modes == 0 && !e.wre && !e.xre,
-                 "NaN in K (coriolis %d): SM_LAPACK_FAILED, no partial output (got %d)", cor, rc);
+        int rc = eig_solve(N, &M, &C, &K, cor, 2, bits, &e);
+        TU_CHECK(
+            rc == SM_LAPACK_FAILED && e.n_modes == 0 && !e.wre && !e.xre,
+            "NaN in K (coriolis %d, fixed_bits %d): SM_LAPACK_FAILED, no partial output (got %d)",
+            cor, bits, rc);
         eig_out_free(&e);
         DM(&K, 1, 1) = 2.0;
         dm_zero(&M);
-        rc = eig_solve(N, &M, &C, &K, cor, 2, &e);
+        rc = eig_solve(N, &M, &C, &K, cor, 2, bits, &e);
         TU_CHECK(rc == SM_SINGULAR && e.n_modes == 0 && !e.wre, "no mass (coriolis %d): SM_SINGULAR (got %d)", cor,
                  rc);
         eig_out_free(&e);

@@ -65,7 +65,7 @@ static void gs_chain(int nn, double kx, double ky, double g, int modes, double t
         gs_roots(kx * t, ky * t, g, want + 2 * (j - 1));
     }
     qsort(want, 2 * (size_t)nn, sizeof *want, gs_cmp);
-    int rc = eig_solve(n, &M, &C, &K, 1, modes, &on);
+    int rc = eig_solve(n, &M, &C, &K, 1, modes, 0, &on);
     TU_CHECK(rc == SM_OK && on.n_modes == modes, "chain %d, g %g: eig_solve %d", nn, g, rc);
     if (rc != SM_OK)
         goto done;
@@ -80,7 +80,7 @@ static void gs_chain(int nn, double kx, double ky, double g, int modes, double t
            "modes %.2e (tol %.0e)\n",
            nn, kx, ky, g, on.wim[0], want[0], modes, worst, tol);
     if (g == 0) { /* C = 0: the gyroscopic route must give the undamped one */
-        rc = eig_solve(n, &M, &C, &K, 0, modes, &off);
+        rc = eig_solve(n, &M, &C, &K, 0, modes, 0, &off);
         TU_CHECK(rc == SM_OK, "chain undamped: %d", rc);
         for (int k = 0; rc == SM_OK && k < modes; k++)
             TU_NEAR(on.wim[k], off.wim[k], 1e-12 * off.wim[k], "chain %d, C = 0, mode %d on vs off", nn, k + 1);

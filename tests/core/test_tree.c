@@ -111,7 +111,8 @@ static void check(const char *name, sm_options *o, double omega)
             /* the eigen-analysis: the same modes, or the dense path's turn when K* is indefinite */
             sm_eig_out ed, et;
             int fb = -1, modes = n >= 40 ? 4 : 1;
-            TU_CHECK(eig_solve(n, &M, &C, &K, 1, modes, &ed) == SM_OK, "%s: dense eig", name);
+            TU_CHECK(eig_solve(n, &M, &C, &K, 1, modes, t.fixed_bits, &ed) == SM_OK,
+                     "%s: dense eig", name);
             TU_CHECK(eig_solve_tree(m, &t, 1, modes, NULL, &et, &fb) == SM_OK, "%s: tree eig", name);
             if (neg > 0 || 4 * modes > n) {
                 TU_CHECK(fb == 1 && et.n_modes == 0 && !et.wim, "%s: indefinite K* or too few coordinates: dense "
