@@ -32,7 +32,7 @@
 extern "C" {
 #endif
 
-#define SM_VERSION "0.8.7"
+#define SM_VERSION "0.8.8"
 
 /* One status table for the whole project (X-macro: name, value, text). */
 #define SM_STATUS_MAP(X)                                                       \
