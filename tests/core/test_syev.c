@@ -100,12 +100,14 @@ static void sy_check(const char *name, int n, const double *A, int il, int iu, i
                 out += share[b] < big ? share[b] : 0;
             mixed = fmax(mixed, out);
         }
-        TU_CHECK(res <= 1e-13 * anorm, "%s [%d, %d], route %d: residual %.2e of |A| %.2e", name, il, iu, route,
-                 res, anorm);
-        TU_CHECK(orth <= 1e-12, "%s [%d, %d], route %d: orthonormality %.2e", name, il, iu, route, orth);
-        TU_CHECK(order <= 0, "%s [%d, %d], route %d: not ascending (%.2e)", name, il, iu, route, order);
-        TU_CHECK(mixed <= 1e-20, "%s [%d, %d], route %d: a vector spread over blocks (%.2e)", name, il, iu, route,
-                 mixed);
+        TU_CHECK(res <= 1e-13 * anorm, "%s [%d, %d], route %d: residual %.2e of |A| %.2e", name, il,
+                 iu, route, res, anorm);
+        TU_CHECK(orth <= 1e-12, "%s [%d, %d], route %d: orthonormality %.2e", name, il, iu, route,
+                 orth);
+        TU_CHECK(order <= 0, "%s [%d, %d], route %d: not ascending (%.2e)", name, il, iu, route,
+                 order);
+        TU_CHECK(mixed <= 1e-20, "%s [%d, %d], route %d: a vector spread over blocks (%.2e)", name,
+                 il, iu, route, mixed);
     }
     double dw = 0;
     for (int j = 0; j < m; j++)
