@@ -120,20 +120,31 @@ static int dm_eigval_block_cmp(const void *a, const void *b)
     return x->block != y->block ? x->block - y->block : dm_eigval_cmp(a, b);
 }
 
+
 /* dm_syev_range's route without bisection (dense.h). */
 static int dm_syev_tri(int n, double *A, int il, int iu, double *w, double *Z, int ldz)
 {
     int m = iu - il + 1, info = LAPACK_WORK_MEMORY_ERROR;
     double *d = malloc(4 * (size_t)n * sizeof(double)), *e = d + n, *tau = e + n, *dd = tau + n;
-    /* wsel and iblock hold m values, but LAPACKE_dstein's NaN check reads n of wsel */
-    double *ee = malloc((size_t)n * sizeof(double)), *wsel = calloc((size_t)n, sizeof(double));
+    double *ee = malloc((size_t)n * sizeof(double)), *wsel = malloc((size_t)m * sizeof(double));
     dm_eigval *ev = malloc((size_t)n * sizeof(dm_eigval));
-    int *isplit = malloc((size_t)n * sizeof(int)), *iblock = malloc((size_t)n * sizeof(int));
-    int *ifail = malloc((size_t)m * sizeof(int)), *perm = malloc((size_t)m * sizeof(int));
-    if (!d || !ee || !wsel || !ev || !isplit || !iblock || !ifail || !perm)
+    int *isplit = malloc((size_t)n * sizeof(int)), *iblock = malloc((size_t)m * sizeof(int));
+    int *iwork = malloc(((size_t)n + 2 * (size_t)m) * sizeof(int)), *ifail = iwork + n,
+        *perm = ifail + m;
+    double *work = NULL, *V = NULL, q1 = 0, q2 = 0;
+    if (!d || !ee || !wsel || !ev || !isplit || !iblock || !iwork)
+        goto done;
+    /* workspace: the most of what dsytrd and dormtr ask for and dstein's 5 n, and DM_SYEV_PAD
+     * beyond; each routine is told its own optimum (dormtr's blocks, and so its last bits, change
+     * with the size it is told) */
+    LAPACKE_dsytrd_work(LAPACK_COL_MAJOR, 'L', n, A, n, d, e, tau, &q1, -1);
+    LAPACKE_dormtr_work(LAPACK_COL_MAJOR, 'L', 'L', 'N', n, m, A, n, tau, Z, ldz, &q2, -1);
+    size_t lwork = (size_t)fmax(fmax(q1, q2), 5.0 * n);
+    if (!(work = malloc((lwork + DM_SYEV_PAD) * sizeof(double))))
         goto done;
     /* A = Q T Q' (Householder; the reduction dsyevr makes) */
-    if ((info = LAPACKE_dsytrd(LAPACK_COL_MAJOR, 'L', n, A, n, d, e, tau)) != 0)
+    if ((info = LAPACKE_dsytrd_work(LAPACK_COL_MAJOR, 'L', n, A, n, d, e, tau, work, (int)lwork)) !=
+        0)
         goto done;
     /* the eigenvalues of each unreduced block of T: root-free QL/QR (dsterf), O(n^2) */
     int nb = dm_tri_split(n, d, e, isplit), ne = 0;
@@ -142,7 +153,7 @@ static int dm_syev_tri(int n, double *A, int il, int iu, double *w, double *Z, i
         memcpy(dd, d + b0, (size_t)len * sizeof(double));
         if (len > 1)
             memcpy(ee, e + b0, (size_t)(len - 1) * sizeof(double));
-        if ((info = LAPACKE_dsterf(len, dd, ee)) != 0)
+        if ((info = LAPACKE_dsterf_work(len, dd, ee)) != 0)
             goto done;
         for (int j = 0; j < len; j++)
             ev[ne++] = (dm_eigval){dd[j], b + 1};
@@ -165,51 +176,67 @@ static int dm_syev_tri(int n, double *A, int il, int iu, double *w, double *Z, i
             perm[i - 1] = t;
             sorted = 0;
         }
-    double *V = sorted ? Z : malloc((size_t)n * m * sizeof(double));
     int ldv = sorted ? ldz : n;
+    V = sorted ? Z : malloc((size_t)n * m * sizeof(double));
     if (!V) {
         info = LAPACK_WORK_MEMORY_ERROR;
         goto done;
     }
     /* the vectors of T by inverse iteration (dstein), then V = Q V */
-    info = LAPACKE_dstein(LAPACK_COL_MAJOR, n, d, e, m, wsel, iblock, isplit, V, ldv, ifail);
+    info = LAPACKE_dstein_work(LAPACK_COL_MAJOR, n, d, e, m, wsel, iblock, isplit, V, ldv, work,
+                               iwork, ifail);
     if (info == 0)
-        info = LAPACKE_dormtr(LAPACK_COL_MAJOR, 'L', 'L', 'N', n, m, A, n, tau, V, ldv);
+        info = LAPACKE_dormtr_work(LAPACK_COL_MAJOR, 'L', 'L', 'N', n, m, A, n, tau, V, ldv, work,
+                                   (int)q2);
     for (int j = 0; j < m; j++) {
         w[j] = wsel[perm[j]];
         if (!sorted && info == 0)
             memcpy(Z + (size_t)j * ldz, V + (size_t)perm[j] * n, (size_t)n * sizeof(double));
     }
-    if (!sorted)
-        free(V);
 done:
+    if (V != Z)
+        free(V);
+    free(work);
     free(d);
     free(ee);
     free(wsel);
     free(ev);
     free(isplit);
     free(iblock);
-    free(ifail);
-    free(perm);
+    free(iwork);
     return info;
 }
 
 int dm_syev_range(int dsyevr_bits, int n, double *A, int il, int iu, double *w, double *Z, int ldz)
 {
+    for (int j = 0; j < n; j++) /* the check of LAPACKE's high-level routines: NaN in A */
+        for (int i = j; i < n; i++)
+            if (isnan(A[(size_t)j * n + i]))
+                return -6;
     if (!dsyevr_bits)
         return dm_syev_tri(n, A, il, iu, w, Z, ldz);
-    /* dsyevr's w takes n values (its bisection may find more at a tie, then discards them) */
-    int m = iu - il + 1, found = 0, info = LAPACK_WORK_MEMORY_ERROR;
-    int *sup = malloc(2 * (size_t)m * sizeof(int));
-    double *wf = malloc((size_t)n * sizeof(double));
-    if (sup && wf)
-        info = LAPACKE_dsyevr(LAPACK_COL_MAJOR, 'V', 'I', 'L', n, A, n, 0, 0, il, iu, 0.0, &found,
-                              wf, Z, ldz, sup);
+    /* dsyevr with the workspace it asks for (so the same blocking and bits as LAPACKE_dsyevr) and
+     * DM_SYEV_PAD beyond it; its w takes n values (its bisection may find more at a tie, then
+     * discards them) */
+    int m = iu - il + 1, found = 0, liwork = 0, info = LAPACK_WORK_MEMORY_ERROR;
+    double q = 0;
+    LAPACKE_dsyevr_work(LAPACK_COL_MAJOR, 'V', 'I', 'L', n, A, n, 0, 0, il, iu, 0.0, &found, w, Z,
+                        ldz, NULL, &q, -1, &liwork, -1);
+    int lwork = (int)q;
+    int *sup = malloc(2 * (size_t)m * sizeof(int)),
+        *iwork = malloc(((size_t)liwork + DM_SYEV_PAD) * sizeof(int));
+    double *wf = malloc((size_t)n * sizeof(double)),
+           *work = malloc(((size_t)lwork + DM_SYEV_PAD) * sizeof(double));
+    if (sup && iwork && wf && work)
+        info = LAPACKE_dsyevr_work(LAPACK_COL_MAJOR, 'V', 'I', 'L', n, A, n, 0, 0, il, iu, 0.0,
+                                   &found, wf, Z, ldz, sup, work, lwork, iwork, liwork);
     if (info == 0 && found != m)
         info = 1;
     if (info == 0)
         memcpy(w, wf, (size_t)m * sizeof(double));
     free(sup);
+    free(iwork);
     free(wf);
+    free(work);
     return info;
 }
