@@ -16,15 +16,15 @@ void _gfortran_concat_string(size_t destlen, char *dest, size_t len1, const char
 
 static int failures, checks;
 
-#define CHECK(cond, ...)                                                                           \
-    do {                                                                                           \
-        checks++;                                                                                  \
-        if (!(cond)) {                                                                             \
-            failures++;                                                                            \
-            printf("FAIL ");                                                                       \
-            printf(__VA_ARGS__);                                                                   \
-            printf("\n");                                                                          \
-        }                                                                                          \
+#define CHECK(cond, ...)         \
+    do {                         \
+        checks++;                \
+        if (!(cond)) {           \
+            failures++;          \
+            printf("FAIL ");     \
+            printf(__VA_ARGS__); \
+            printf("\n");        \
+        }                        \
     } while (0)
 
 static void against_libgfortran(void)
@@ -50,8 +50,8 @@ static void against_libgfortran(void)
                 memset(y, '#', sizeof y);
                 _gfortran_concat_string(d, x, a, s1, b, s2);
                 ref(d, y, a, s1, b, s2);
-                CHECK(memcmp(x, y, sizeof x) == 0, "dest %zu, lengths %zu and %zu: %.20s against %.20s", d, a,
-                      b, x, y);
+                CHECK(memcmp(x, y, sizeof x) == 0,
+                      "dest %zu, lengths %zu and %zu: %.20s against %.20s", d, a, b, x, y);
                 cases++;
             }
     printf("%d length combinations against libgfortran's routine\n", cases);
@@ -68,8 +68,10 @@ static void through_lapack(void)
     for (int i = 0; i < N; i++)
         x[i] = y[i] = 1 + i;
     CHECK(LAPACKE_dsytrd(LAPACK_COL_MAJOR, 'L', N, A, N, d, e, tau) == 0, "dsytrd");
-    CHECK(LAPACKE_dormtr(LAPACK_COL_MAJOR, 'L', 'L', 'N', N, 1, A, N, tau, y, N) == 0, "dormtr Q x");
-    CHECK(LAPACKE_dormtr(LAPACK_COL_MAJOR, 'L', 'L', 'T', N, 1, A, N, tau, y, N) == 0, "dormtr Q' y");
+    CHECK(LAPACKE_dormtr(LAPACK_COL_MAJOR, 'L', 'L', 'N', N, 1, A, N, tau, y, N) == 0,
+          "dormtr Q x");
+    CHECK(LAPACKE_dormtr(LAPACK_COL_MAJOR, 'L', 'L', 'T', N, 1, A, N, tau, y, N) == 0,
+          "dormtr Q' y");
     double err = 0;
     for (int i = 0; i < N; i++)
         err = err > (y[i] - x[i]) * (y[i] - x[i]) ? err : (y[i] - x[i]) * (y[i] - x[i]);
