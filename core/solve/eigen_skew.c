@@ -2,7 +2,8 @@
  * eigen_skew.c — the Hermitian gyroscopic eigenproblem of eigen.c in its two forms (DESIGN.md
  * 1.4): the direct form -i S, S = [[0, B], [-B', -G]] real skew, and the inverse form
  * i E = (-i S)^-1, E = [[-F, -D'], [D, 0]].  Each has a fast route (the real symmetric square
- * S'S or E'E by dsyevr, complex candidates, a Rayleigh-Ritz step) and a zheevr fallback.
+ * S'S or E'E by dm_syev_range: dsyevr for a kind with fixed_bits; complex candidates, a
+ * Rayleigh-Ritz step) and a zheevr fallback.
  * eigen.c condenses the problem, builds B, G or D, F, and picks the form per mode.
  */
 #include "internal.h"
@@ -71,7 +72,7 @@ static void eig_dir_apply(int r, const double *B, const double *G, int m, const 
  * The k lowest positive eigenpairs of the Hermitian matrix -i S, S real
  * skew (above), without complex arithmetic on the 2r-sized problem:
  * S'S = -S^2 = [[B B', B G], [-G B', B'B + G'G]] is real symmetric with the
- * eigenvalues w^2, each twice.  dsyevr gives the 2k lowest; each real
+ * eigenvalues w^2, each twice.  dm_syev_range gives the 2k lowest; each real
  * eigenvector v yields y = v - i S v / w with S y = i w y; the candidates are
  * orthonormalised (a pair gives one direction) and a Rayleigh-Ritz step on
  * -i S restores full accuracy (the squared problem alone loses digits of the
@@ -230,7 +231,7 @@ static void eig_inv_square(int r, const double *D, const double *F, double *A)
 
 /*
  * The k lowest frequencies w (ascending) and the vectors y (S y = i w y) of the Hermitian
- * i E = (-i S)^-1, without complex arithmetic on the 2r-sized problem: dsyevr gives the 2k
+ * i E = (-i S)^-1, without complex arithmetic on the 2r-sized problem: dm_syev_range gives the 2k
  * largest eigenvalues 1/w^2 of E'E; each real eigenvector v yields y = v + i w E v with
  * i E y = y / w; the candidates are orthonormalised (a pair gives one direction) and a
  * Rayleigh-Ritz step on i E restores full accuracy (the squared problem alone loses digits of a
