@@ -120,6 +120,27 @@ static int dm_eigval_block_cmp(const void *a, const void *b)
     return x->block != y->block ? x->block - y->block : dm_eigval_cmp(a, b);
 }
 
+/* Doubles (and ints) of workspace given to LAPACK's symmetric eigen-solvers beyond what they ask
+ * for.  OpenBLAS 0.3.21's dsymv_L kernel for the Prescott core (the one it runs on a CPU it does
+ * not know: this machine's Xeon, model 207) reads up to three entries past its y, which dlatrd
+ * (inside dsytrd) places at the end of the workspace: with the exact workspace the high-level
+ * LAPACKE routines allocate, the read left the block (valgrind with OPENBLAS_CORETYPE=Prescott:
+ * dsytrd, dsyevx, dsyevr for all eigenvalues; a segmentation fault under AddressSanitizer where
+ * the block ended a mapping).  dm_syev_range and dm_sy_lowest call the _work routines with the
+ * workspace LAPACK asks for plus this, so the blocking and the bits are the high-level
+ * routines'. */
+#define DM_SYEV_PAD 64
+
+/* 1 when the lower triangle of A (n x n, leading dimension n) holds a NaN: what LAPACKE's
+ * high-level symmetric routines refuse (dsy_nancheck). */
+static int dm_sy_nan(int n, const double *A)
+{
+    for (int j = 0; j < n; j++)
+        for (int i = j; i < n; i++)
+            if (isnan(A[(size_t)j * n + i]))
+                return 1;
+    return 0;
+}
 
 /* dm_syev_range's route without bisection (dense.h). */
 static int dm_syev_tri(int n, double *A, int il, int iu, double *w, double *Z, int ldz)
@@ -143,8 +164,7 @@ static int dm_syev_tri(int n, double *A, int il, int iu, double *w, double *Z, i
     if (!(work = malloc((lwork + DM_SYEV_PAD) * sizeof(double))))
         goto done;
     /* A = Q T Q' (Householder; the reduction dsyevr makes) */
-    if ((info = LAPACKE_dsytrd_work(LAPACK_COL_MAJOR, 'L', n, A, n, d, e, tau, work, (int)lwork)) !=
-        0)
+    if ((info = LAPACKE_dsytrd_work(LAPACK_COL_MAJOR, 'L', n, A, n, d, e, tau, work, (int)q1)) != 0)
         goto done;
     /* the eigenvalues of each unreduced block of T: root-free QL/QR (dsterf), O(n^2) */
     int nb = dm_tri_split(n, d, e, isplit), ne = 0;
@@ -209,10 +229,8 @@ done:
 
 int dm_syev_range(int dsyevr_bits, int n, double *A, int il, int iu, double *w, double *Z, int ldz)
 {
-    for (int j = 0; j < n; j++) /* the check of LAPACKE's high-level routines: NaN in A */
-        for (int i = j; i < n; i++)
-            if (isnan(A[(size_t)j * n + i]))
-                return -6;
+    if (dm_sy_nan(n, A))
+        return -6; /* LAPACKE_dsyevr's answer */
     if (!dsyevr_bits)
         return dm_syev_tri(n, A, il, iu, w, Z, ldz);
     /* dsyevr with the workspace it asks for (so the same blocking and bits as LAPACKE_dsyevr) and
@@ -238,5 +256,34 @@ int dm_syev_range(int dsyevr_bits, int n, double *A, int il, int iu, double *w, 
     free(iwork);
     free(wf);
     free(work);
+    return info;
+}
+
+int dm_sy_lowest(int n, double *A, double *lambda)
+{
+    if (dm_sy_nan(n, A))
+        return -6; /* LAPACKE_dsyevx's answer */
+    int found = 0, info = LAPACK_WORK_MEMORY_ERROR;
+    double q = 0, *w = malloc((size_t)(n ? n : 1) * sizeof(double)), *work = NULL;
+    int *iwork = malloc(5 * (size_t)(n ? n : 1) * sizeof(int)),
+        *ifail = malloc((size_t)(n ? n : 1) * sizeof(int));
+    if (!w || !iwork || !ifail)
+        goto done;
+    LAPACKE_dsyevx_work(LAPACK_COL_MAJOR, 'N', 'I', 'L', n, A, n, 0, 0, 1, 1, 0.0, &found, w, NULL,
+                        1, &q, -1, iwork, ifail);
+    int lwork = (int)q;
+    if (!(work = malloc(((size_t)lwork + DM_SYEV_PAD) * sizeof(double))))
+        goto done;
+    info = LAPACKE_dsyevx_work(LAPACK_COL_MAJOR, 'N', 'I', 'L', n, A, n, 0, 0, 1, 1, 0.0, &found, w,
+                               NULL, 1, work, lwork, iwork, ifail);
+    if (info == 0 && found != 1)
+        info = 1;
+    if (info == 0)
+        *lambda = w[0];
+done:
+    free(w);
+    free(work);
+    free(iwork);
+    free(ifail);
     return info;
 }

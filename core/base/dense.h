@@ -44,17 +44,6 @@ int dm_lapack_status(int info, int on_positive);
  *  its determinant.  The one inertia count of the core (eigen.c, tree.c). */
 int dm_sytrf_negative(int n, const double *A, const int *ipiv);
 
-/* Doubles (and ints) of workspace given to LAPACK's symmetric eigen-solvers beyond what they ask
- * for.  OpenBLAS 0.3.21's dsymv_L kernel for the Prescott core (the one it runs on a CPU it does
- * not know: this machine's Xeon, model 207) reads up to three entries past its y, which dlatrd
- * (inside dsytrd) places at the end of the workspace: with the exact workspace the high-level
- * LAPACKE routines allocate, the read left the block (valgrind with OPENBLAS_CORETYPE=Prescott:
- * dsytrd, dsyevx, dsyevr for all eigenvalues; a segmentation fault under AddressSanitizer where
- * the block ended a mapping).  The callers (dm_syev_range, smi_lin_lowest) use the _work
- * routines with the workspace LAPACK asks for plus this, so the blocking and the bits are the
- * high-level routines'. */
-#define DM_SYEV_PAD 64
-
 /**
  * The il-th to iu-th smallest eigenvalues (1 <= il <= iu <= n) of the symmetric n x n matrix A
  * (lower triangle, column-major, leading dimension n; overwritten) in w[0..iu-il], ascending, and
@@ -70,5 +59,12 @@ int dm_sytrf_negative(int n, const double *A, const int *ipiv);
  * through dm_lapack_status).
  */
 int dm_syev_range(int dsyevr_bits, int n, double *A, int il, int iu, double *w, double *Z, int ldz);
+
+/**
+ * The lowest eigenvalue of the symmetric n x n matrix A (lower triangle, leading dimension n;
+ * overwritten) in *lambda, without vectors: LAPACK's dsyevx, with the bits LAPACKE_dsyevx gives.
+ * Returns a LAPACK info as dm_syev_range does (negative for NaN in A, as LAPACKE's check).
+ */
+int dm_sy_lowest(int n, double *A, double *lambda);
 
 #endif

@@ -230,39 +230,9 @@ void smi_lin_nodal(const sm_model *m, smi_lin *L, const double *xr, const double
 
 int smi_lin_lowest(const sm_model *m, smi_lin *L, double *lambda)
 {
-    int n = m->n, found = 0, rc;
-    double *w = dm_vec((size_t)n), vl = 0, vu = 0, q = 0, *work = NULL;
-    int *ifail = calloc((size_t)(n ? n : 1), sizeof(int)),
-        *iwork = malloc(5 * (size_t)(n ? n : 1) * sizeof(int));
-
     *lambda = NAN;
-    rc = SM_NOMEM;
-    if (!w || !ifail || !iwork || L->tree)
-        goto done;
-    rc = SM_LAPACK_FAILED;
-    if (!dm_finite(&L->D.K)) /* what LAPACKE_dsyevx's own check refused */
-        goto done;
-    /* the lowest eigenvalue of the symmetric K* (its sign change is that of det K*): dsyevx with
-     * the workspace it asks for (LAPACKE_dsyevx's, the same bits) and DM_SYEV_PAD beyond it
-     * (OpenBLAS's Prescott dsymv reads past its end, dense.h) */
-    LAPACKE_dsyevx_work(LAPACK_COL_MAJOR, 'N', 'I', 'L', n, L->D.K.a, n, vl, vu, 1, 1, 0.0, &found,
-                        w, NULL, 1, &q, -1, iwork, ifail);
-    int lwork = (int)q;
-    rc = SM_NOMEM;
-    if (!(work = malloc(((size_t)lwork + DM_SYEV_PAD) * sizeof(double))))
-        goto done;
-    rc = dm_lapack_status(LAPACKE_dsyevx_work(LAPACK_COL_MAJOR, 'N', 'I', 'L', n, L->D.K.a, n, vl,
-                                              vu, 1, 1, 0.0, &found, w, NULL, 1, work, lwork, iwork,
-                                              ifail),
-                          SM_LAPACK_FAILED);
-    if (rc == SM_OK && found == 1)
-        *lambda = w[0];
-    else if (rc == SM_OK)
-        rc = SM_LAPACK_FAILED;
-done:
-    free(w);
-    free(ifail);
-    free(iwork);
-    free(work);
-    return rc;
+    if (L->tree)
+        return SM_NOMEM;
+    /* the lowest eigenvalue of the symmetric K* (its sign change is that of det K*) */
+    return dm_lapack_status(dm_sy_lowest(m->n, L->D.K.a, lambda), SM_LAPACK_FAILED);
 }
