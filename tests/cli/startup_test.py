@@ -2,8 +2,13 @@
 """How the CLI starts (issue 27, DESIGN.md 2.1): OpenBLAS from its archive, on one thread.
 
 Usage: startup_test.py SPINMODAL LINK REQUEST...
-LINK: "static" when meson linked the CLI with OpenBLAS's archive (-Dstatic_openblas, found),
-"shared" otherwise.
+LINK: "static-pie" when meson linked the whole CLI static-pie (-Dstatic_cli, found), "static"
+when it linked it with OpenBLAS's archive (-Dstatic_openblas, found), "shared" otherwise.
+
+  - static-pie: every check of "static", and the CLI has no program interpreter (PT_INTERP) and
+    needs no shared library at all (no dynamic loader at its start: 0.3-0.5 ms of a small solve
+    in a virtual machine), and is position independent (ELF type DYN: its addresses are still
+    randomised);
 
   - static: the CLI needs none of libopenblas.so.0, libblas.so.3, liblapack.so.3 (ELF NEEDED,
     readelf -d), nor libgfortran.so.5 (server/fortran_rt.c defines the one routine OpenBLAS's
@@ -35,6 +40,14 @@ def needed(path):
     return set(re.findall(r"\(NEEDED\)\s+Shared library: \[([^\]]+)\]", out))
 
 
+def program_headers(path):
+    """readelf -lW: (ELF file type line, the program headers' types)."""
+    out = subprocess.run(["readelf", "-lW", path], capture_output=True, text=True,
+                         check=True).stdout
+    kind = re.search(r"Elf file type is (\S+)", out)
+    return (kind.group(1) if kind else "?"), set(re.findall(r"^\s+([A-Z_]+)\s+0x", out, re.M))
+
+
 def env_without_blas(**extra):
     env = {k: v for k, v in os.environ.items()
            if k not in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "GOTO_NUM_THREADS")}
@@ -54,10 +67,16 @@ def main():
     cli, link, reqs = sys.argv[1], sys.argv[2], sys.argv[3:]
     libs = needed(cli)
     blas = sorted(libs & {"libopenblas.so.0", "libblas.so.3", "liblapack.so.3"})
-    if link == "static":
+    if link == "static-pie":
+        kind, headers = program_headers(cli)
+        check(not libs, "static-pie: the CLI needs no shared library (NEEDED: %s)" % sorted(libs))
+        check("INTERP" not in headers and "LOAD" in headers,
+              "static-pie: no program interpreter (program headers: %s)" % sorted(headers))
+        check(kind == "DYN", "static-pie: position independent (ELF type %s)" % kind)
+    if link in ("static", "static-pie"):
         check(not blas, "static: the CLI needs no shared BLAS/LAPACK (NEEDED: %s)" % sorted(libs))
         imports = subprocess.run(["nm", "-D", "--undefined-only", cli], capture_output=True,
-                                 text=True, check=True).stdout
+                                 text=True).stdout  # a static-pie program has none: "no symbols"
         check("libgfortran.so.5" not in libs,
               "static: the CLI needs no libgfortran (NEEDED: %s; its imports from it: %s)"
               % (sorted(libs), sorted(set(re.findall(r"_gfortran_\w+", imports)))))
