@@ -13,7 +13,7 @@
 #                 BASE, ldd of every binary with the pack's libraries (a "not found" is named)
 #   sweeps.txt    bench_sweeps.sh BASE NEW 5           (speed sweeps, BASE vs NEW --threads 1..16)
 #   small.txt     bench_small.sh NEW BASE 30           (whole-process time of small solves)
-#   faults.txt    bench_faults.sh NEW 15 (the cost of a page fault; small solves with the heap
+#   faults.txt    bench_faults.sh BASE 15 (the cost of a page fault; small solves with the heap
 #                 faulted in up front, or in huge pages)
 #   bmodes.txt    BMODES_BIN=CARRY/bmodes bench_bmodes.sh NEW 3 at 12 48 96 elements and the
 #                 16-speed sweep; then, after the throughput tables and only when the time left
@@ -247,8 +247,9 @@ want small && step small small.txt 75 \
     bash tests/bench/bench_small.sh "$NEW" "$BASE" "${DEVRUN_SMALL_N:-30}"
 # what a page fault costs on the device, and small solves with their heap faulted in up front or
 # in huge pages (bench_faults.sh; its probe and preload come from CARRY)
+# (on BASE: HEAD's CLI is static-pie, which LD_PRELOAD cannot reach and bench_faults.sh refuses)
 want faults && step faults faults.txt 60 \
-    bash tests/bench/bench_faults.sh "$NEW" "${DEVRUN_FAULTS_N:-15}" "$CARRY/fault_probe" "$CARRY/prefault.so"
+    bash tests/bench/bench_faults.sh "$BASE" "${DEVRUN_FAULTS_N:-15}" "$CARRY/fault_probe" "$CARRY/prefault.so"
 want bmodes && step bmodes bmodes.txt 120 \
     env BMODES_BIN="$BMODES" BMODES_ELEMENTS="${DEVRUN_BMODES_ELEMENTS-12 48 96}" \
     BMODES_SWEEP="${DEVRUN_BMODES_SWEEP:-1}" bash tests/bench/bench_bmodes.sh "$NEW" "${DEVRUN_BMODES_N:-3}"
