@@ -8,7 +8,8 @@
 # Cases: examples/angled-beam-90.json (planar, 48 elements, 1 speed) and the BModes CertTest
 # blade Test01 imported by NEW (`spinmodal import bmodes`): with --bmodes-mesh 1, 2, 4, 8
 # (12, 24, 48, 96 elements, BModes' own model) and without it (48 elements, interpolated).
-# The first row, `--version`, is the process floor: loading, start-up and exit without a request.
+# The first row, /bin/true, is what any process costs here (the same program in both columns);
+# the second, `--version`, the CLI's own floor: loading, start-up and exit without a request.
 # Columns: wall ms (median), cpu ms (user + system of the child, median: steadier than wall on
 # a shared machine), faults (the child's minor page faults, median: on a machine where a fault is
 # dear, e.g. under gVisor, they are much of a small solve's wall time), then wall and cpu for
@@ -30,7 +31,7 @@ fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 bmi=tests/reference/blades/bmodes_certtest/Test01_nonunif_blade.bmi
-cases=("floor--version=--version" "beam48-planar=examples/angled-beam-90.json")
+cases=("any-process=/bin/true" "floor--version=--version" "beam48-planar=examples/angled-beam-90.json")
 for k in 1 2 4 8; do
   "$new" import bmodes "$bmi" --bmodes-mesh "$k" >"$tmp/t01_m$k.json" 2>/dev/null
   cases+=("blade$((12 * k))-bmodes-mesh=$tmp/t01_m$k.json")
@@ -48,9 +49,12 @@ null = os.open(os.devnull, os.O_WRONLY)
 
 def once(exe, path):
     """Wall ms, child CPU ms and minor faults of one whole-process solve (posix_spawn: no shell,
-    no fork copy); path "--version" runs `exe --version` (the process floor)."""
+    no fork copy); path "--version" runs `exe --version` (the process floor), path /bin/true
+    runs /bin/true instead of exe (any process's floor)."""
     fa = [(os.POSIX_SPAWN_DUP2, null, 1), (os.POSIX_SPAWN_DUP2, null, 2)]
-    argv = [exe, path] if path == "--version" else [exe, "solve", path]
+    if path == "/bin/true":
+        exe = path
+    argv = [exe, path] if path == "--version" else [exe] if path == "/bin/true" else [exe, "solve", path]
     t0 = time.perf_counter_ns()
     pid = os.posix_spawn(exe, argv, os.environ, file_actions=fa)
     _, status, ru = os.wait4(pid, 0)
