@@ -264,10 +264,10 @@ void frames_hessian(const sm_model *m, const double *q, const sm_kin *k, dmat *H
 /** fg += f_g(q) = sum_e P_e T_e' G_e T_e q_s (eqs. 22, 24, 26); fg: n. */
 void lin_geometric_force(const sm_model *m, const double *q, double *fg);
 /** Kt += d f_g/dq at q; frozen != 0: P_e held at P_e(q) (the paper's K*, symmetric), else the full
- *  derivative (Newton).  work: >= 4 max m_s doubles. */
+ *  derivative (Newton).  work: >= 5 max m_s doubles. */
 void lin_geometric_tangent(const sm_model *m, const double *q, int frozen, dmat *Kt, double *work);
 /** A += d f_g,s/dq_s of substructure s alone, m_s x m_s with leading dimension lda (the diagonal
- *  block of lin_geometric_tangent); frozen as there.  work: >= 4 max m_s doubles. */
+ *  block of lin_geometric_tangent); frozen as there.  work: >= 5 max m_s doubles. */
 void lin_geometric_tangent_sub(const sm_model *m, int s, const double *q, int frozen, double *A, int lda,
                                double *work);
 /** P[e] = d_e . q_s, the axial force of every FE element (eq. 24), N; P: n_elems. */
@@ -284,7 +284,7 @@ void lin_gyro(const sm_model *m, const sm_kin *k, double omega, dmat *C, dmat *W
  * Kt = K + d f_g/dq - s (M* + H) at q with its kinematics in k, s = Omega^2:
  * the Newton tangent (frozen = 0) or K* with P frozen (frozen != 0, eq. 44).
  * The one assembly of it; also leaves M* in M and H in H.  W: n x 2 n_mp
- * scratch; work: >= 4 max m_s doubles.  Writes the scratch fields of k
+ * scratch; work: >= 5 max m_s doubles.  Writes the scratch fields of k
  * (frames_hessian).
  */
 void lin_tangent(const sm_model *m, const double *q, const sm_kin *k, double s, int frozen, dmat *Kt,

@@ -58,7 +58,16 @@ void lin_geometric_force(const sm_model *m, const double *q, double *f)
 /**
  * A += d f_g,s / dq_s for substructure s alone (m_s x m_s, leading dimension
  * lda).  frozen != 0: P_e held at P_e(q) (K*, symmetric); otherwise the full
- * derivative, adding (T' G T q) d_e'.  work: >= 4*max m.
+ * derivative, adding (T' G T q) d_e'.  work: >= 5*max m.
+ *
+ * Each element adds P_e Tb' G Tb (+ Tb' G tb d_e'), Tb the element's four bending rows of T_s.
+ * Those rows are copied into work first, one contiguous row each (T_s is column-major with
+ * 6 nel rows: a row of it is strided), and V = G Tb is formed a column at a time inside the
+ * column loop, so the inner loop over the rows of A reads and writes contiguous memory (issue
+ * 27: 52 % of a 500-coordinate one-frame planar model's time, strided).  Every entry of A
+ * receives the same operations in the same order as in solver 0.8.8 (t summed over r = 0..3
+ * from 0, then P t added, then the d_e' term; elements in order), so the bits are the same
+ * (test_geometric_tangent compares with that form).
  */
 void lin_geometric_tangent_sub(const sm_model *m, int s, const double *q, int frozen, double *A, int lda,
                                double *work)
@@ -67,37 +76,59 @@ void lin_geometric_tangent_sub(const sm_model *m, int s, const double *q, int fr
     const sm_sub *b = &m->subs[s];
     const double *qs = q + b->q0;
     int mm = b->m;
-    double *V = work; /* 4 x mm: V = G Tb */
+    double *Tr = work, *u = work + 4 * (size_t)mm; /* Tr: 4 x mm, rows of Tb; u = Tb' G tb */
     for (int j = 0; j < b->nel; j++) {
         double tb[4];
         double P = lin_element_state(b, j, qs, tb);
         const double *g = b->gq + 16 * j, *d = b->d + (size_t)j * mm;
+        const double *T0 = Tr, *T1 = Tr + mm, *T2 = Tr + 2 * (size_t)mm, *T3 = Tr + 3 * (size_t)mm;
         for (int c = 0; c < mm; c++)
-            for (int r = 0; r < 4; r++) {
-                double t = 0;
-                for (int p = 0; p < 4; p++)
-                    t += g[r + 4 * p] * DM(&b->T, 6 * j + rows[p], c);
-                V[r + 4 * c] = t;
-            }
-        /* A += P Tb' V */
-        for (int jc = 0; jc < mm; jc++)
-            for (int ic = 0; ic < mm; ic++) {
-                double t = 0;
-                for (int r = 0; r < 4; r++)
-                    t += DM(&b->T, 6 * j + rows[r], ic) * V[r + 4 * jc];
-                A[(size_t)jc * lda + ic] += P * t;
-            }
+            for (int r = 0; r < 4; r++)
+                Tr[(size_t)r * mm + c] = DM(&b->T, 6 * j + rows[r], c);
         if (!frozen) {
-            /* + (Tb' G tb) d' */
             double gt[4];
             for (int r = 0; r < 4; r++)
                 gt[r] = g[r] * tb[0] + g[r + 4] * tb[1] + g[r + 8] * tb[2] + g[r + 12] * tb[3];
             for (int ic = 0; ic < mm; ic++) {
                 double t = 0;
-                for (int r = 0; r < 4; r++)
-                    t += DM(&b->T, 6 * j + rows[r], ic) * gt[r];
-                for (int jc = 0; jc < mm; jc++)
-                    A[(size_t)jc * lda + ic] += t * d[jc];
+                t += T0[ic] * gt[0];
+                t += T1[ic] * gt[1];
+                t += T2[ic] * gt[2];
+                t += T3[ic] * gt[3];
+                u[ic] = t;
+            }
+        }
+        for (int jc = 0; jc < mm; jc++) {
+            double v[4]; /* column jc of V = G Tb */
+            for (int r = 0; r < 4; r++) {
+                double t = 0;
+                t += g[r] * T0[jc];
+                t += g[r + 4] * T1[jc];
+                t += g[r + 8] * T2[jc];
+                t += g[r + 12] * T3[jc];
+                v[r] = t;
+            }
+            double *a = A + (size_t)jc * lda;
+            if (frozen) {
+                for (int ic = 0; ic < mm; ic++) {
+                    double t = 0;
+                    t += T0[ic] * v[0];
+                    t += T1[ic] * v[1];
+                    t += T2[ic] * v[2];
+                    t += T3[ic] * v[3];
+                    a[ic] += P * t;
+                }
+            } else {
+                double dj = d[jc];
+                for (int ic = 0; ic < mm; ic++) {
+                    double t = 0;
+                    t += T0[ic] * v[0];
+                    t += T1[ic] * v[1];
+                    t += T2[ic] * v[2];
+                    t += T3[ic] * v[3];
+                    a[ic] += P * t;
+                    a[ic] += u[ic] * dj;
+                }
             }
         }
     }
@@ -160,7 +191,7 @@ void lin_gyro(const sm_model *m, const sm_kin *k, double omega, dmat *C, dmat *W
  * in k (frames_eval): the Newton tangent of F (frozen = 0, equilibrium.c) or
  * the paper's K* with P_e frozen at P_e(q) (frozen != 0, eq. 44, sweep.c).
  * Leaves M* (eq. 42) in M and the Hessian term H in H.  All matrices n x n,
- * W n x 2 n_mp scratch, work >= 4*max m_s doubles; nothing is allocated.
+ * W n x 2 n_mp scratch, work >= 5*max m_s doubles; nothing is allocated.
  */
 void lin_tangent(const sm_model *m, const double *q, const sm_kin *k, double s, int frozen, dmat *Kt,
                  dmat *M, dmat *H, dmat *W, double *work)
