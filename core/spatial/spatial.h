@@ -164,7 +164,7 @@ void sp_hessian_end(const sm_model *m, sp_kin *k);
 /* ------------------------------------------------------------- lin3.c */
 /** f += f_g(q) = sum_e P_e T_e' G_e T_e q_s (the 3D G of fe3_geometric). */
 void lin3_geometric_force(const sm_model *m, const double *q, double *f);
-/** Kt += d f_g / dq; frozen: P_e held at P_e(q). work: >= 12 max m_s doubles. */
+/** Kt += d f_g / dq; frozen: P_e held at P_e(q). work: >= 13 max m_s doubles. */
 void lin3_geometric_tangent(const sm_model *m, const double *q, int frozen, dmat *Kt, double *work);
 /** Kt (m_s x m_s block of frame s, leading dimension ld) += d f_g,s / dq_s, as lin3_geometric_tangent. */
 void lin3_geometric_tangent_sub(const sm_model *m, int s, const double *q, int frozen, double *Kt, int ld,
@@ -179,7 +179,7 @@ void lin3_mass(const sm_model *m, const sp_kin *k, dmat *M, dmat *Y);
  *  Y_p = -skew(X_p e_z) + X_p S + S X_p (skew).  Y: n x 6P scratch. */
 void lin3_gyro(const sm_model *m, const sp_kin *k, double omega, dmat *C, dmat *Y);
 /** Kt = K + d f_g/dq - s H at q, frozen as lin3_geometric_tangent; H (n x n) receives dg/dq
- *  (untouched when s = 0).  Uses the complex scratch of k.  work: >= 12 max m_s doubles. */
+ *  (untouched when s = 0).  Uses the complex scratch of k.  work: >= 13 max m_s doubles. */
 void lin3_tangent(const sm_model *m, const double *q, sp_kin *k, double s, int frozen, dmat *Kt, dmat *H,
                   double *work);
 /** nodes (6 n_nodes) = x, y, z and the rotation vector of each node's triad (DESIGN.md 7.3);

@@ -145,7 +145,7 @@ int tree3_assemble(const sm_model *m, const double *q, sp_kin *k, double s2, int
 {
     int mx = t->max_m, finite = 1;
     size_t lmax = 6 + (size_t)mx;
-    double *Jl = t->work; /* tree_alloc: >= 6 lmax + lmax^2 + 13 mx */
+    double *Jl = t->work; /* tree_alloc: >= 6 lmax + lmax^2 + 14 mx */
     double *Wl = Jl + 3 * lmax, *Cr = Wl + 3 * lmax, *col = Cr + lmax * lmax, *gw = col + mx;
     sp_eval(m, q, k);
     tree3_links(m, k, t);
