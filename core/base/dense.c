@@ -287,3 +287,37 @@ done:
     free(ifail);
     return info;
 }
+
+int dm_ptap_ordered(int n, int m, const double *K, const double *N, double *KN, double *C)
+{
+    double *Nt = dm_vec((size_t)m * (size_t)n); /* Nt[p m + i] = N(p, i) */
+    if (!Nt)
+        return SM_NOMEM;
+    for (int i = 0; i < m; i++)
+        for (int p = 0; p < n; p++)
+            Nt[(size_t)p * m + i] = N[(size_t)i * n + p];
+    for (int j = 0; j < m; j++) { /* KN(:, j) = sum_p K(:, p) N(p, j) */
+        double *restrict col = KN + (size_t)j * n;
+        for (int i = 0; i < n; i++)
+            col[i] = 0;
+        for (int p = 0; p < n; p++) {
+            const double *restrict kp = K + (size_t)p * n;
+            double np = N[(size_t)j * n + p];
+            for (int i = 0; i < n; i++)
+                col[i] += kp[i] * np;
+        }
+    }
+    for (int j = 0; j < m; j++) { /* C(:, j) = sum_p N(p, :)' KN(p, j) */
+        double *restrict col = C + (size_t)j * m;
+        for (int i = 0; i < m; i++)
+            col[i] = 0;
+        for (int p = 0; p < n; p++) {
+            const double *restrict np = Nt + (size_t)p * m;
+            double kn = KN[(size_t)j * n + p];
+            for (int i = 0; i < m; i++)
+                col[i] += np[i] * kn;
+        }
+    }
+    free(Nt);
+    return SM_OK;
+}

@@ -67,4 +67,15 @@ int dm_syev_range(int dsyevr_bits, int n, double *A, int il, int iu, double *w, 
  */
 int dm_sy_lowest(int n, double *A, double *lambda);
 
+/**
+ * C (m x m, leading dimension m) = N' K N, K (n x n) and N (n x m) column-major, each entry with
+ * the bits of the plain loops: (K N)(i, j) summed over p = 0..n-1 in order from 0, then
+ * C(i, j) = sum over p in order of N(p, i) (K N)(p, j) — no BLAS, whose blocking reorders sums
+ * (the planar kind's results are fixed to the byte, issue 27).  Written as column updates
+ * (axpy) instead of dot products, so that the independent entries of a column are summed side by
+ * side in vector registers while each one keeps its order.  K N in KN (n x m, caller's);
+ * allocates an m x n transpose of N.  Returns SM_OK or SM_NOMEM.
+ */
+int dm_ptap_ordered(int n, int m, const double *K, const double *N, double *KN, double *C);
+
 #endif
