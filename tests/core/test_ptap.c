@@ -27,7 +27,8 @@ static void check(int n, int m, unsigned seed)
     unsigned s = seed;
     for (int j = 0; j < n; j++) /* symmetric, graded over 12 decades, signs mixed */
         for (int i = 0; i <= j; i++)
-            K[(size_t)j * n + i] = K[(size_t)i * n + j] = rnd(&s) * pow(10.0, 12.0 * (i + j) / (2.0 * n) - 6);
+            K[(size_t)j * n + i] = K[(size_t)i * n + j] =
+                rnd(&s) * pow(10.0, 12.0 * (i + j) / (2.0 * n) - 6);
     for (size_t i = 0; i < (size_t)n * m; i++)
         N[i] = rnd(&s) * (i % 7 == 3 ? 1e-9 : 1.0);
     for (int i = 0; i < n; i++) /* the loops modes_planar.c had */
@@ -45,8 +46,10 @@ static void check(int n, int m, unsigned seed)
             C0[(size_t)j * m + i] = t;
         }
     TU_CHECK(dm_ptap_ordered(n, m, K, N, KN, C) == SM_OK, "%d x %d: runs", n, m);
-    TU_CHECK(memcmp(KN, KN0, (size_t)n * m * sizeof(double)) == 0, "%d x %d: K N, the loops' bits", n, m);
-    TU_CHECK(memcmp(C, C0, (size_t)m * m * sizeof(double)) == 0, "%d x %d: N' K N, the loops' bits", n, m);
+    TU_CHECK(memcmp(KN, KN0, (size_t)n * m * sizeof(double)) == 0, "%d x %d: K N, the loops' bits",
+             n, m);
+    TU_CHECK(memcmp(C, C0, (size_t)m * m * sizeof(double)) == 0, "%d x %d: N' K N, the loops' bits",
+             n, m);
     cblas_dgemm(CblasColMajor, CblasNoTrans, CblasNoTrans, n, m, n, 1.0, K, n, N, n, 0.0, KN0, n);
     cblas_dgemm(CblasColMajor, CblasTrans, CblasNoTrans, m, m, n, 1.0, N, n, KN0, n, 0.0, C1, m);
     double err = 0, ref = 0;
