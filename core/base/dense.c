@@ -288,36 +288,33 @@ done:
     return info;
 }
 
+/* y (rows) = sum over p = 0..cols-1 in order of A(:, p) x[p] (A column-major, leading dimension
+ * rows), each entry summed from 0: column updates, vectorised across the entries of y. */
+static void dm_colsum_ordered(int rows, int cols, const double *restrict A,
+                              const double *restrict x, double *restrict y)
+{
+    for (int i = 0; i < rows; i++)
+        y[i] = 0;
+    for (int p = 0; p < cols; p++) {
+        const double *restrict ap = A + (size_t)p * rows;
+        double xp = x[p];
+        for (int i = 0; i < rows; i++)
+            y[i] += ap[i] * xp;
+    }
+}
+
 int dm_ptap_ordered(int n, int m, const double *K, const double *N, double *KN, double *C)
 {
-    double *Nt = dm_vec((size_t)m * (size_t)n); /* Nt[p m + i] = N(p, i) */
+    double *Nt = dm_vec((size_t)m * (size_t)n); /* Nt[p m + i] = N(p, i): N' column-major */
     if (!Nt)
         return SM_NOMEM;
     for (int i = 0; i < m; i++)
         for (int p = 0; p < n; p++)
             Nt[(size_t)p * m + i] = N[(size_t)i * n + p];
-    for (int j = 0; j < m; j++) { /* KN(:, j) = sum_p K(:, p) N(p, j) */
-        double *restrict col = KN + (size_t)j * n;
-        for (int i = 0; i < n; i++)
-            col[i] = 0;
-        for (int p = 0; p < n; p++) {
-            const double *restrict kp = K + (size_t)p * n;
-            double np = N[(size_t)j * n + p];
-            for (int i = 0; i < n; i++)
-                col[i] += kp[i] * np;
-        }
-    }
-    for (int j = 0; j < m; j++) { /* C(:, j) = sum_p N(p, :)' KN(p, j) */
-        double *restrict col = C + (size_t)j * m;
-        for (int i = 0; i < m; i++)
-            col[i] = 0;
-        for (int p = 0; p < n; p++) {
-            const double *restrict np = Nt + (size_t)p * m;
-            double kn = KN[(size_t)j * n + p];
-            for (int i = 0; i < m; i++)
-                col[i] += np[i] * kn;
-        }
-    }
+    for (int j = 0; j < m; j++) /* KN(:, j) = sum_p K(:, p) N(p, j) */
+        dm_colsum_ordered(n, n, K, N + (size_t)j * n, KN + (size_t)j * n);
+    for (int j = 0; j < m; j++) /* C(:, j) = sum_p N(p, :)' KN(p, j) */
+        dm_colsum_ordered(m, n, Nt, KN + (size_t)j * n, C + (size_t)j * m);
     free(Nt);
     return SM_OK;
 }

@@ -109,6 +109,8 @@ void lin_geometric_tangent_sub(const sm_model *m, int s, const double *q, int fr
                 v[r] = t;
             }
             double *a = A + (size_t)jc * lda;
+            /* two loops, not one with u d_e' scaled by !frozen: adding 0 would turn a -0 entry
+             * into +0, and the branch stays out of the inner loop */
             if (frozen) {
                 for (int ic = 0; ic < mm; ic++) {
                     double t = 0;

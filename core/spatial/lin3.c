@@ -64,6 +64,7 @@ void lin3_geometric_force(const sm_model *m, const double *q, double *f)
 static void lin3_geo_column(int mm, const double *restrict Tr, const double *restrict g, double P,
                             const double *restrict v, double dc, double *restrict k)
 {
+    /* two loops, not one with v dc scaled by 0: adding 0 would turn a -0 entry into +0 */
     if (!v) { /* Kt_ss += P T' G T */
         for (int a = 0; a < mm; a++) {
             double s2 = 0;
