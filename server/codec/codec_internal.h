@@ -23,6 +23,7 @@
  *   result.c    the result document (DESIGN.md section 4)            res_
  *   csv.c       the result's frequency table as CSV                  csv_
  *   problem.c   RFC 9457 problem documents                           (no helpers)
+ *   jsonread.c  a request's text as jansson's tree, read faster      jr_
  *   jobdoc.c    the daemon's job documents, the text buffer (jobdoc.h)  jdoc_
  *   run.c       the pipeline request -> model -> solve -> documents
  *               (run.h; the CLI and the job workers call it)         run_
@@ -654,5 +655,16 @@ int codec_json_dump_rows(const json_t *x, json_dump_callback_t cb, void *data,
  *  written by jsontext.c (keys sorted by strcmp as jansson does).  x: an object or an array.
  *  Returns the malloc'd text, or NULL (out of memory, a string not valid UTF-8). */
 char *codec_json_dumps_sorted(const json_t *x);
+
+/* ====================================================== jsonread.c: jr_ */
+
+/** The tree json_loadb(text, len, flags, NULL) gives, read by jsonread.c's fast reader; NULL
+ *  where that reader gives up (anything but plain ASCII JSON, flags other than
+ *  JSON_REJECT_DUPLICATES, out of memory) or where jansson would refuse the text. */
+json_t *codec_json_fast(const char *text, size_t len, size_t flags);
+
+/** json_loadb(text, len, flags, error): codec_json_fast's tree, or jansson's own answer (tree,
+ *  or NULL with its error) where the fast reader gives up. */
+json_t *codec_json_loadb(const char *text, size_t len, size_t flags, json_error_t *error);
 
 #endif /* SPINMODAL_CODEC_INTERNAL_H */

@@ -699,7 +699,7 @@ static int req_parse(codec_request **out, const char *text, size_t len, const co
             return SM_NOMEM;
         return SM_INVALID_INPUT;
     }
-    root = json_loadb(text, len, JSON_REJECT_DUPLICATES, &jerr);
+    root = codec_json_loadb(text, len, JSON_REJECT_DUPLICATES, &jerr);
     if (!root) {
         err_mark_malformed(errs);
         for (size_t k = 0; jerr.text[k]; k++) /* jansson's "near '...'" may cut a UTF-8 char */

@@ -32,6 +32,10 @@
  *     also solved, with a budget of progress callbacks, and the result is
  *     encoded as JSON and CSV, which must succeed.
  *
+ *   the fast JSON reader (codec_json_fast, server/codec/jsonread.c), with and
+ *     without JSON_REJECT_DUPLICATES: a tree only where json_loadb gives one,
+ *     and the same tree (../codec/json_same.h: reals by bits, members in order).
+ *
  * SM_NOMEM is accepted at every step (it cannot be told from a bug here).
  */
 #include <math.h>
@@ -43,7 +47,8 @@
 #include <jansson.h>
 
 #include "codec.h"
-#include "codec_internal.h" /* req_parse_codec_only */
+#include "codec_internal.h" /* req_parse_codec_only, codec_json_fast */
+#include "../codec/json_same.h"
 #include "fuzz.h"
 #include "spinmodal.h"
 
@@ -373,6 +378,23 @@ done:
     codec_errors_free(errs);
 }
 
+/* codec_json_fast against json_loadb (ref: its tree with JSON_REJECT_DUPLICATES, or NULL);
+ * a tree only where jansson gives one, and the same tree.  have_ref: ref was read (the body is
+ * within the cap). */
+static void fuzz_json_fast(const uint8_t *data, size_t size, int have_ref, const json_t *ref)
+{
+    const char *text = (const char *)data;
+    json_t *fast = codec_json_fast(text, size, JSON_REJECT_DUPLICATES);
+    if (have_ref)
+        FUZZ_CHECK(!fast || json_same(fast, ref));
+    json_decref(fast);
+    json_t *any = json_loadb(text, size, 0, NULL);
+    fast = codec_json_fast(text, size, 0);
+    FUZZ_CHECK(!fast || json_same(fast, any));
+    json_decref(fast);
+    json_decref(any);
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     codec_limits lim;
@@ -389,6 +411,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     rc = codec_request_parse(&r, (const char *)data, size, &lim, errs);
     if (size <= lim.max_request_bytes)
         root = json_loadb((const char *)data, size, JSON_REJECT_DUPLICATES, &jerr);
+    fuzz_json_fast(data, size, size <= lim.max_request_bytes, root);
 
     if (rc == SM_OK) {
         FUZZ_CHECK(r != NULL && root != NULL && codec_errors_count(errs) == 0);
