@@ -122,8 +122,9 @@ typedef struct smi_kind {
     /** e[5..7] += bending and torsion strain of E from its ends' motion. */
     void (*label_strain)(const sm_elem *E, const double v[2], const double w[2], const double tx[2],
                          const double r2[2], const double r3[2], double e[SM_ENERGY_PARTS]);
-    /** e += the point-mass rotary parts at the far node of element el for shape s; NULL: none. */
-    void (*label_point)(const sm_model *m, const sm_case *c, int el, const double *s,
+    /** e += the point-mass rotary parts at the far node of element el for shape s, ax: its
+     *  axes t, p2, p3 (label_axes); NULL: none. */
+    void (*label_point)(const sm_model *m, int el, const double ax[9], const double *s,
                         double e[SM_ENERGY_PARTS]);
 } smi_kind;
 

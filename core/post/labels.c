@@ -64,16 +64,18 @@ char *sm_mode_label(int kind, int ordinal, char *buf, size_t size)
 }
 
 /* e[0..3] += kinetic (axial, edge, flap, torsion), e[4..7] += strain of element el for one
- * real shape s (a part of a complex one); the kind gives the axes, the nodes' motion in 3D,
- * the rotary inertia's parts and the bending and torsion strain. */
-static void lab_element(const sm_model *m, const sm_case *c, int el, const double *s, double e[SM_ENERGY_PARTS])
+ * real shape s (a part of a complex one); ax: the element's axes t, p2, p3 (the kind's
+ * label_axes); the kind gives the nodes' motion in 3D, the rotary inertia's parts and the
+ * bending and torsion strain. */
+static void lab_element(const sm_model *m, int el, const double ax[9], const double *s,
+                        double e[SM_ENERGY_PARTS])
 {
     const smi_kind *K = m->kind;
     const sm_elem *E = &m->elems[el];
-    double t[3], p2[3], p3[3], d[2][3], r[2][3], u[2], v[2], w[2], tx[2], r2[2], r3[2];
+    const double *t = ax, *p2 = ax + 3, *p3 = ax + 6;
+    double d[2][3], r[2][3], u[2], v[2], w[2], tx[2], r2[2], r3[2];
     int nd[2] = {E->n1, E->n2};
 
-    K->label_axes(m, c, E, t, p2, p3);
     for (int h = 0; h < 2; h++) {
         K->label_node(s, nd[h], d[h], r[h]);
         u[h] = smi_dot3(t, d[h]);
@@ -96,21 +98,23 @@ static void lab_element(const sm_model *m, const sm_case *c, int el, const doubl
     K->label_strain(E, v, w, tx, r2, r3, e);
 }
 
-/* Energy fractions of one nodal shape (re, and im or NULL) into f[SM_ENERGY_PARTS]; *support
- * (may be NULL) = the supports' share of the strain energy. */
-static void lab_energy(const sm_model *m, const sm_case *c, const double *re, const double *im,
+/* Energy fractions of one nodal shape (re, and im or NULL) into f[SM_ENERGY_PARTS]; ax: the
+ * elements' axes, 9 a element (lab_case); *support (may be NULL) = the supports' share of the
+ * strain energy. */
+static void lab_energy(const sm_model *m, const double *ax, const double *re, const double *im,
                        double f[SM_ENERGY_PARTS], double *support)
 {
     double e[SM_ENERGY_PARTS] = {0};
 
     for (int el = 0; el < m->n_elems; el++) {
-        lab_element(m, c, el, re, e);
+        const double *a = ax + (size_t)9 * el;
+        lab_element(m, el, a, re, e);
         if (im)
-            lab_element(m, c, el, im, e);
+            lab_element(m, el, a, im, e);
         if (m->kind->label_point) {
-            m->kind->label_point(m, c, el, re, e);
+            m->kind->label_point(m, el, a, re, e);
             if (im)
-                m->kind->label_point(m, c, el, im, e);
+                m->kind->label_point(m, el, a, im, e);
         }
     }
     for (int h = 0; h < 2; h++) {
@@ -155,12 +159,20 @@ int lab_case(const sm_model *m, sm_case *c)
     c->label_confidence = malloc((size_t)k * sizeof(double));
     if (m->has_supports && !(c->support_share = malloc((size_t)k * sizeof(double))))
         return SM_NOMEM;
-    if (!c->energy || !c->label_kind || !c->label_ordinal || !c->label_confidence)
+    /* the elements' axes at the steady state, once for every mode (issue 27) */
+    double *ax = malloc((size_t)9 * (size_t)(m->n_elems > 0 ? m->n_elems : 1) * sizeof(double));
+    if (!c->energy || !c->label_kind || !c->label_ordinal || !c->label_confidence || !ax) {
+        free(ax);
         return SM_NOMEM;
+    }
+    for (int el = 0; el < m->n_elems; el++) {
+        double *a = ax + (size_t)9 * el;
+        m->kind->label_axes(m, c, &m->elems[el], a, a + 3, a + 6);
+    }
     for (int j = 0; j < k; j++) { /* modes are in ascending frequency: ordinals count up */
         double *f = c->energy + (size_t)j * SM_ENERGY_PARTS;
-        lab_energy(m, c, c->shape_re + j * stride, c->shape_im ? c->shape_im + j * stride : NULL, f,
-                   c->support_share ? c->support_share + j : NULL);
+        lab_energy(m, ax, c->shape_re + j * stride, c->shape_im ? c->shape_im + j * stride : NULL,
+                   f, c->support_share ? c->support_share + j : NULL);
         c->label_kind[j] = lab_kind(m, f, &c->label_confidence[j]);
         if (m->base && c->frequency[j] == 0) { /* a free base's rigid-body mode (linsys.c) */
             c->label_kind[j] = SM_MODE_RIGID;
@@ -168,5 +180,6 @@ int lab_case(const sm_model *m, sm_case *c)
         }
         c->label_ordinal[j] = c->label_kind[j] == SM_MODE_COUPLED ? 0 : ++count[c->label_kind[j]];
     }
+    free(ax);
     return SM_OK;
 }

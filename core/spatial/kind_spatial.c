@@ -193,17 +193,16 @@ static void spatial_label_strain(const sm_elem *E, const double v[2], const doub
     e[7] += smi_elem_bar_energy(E->GJ, E->l, tx[0], tx[1]);
 }
 
-/* Point-mass rotary inertia of the far node of element el in the axes (t, p2, p3): its
+/* Point-mass rotary inertia of the far node of element el in its axes axes = (t, p2, p3): its
  * diagonal. */
-static void spatial_label_point(const sm_model *m, const sm_case *c, int el, const double *s,
+static void spatial_label_point(const sm_model *m, int el, const double axes[9], const double *s,
                                 double e[SM_ENERGY_PARTS])
 {
     const sm_elem *E = &m->elems[el];
-    const double *P = m->nodes[E->n2].point_rot;
-    double t[3], p2[3], p3[3], d[3], r[3], *ax[3] = {t, p2, p3};
+    const double *P = m->nodes[E->n2].point_rot, *ax[3] = {axes, axes + 3, axes + 6};
+    double d[3], r[3];
     int slot[3] = {3, 2, 1}; /* about t: torsion; about p2: flap; about p3: edge */
 
-    spatial_label_axes(m, c, E, t, p2, p3);
     spatial_label_node(s, E->n2, d, r);
     for (int a = 0; a < 3; a++) {
         double Pa[3], ra = smi_dot3(ax[a], r);
