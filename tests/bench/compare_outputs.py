@@ -7,7 +7,8 @@ bytes unchanged, no frequency moves by more than 1e-10").  A tool, not a test: i
 Solves every request of examples/ and tests/codec/cases/ (or the FILEs), plus generated tree-path
 requests (examples/ and the codec cases have none: planar angled beam at 599 and 1799
 coordinates with and without Coriolis, spatial precone blade at 288 coordinates over 21 speeds
-and at 1200 coordinates), with both CLIs, as JSON and as --csv, with OPENBLAS_NUM_THREADS=1.
+and at 1200 coordinates) and the one-frame models of sweep_cases.large_frames (planar 500 and 664
+coordinates, spatial 360), with both CLIs, as JSON and as --csv, with OPENBLAS_NUM_THREADS=1.
 It compares the outputs byte for byte without timing_ms, the solver version and "seconds", and
 for each request whose JSON differs prints the largest change of a frequency or eigenvalue
 (the imaginary part: a frequency; and the real part: a growth or decay rate, both relative to the
@@ -25,7 +26,7 @@ import tempfile
 
 ROOT = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", ".."))
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from sweep_cases import precone_blade  # noqa: E402
+from sweep_cases import large_frames, precone_blade  # noqa: E402
 
 
 def generated(tmp):
@@ -39,6 +40,7 @@ def generated(tmp):
         out.append(("planar-tree-%d-%s.json" % (6 * ne - 1, "c" if cor else "n"), r))
     out.append(("spatial-tree-288.json", precone_blade(mode_shapes=True)))
     out.append(("spatial-tree-1200.json", precone_blade(200, [0.0, 10.0, 20.0], 6, mode_shapes=True)))
+    out += [(name + ".json", r) for name, r in large_frames(ROOT)]
     files = []
     for name, r in out:
         path = os.path.join(tmp, name)

@@ -1,7 +1,8 @@
 """tests/bench/sweep_cases.py — the sweep cases of issue 27's benchmarks, written once
-(bench_sweeps.sh, bench_ab.sh, compare_outputs.py): the R3-style precone blade of bench_spatial.c,
-hub radius 1 m, 10 m at 10 degrees precone, per-element frames (6 coordinates each), clamped at
-the hub; and the benchmark files (write_bench_files)."""
+(bench_sweeps.sh, bench_ab.sh, bench_large.sh, compare_outputs.py): the R3-style precone blade of
+bench_spatial.c, hub radius 1 m, 10 m at 10 degrees precone, per-element frames (6 coordinates
+each), clamped at the hub; the benchmark files (write_bench_files); and the models with one large
+frame (large_frames: the classical floating-frame setup)."""
 import json
 import math
 import os
@@ -35,6 +36,26 @@ def write_bench_files(folder, root="."):
                       ("blade101", precone_blade(omegas=speeds))):
         with open(os.path.join(folder, name + ".json"), "w") as f:
             json.dump(req, f)
+
+
+def large_frames(root="."):
+    """(name, request) of the one-frame models: the angled beam (examples/angled-beam-90.json)
+    with 125 and 166 elements a member in one frame (500 and 664 coordinates, planar, 0 and
+    10 rad/s), and the precone blade with 60 elements in one frame (360 coordinates, spatial, 0
+    and 20 rad/s, 4 modes).  root: the repository."""
+    out = []
+    for ne in (125, 166):
+        with open(os.path.join(root, "examples", "angled-beam-90.json")) as f:
+            r = json.load(f)
+        r["frames"] = "single"
+        for mb in r["structure"]["members"]:
+            mb["elements"] = ne
+        r["analysis"]["omega"] = [0, 10]
+        out.append(("planar-1frame-%d" % (4 * ne), r))
+    b = precone_blade(60, [0, 20], 4)
+    b["frames"] = "single"
+    out.append(("spatial-1frame-360", b))
+    return out
 
 
 if __name__ == "__main__":
