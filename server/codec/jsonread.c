@@ -19,7 +19,7 @@
 #include "codec_internal.h"
 
 #include <errno.h>
-#include <locale.h>
+#include <langinfo.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -280,8 +280,10 @@ static json_t *jr_value(jr *r)
 
 json_t *codec_json_fast(const char *text, size_t len, size_t flags)
 {
-    const struct lconv *lc = localeconv();
-    if ((flags & ~(size_t)JSON_REJECT_DUPLICATES) || !text || !lc || strcmp(lc->decimal_point, "."))
+    /* nl_langinfo, not localeconv: glibc's localeconv writes a static struct on every call (a
+     * data race between the daemon's request threads); nl_langinfo only reads the locale */
+    const char *point = nl_langinfo(RADIXCHAR);
+    if ((flags & ~(size_t)JSON_REJECT_DUPLICATES) || !text || !point || strcmp(point, "."))
         return NULL;
     jr r = {text, text + len, (flags & JSON_REJECT_DUPLICATES) != 0, 0, NULL, 0};
     jr_ws(&r);
