@@ -229,6 +229,10 @@ int sweep_pool_finish(sweep_pool *p, smi_lin *L, sm_progress *pr)
         }
         pool_ask(p, pr);
     }
+    /* the last case may have ended while the callback above ran (the lock is released for it):
+     * the callback's last call must still say every case is done */
+    if (pr->done != p->finished)
+        pool_ask(p, pr);
     int rc = p->rc;
     pthread_mutex_unlock(&p->mu);
     return rc;
