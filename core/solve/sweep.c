@@ -147,7 +147,7 @@ int sweep_run(const sm_model *m, const double *omegas, int n_omegas, sm_progress
     r->n_cases = n_omegas;
     /* One speed without a pool: the modes' workspace comes after the equilibrium's is freed, so
      * that it takes the same memory instead of fresh pages (a page fault costs 1-2 us where the
-     * small solves were measured: 200 of the planar beam's 1 070, issue 27).  Nothing else
+     * small solves were measured: 270 of the planar beam's 1 070, issue 27).  Nothing else
      * changes: both start zeroed. */
     int single = n_omegas == 1; /* a pool takes two speeds or more */
     if ((!single && (rc = smi_lin_new(m, SMI_USE_MODES, tree_use(m), &L)) < 0) ||
