@@ -23,6 +23,7 @@
 #include <string.h>
 
 #include "codec_internal.h"
+#include "xorshift.h"
 #include "json_same.h"
 
 static long checked, fast_taken, failures;
@@ -31,10 +32,7 @@ static uint64_t rng = 0x2545F4914F6CDD1DULL;
 
 static uint64_t next_u64(void)
 {
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return rng;
+    return xorshift64(&rng);
 }
 
 static void show(const char *what, const char *text, size_t len)

@@ -22,6 +22,7 @@
 #include <string.h>
 
 #include "codec_internal.h"
+#include "xorshift.h"
 
 static long checked, failures;
 
@@ -29,10 +30,7 @@ static uint64_t rng = 0x9E3779B97F4A7C15ULL;
 
 static uint64_t next_u64(void)
 {
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return rng;
+    return xorshift64(&rng);
 }
 
 /* x against snprintf, and against jansson's dump when with_jansson. */
