@@ -137,6 +137,10 @@ void field_set(val_ctx *v, json_t *canon, const char *key, json_t *value);
  */
 void field_check_keys(val_ctx *v, const json_t *obj, const char *base,
                       const char *const *allowed, const char *what);
+/** field_check_keys, the keys of skip (NULL-terminated) neither allowed nor reported: their
+ *  caller has its own message for them (a station's material keys). */
+void field_check_keys_but(val_ctx *v, const json_t *obj, const char *base,
+                          const char *const *allowed, const char *const *skip, const char *what);
 
 /** Numeric value of an integer or real into *d: 1, or 0 if x is not a number. */
 int field_number(const json_t *x, double *d);

@@ -124,6 +124,12 @@ void field_set(val_ctx *v, json_t *canon, const char *key, json_t *value)
 void field_check_keys(val_ctx *v, const json_t *obj, const char *base,
                       const char *const *allowed, const char *what)
 {
+    field_check_keys_but(v, obj, base, allowed, NULL, what);
+}
+
+void field_check_keys_but(val_ctx *v, const json_t *obj, const char *base,
+                          const char *const *allowed, const char *const *skip, const char *what)
+{
     const char *key;
     json_t *val;
 
@@ -133,6 +139,8 @@ void field_check_keys(val_ctx *v, const json_t *obj, const char *base,
         (void)val;
         for (i = 0; allowed[i] && !found; i++)
             found = !strcmp(key, allowed[i]);
+        for (i = 0; skip && skip[i] && !found; i++)
+            found = !strcmp(key, skip[i]);
         if (found)
             continue;
         for (i = 0; allowed[i]; i++) { /* an unknown key: the closest allowed one, if close */
@@ -187,61 +195,98 @@ static int field_integer(const json_t *x, long lo, long hi, long *out)
     return 1;
 }
 
-/* Check a real value x at ptr; 1 and *out when valid. */
-int field_check_real(val_ctx *v, const json_t *x, const char *ptr,
-                     enum field_real_kind kind, const char *unit, double *out)
+/* field_check_real's check without its message: 0 when x is valid (*out its value, -0 as 0),
+ * else which of the messages field_real_report writes (*out then x's number, if any). */
+enum {
+    FIELD_REAL_OK,
+    FIELD_REAL_NAN,
+    FIELD_REAL_INF,
+    FIELD_REAL_SUBNORMAL,
+    FIELD_REAL_POS,
+    FIELD_REAL_NONNEG
+};
+static int field_real_fault(const json_t *x, enum field_real_kind kind, double *out)
 {
-    double d;
+    double d = 0;
 
-    if (!field_number(x, &d)) {
+    if (!field_number(x, &d))
+        return FIELD_REAL_NAN;
+    *out = d;
+    if (!isfinite(d))
+        return FIELD_REAL_INF;
+    if (d != 0 && fabs(d) < DBL_MIN)
+        return FIELD_REAL_SUBNORMAL;
+    if (kind == FIELD_POSITIVE && !(d > 0))
+        return FIELD_REAL_POS;
+    if (kind == FIELD_NONNEG && !(d >= 0))
+        return FIELD_REAL_NONNEG;
+    if (d == 0)
+        *out = 0.0; /* -0 and 0 are the same request */
+    return FIELD_REAL_OK;
+}
+
+/* The message of a field_real_fault at ptr (d: the number, when there is one). */
+static void field_real_report(val_ctx *v, const char *ptr, int fault, const json_t *x, double d,
+                              const char *unit)
+{
+    switch (fault) {
+    case FIELD_REAL_NAN:
         field_error(v, ptr, "must be a number%s, not %s", unit, field_type_name(x));
-        return 0;
-    }
-    if (!isfinite(d)) {
+        break;
+    case FIELD_REAL_INF:
         field_error(v, ptr, "must be a finite number");
-        return 0;
-    }
-    if (d != 0 && fabs(d) < DBL_MIN) {
+        break;
+    case FIELD_REAL_SUBNORMAL:
         field_error(v, ptr, "%g is below the smallest normal double (%g): not a value the "
                     "numerics can carry%s", d, DBL_MIN, unit);
-        return 0;
-    }
-    if (kind == FIELD_POSITIVE && !(d > 0)) {
+        break;
+    case FIELD_REAL_POS:
         field_error(v, ptr, "must be a positive number%s, got %g", unit, d);
-        return 0;
-    }
-    if (kind == FIELD_NONNEG && !(d >= 0)) {
+        break;
+    default:
         field_error(v, ptr, "must be a number >= 0%s, got %g", unit, d);
+        break;
+    }
+}
+
+/* Check a real value x at ptr; 1 and *out when valid. */
+int field_check_real(val_ctx *v, const json_t *x, const char *ptr, enum field_real_kind kind,
+                     const char *unit, double *out)
+{
+    double d = 0;
+    int fault = field_real_fault(x, kind, &d);
+
+    if (fault) {
+        field_real_report(v, ptr, fault, x, d, unit);
         return 0;
     }
-    if (d == 0)
-        d = 0.0; /* -0 and 0 are the same request */
     *out = d;
     return 1;
 }
 
-/* Real field obj[key]: required, checked, written to canon as a real. */
+/* Real field obj[key]: required, checked, written to canon as a real.  The field's pointer is
+ * written only for a message (a blade's stations have thousands of valid reals: issue 27). */
 int field_real(val_ctx *v, const json_t *obj, const char *key, const char *base,
                json_t *canon, enum field_real_kind kind, const char *unit, double *out)
 {
     const json_t *x = json_object_get(obj, key);
-    char *ptr;
     double d = 0;
-    int ok;
+    int fault;
 
     if (!x) {
         field_error_key(v, base, key, "required field '%s' is missing", key);
         return 0;
     }
-    ptr = err_ptr_key(base, key);
-    if (!ptr) {
-        v->nomem = 1;
+    if ((fault = field_real_fault(x, kind, &d))) {
+        char *ptr = err_ptr_key(base, key);
+        if (!ptr) {
+            v->nomem = 1;
+            return 0;
+        }
+        field_real_report(v, ptr, fault, x, d, unit);
+        free(ptr);
         return 0;
     }
-    ok = field_check_real(v, x, ptr, kind, unit, &d);
-    free(ptr);
-    if (!ok)
-        return 0;
     field_set(v, canon, key, json_real(d));
     if (out)
         *out = d;

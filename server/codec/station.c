@@ -183,16 +183,9 @@ static int stn_station(val_ctx *v, const json_t *st, const char *p, size_t j, si
 {
     size_t k, before = (size_t)codec_errors_count(v->errs);
     double s = 0, x[2];
-    json_t *rest = json_copy((json_t *)st);
 
-    if (!rest) {
-        v->nomem = 1;
-        return 0;
-    }
-    for (k = 0; stn_material[k]; k++) /* material keys get their own message */
-        json_object_del(rest, stn_material[k]);
-    field_check_keys(v, rest, p, stn_allowed, "station");
-    json_decref(rest);
+    /* material keys get their own message (stn_station_keys) */
+    field_check_keys_but(v, st, p, stn_allowed, stn_material, "station");
     stn_station_keys(v, st, p, all);
     if (stn_s(v, st, p, j, n, prev))
         s = *prev;

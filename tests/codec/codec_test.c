@@ -9,7 +9,9 @@
  *       codec_model_new (topology errors come from the core).  Every entry
  *       of "errors" ({"pointer" or "pointer_prefix", "contains"}) must match
  *       one reported error; optional "status" is the HTTP status (400, 413,
- *       422) and "limits" overrides codec_limits fields.
+ *       422), "limits" overrides codec_limits fields and "error_count" is how many
+ *       errors the request has in all (none beyond those listed, e.g. a key that has its own
+ *       message not also reported as unknown).
  *   request.json + checks.json  a valid request; checks: canonical_contains,
  *       canonical_text and sha256 (exact: pins of the canonical form),
  *       same_sha_as / different_sha_from (other files of the folder),
@@ -223,6 +225,10 @@ static void run_invalid(test_case *tc, const char *dir, const json_t *exp)
             free(want);
         }
     }
+    const json_t *count = json_object_get(exp, "error_count");
+    if (count && codec_errors_count(errs) != (int)json_integer_value(count))
+        fail(tc, "%d errors reported, expected %d", codec_errors_count(errs),
+             (int)json_integer_value(count));
     for (i = 0; i < codec_errors_count(errs); i++)
         if (!pointer_ok(codec_errors_pointer(errs, i)))
             fail(tc, "malformed pointer '%s'", codec_errors_pointer(errs, i));
