@@ -639,6 +639,9 @@ int codec_sha256_accelerated(void);
  *  leading zeros in the exponent), the same bytes, ~10 times faster.  buf: CODEC_NUMTEXT_MAX
  *  chars.  Returns the length. */
 int codec_numtext(char *buf, double x, int json);
+/** 1 when codec_numtext writes x itself, 0 when it asks snprintf (a near-tie, a subnormal, a
+ *  value that is not finite, or no 128-bit integers): numtext_test checks how seldom. */
+int codec_numtext_direct(double x);
 
 /** A placeholder for codec_json_dump_rows: the empty array `at` of a tree stands for the n rows
  *  of dof reals each at v (row-major), written [[v0, ..., v(dof-1)], ...] as the array of

@@ -6,10 +6,13 @@
  *     and beyond it);
  *  3. values near ties and edges: the first, a random and the last double of every binary
  *     exponent; m 2^k for small odd m and k = -200..200 (finite binary
- *     fractions: their exact decimals end in 5), 10^k and its neighbours, integers around
+ *     fractions: their exact decimals end in 5), 10^k and its neighbours in every decade of the
+ *     normal doubles (and random values of each, which codec_numtext must write without
+ *     snprintf: every power of ten of its table in use), integers around
  *     10^16 and 10^17, numbers whose 17-digit rounding carries into a new decade
  *     (9.99999999999999999e k), 0, -0, the largest and smallest doubles;
- *  4. the numbers of a solved result: frequencies, shape components, eigenvalues;
+ *  4. the numbers of a solved result: frequencies, shape components, eigenvalues (all of them
+ *     written without snprintf; of all normal values checked at least 99 %);
  * and codec_json_dump / codec_json_dumps_sorted (jsontext.c) against jansson's own compact
  * dump, with and without JSON_SORT_KEYS, on 3 000 random documents (nested objects and arrays,
  * keys and strings with quotes, backslashes, control characters and UTF-8, reals, integers).
@@ -25,6 +28,7 @@
 #include "xorshift.h"
 
 static long checked, failures;
+static long normals, direct; /* normal values checked, and how many codec_numtext wrote itself */
 
 static uint64_t rng = 0x9E3779B97F4A7C15ULL;
 
@@ -40,6 +44,10 @@ static void check(double x, int with_jansson)
     if (!isfinite(x))
         return;
     checked++;
+    if (isnormal(x)) {
+        normals++;
+        direct += codec_numtext_direct(x);
+    }
     snprintf(want, sizeof want, "%.17g", x);
     int n = codec_numtext(got, x, 0);
     if (n != (int)strlen(want) || strcmp(got, want)) {
@@ -161,8 +169,8 @@ int main(void)
     for (int k = -200; k <= 200; k++)
         for (int m = 1; m < 2000; m += 2)
             check(ldexp((double)m, k), m < 200);
-    for (int k = -44; k <= 74; k++) {
-        double p = pow(10.0, k);
+    for (int k = -307; k <= 308; k++) { /* every decade of the normal doubles */
+        double p = k < 0 ? 1.0 / pow(10.0, -k) : pow(10.0, k);
         double x = p;
         for (int s = 0; s < 40; s++) {
             check(x, 1);
@@ -173,9 +181,22 @@ int main(void)
             check(x, 1);
             x = nextafter(x, 0);
         }
-        check(9.99999999999999999 * p, 1);
-        check(9.9999999999999995 * p, 1);
+        if (k < 308) {
+            check(9.99999999999999999 * p, 1);
+            check(9.9999999999999995 * p, 1);
+        }
         check(1.00000000000000005 * p, 1);
+        /* random values of the decade: each power of ten of the table in use.  None is near a
+         * tie, except in 1e14..1e16, where a double has 2 or 3 binary digits after the point
+         * (so 18 significant decimals, the last one 5, for every other value of 1e15) */
+        for (int r = 0; r < 4 && (k < 14 || k > 15); r++) {
+            double y = p * (1 + 8.9 * (double)(next_u64() >> 11) / 9007199254740992.0);
+            check(y, 0);
+            if (isfinite(y) && !codec_numtext_direct(y)) {
+                failures++;
+                printf("FAIL %a (decade %d) went to snprintf\n", y, k);
+            }
+        }
     }
     /* every binary exponent: its first double, a random one and its last (the exponent and
      * the decimal exponent's first guess come from the bits, numtext_digits), either sign */
@@ -218,7 +239,27 @@ int main(void)
         check((2 * v - 1) * pow(10.0, -18 * u), i % 4 == 0); /* shape components */
         check(-1e-3 * u * v, i % 4 == 0);                    /* small real parts */
     }
+    /* the result-like numbers of 4. never near a tie: all written without snprintf */
+    long before = direct, of = normals;
+    for (int i = 0; i < 20000; i++) {
+        double u = (double)(next_u64() >> 11) / 9007199254740992.0;
+        double v = (double)(next_u64() >> 11) / 9007199254740992.0;
+        check(1 + 500 * u, 0);
+        check((2 * v - 1) * pow(10.0, -18 * u), 0);
+    }
+    if (direct - before != normals - of) {
+        failures++;
+        printf("FAIL %ld of %ld result-like values went to snprintf\n",
+               (normals - of) - (direct - before), normals - of);
+    }
     check_documents(3000);
-    printf("numtext: %ld values and documents, %ld failures\n", checked, failures);
+    /* snprintf only near ties (binary fractions with few digits, section 3): ~0.5 % here */
+    if (!(direct >= 0.99 * normals)) {
+        failures++;
+        printf("FAIL only %ld of %ld normal values written without snprintf\n", direct, normals);
+    }
+    printf("numtext: %ld values and documents, %ld failures; %ld of %ld normal values without "
+           "snprintf\n",
+           checked, failures, direct, normals);
     return failures ? 1 : 0;
 }
