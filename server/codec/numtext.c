@@ -15,7 +15,6 @@
  */
 #include "codec_internal.h"
 
-#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -34,8 +33,9 @@ static const char numtext_pairs[201] = "0001020304050607080910111213141516171819
 
 /* N = m 2^q 10^p with the table's c 2^b for 10^p (numtext_pow10.h): the product P = m c is
  * exact in 192 bits and N = P / 2^s, s = -(q + b).  *N receives floor(P / 2^s), *R the bits of P
- * below (the fraction, out of 2^s), *s s.  0 when p is outside the table or floor(N) would not
- * have 54 to 63 bits below it (N between 2^50 and 2^63 or so: not the scale wanted). */
+ * below (the fraction, out of 2^s), *s s.  0 when p is outside the table or s - 64 is outside
+ * 54..63 (then floor(N) would not fit 64 bits, or the fraction 127: N is far from 10^16..10^17,
+ * not the scale wanted). */
 static int numtext_scale(uint64_t m, int q, int p, uint64_t *N, numtext_u128 *R, int *s)
 {
     if (p < NUMTEXT_P_MIN || p > NUMTEXT_P_MAX)
