@@ -116,35 +116,53 @@ static int jt_rows(jt_out *o, const json_t *x)
     return 1;
 }
 
-static int jt_key_cmp(const void *a, const void *b)
+/* A member of an object being written with its keys sorted. */
+typedef struct jt_member {
+    const char *key;
+    const json_t *v;
+} jt_member;
+
+static int jt_member_cmp(const void *a, const void *b)
 {
-    return strcmp(*(const char *const *)a, *(const char *const *)b);
+    return strcmp(((const jt_member *)a)->key, ((const jt_member *)b)->key);
 }
 
-/* An object with its keys sorted (jansson: the keys gathered, qsort by strcmp). */
+/* An object with its keys sorted by strcmp, as jansson's JSON_SORT_KEYS writes it.  Objects of
+ * up to JT_SMALL members (every object of a request but the big tables) are sorted on the stack
+ * by insertion (the keys are distinct: any correct sort gives the same order), their values taken
+ * with their keys instead of looked up again (issue 27: the canonical text of every request). */
+#define JT_SMALL 32
 static void jt_sorted(jt_out *o, const json_t *x)
 {
     size_t n = json_object_size(x), i = 0;
-    const char **keys = malloc((n ? n : 1) * sizeof *keys);
+    jt_member small[JT_SMALL], *mem = n <= JT_SMALL ? small : malloc(n * sizeof *mem);
     const char *key;
     json_t *v;
-    if (!keys) {
+    if (!mem) {
         o->err = 1;
         return;
     }
-    json_object_foreach((json_t *)x, key, v)
-        keys[i++] = key;
-    qsort(keys, n, sizeof *keys, jt_key_cmp);
+    json_object_foreach((json_t *)x, key, v) {
+        jt_member t = {key, v};
+        size_t j = i++;
+        if (n <= JT_SMALL) /* insertion */
+            for (; j > 0 && strcmp(mem[j - 1].key, key) > 0; j--)
+                mem[j] = mem[j - 1];
+        mem[j] = t;
+    }
+    if (n > JT_SMALL)
+        qsort(mem, n, sizeof *mem, jt_member_cmp);
     jt_put(o, "{", 1);
     for (i = 0; i < n; i++) {
         if (i > 0)
             jt_put(o, ",", 1);
-        jt_string(o, keys[i], strlen(keys[i]));
+        jt_string(o, mem[i].key, strlen(mem[i].key));
         jt_put(o, ":", 1);
-        jt_value(o, json_object_get(x, keys[i]));
+        jt_value(o, mem[i].v);
     }
     jt_put(o, "}", 1);
-    free(keys);
+    if (mem != small)
+        free(mem);
 }
 
 static void jt_value(jt_out *o, const json_t *x)
