@@ -199,7 +199,7 @@ static int field_integer(const json_t *x, long lo, long hi, long *out)
  * else which of the messages field_real_report writes (*out then x's number, if any). */
 enum {
     FIELD_REAL_OK,
-    FIELD_REAL_NAN,
+    FIELD_REAL_NOT_NUMBER,
     FIELD_REAL_INF,
     FIELD_REAL_SUBNORMAL,
     FIELD_REAL_POS,
@@ -210,7 +210,7 @@ static int field_real_fault(const json_t *x, enum field_real_kind kind, double *
     double d = 0;
 
     if (!field_number(x, &d))
-        return FIELD_REAL_NAN;
+        return FIELD_REAL_NOT_NUMBER;
     *out = d;
     if (!isfinite(d))
         return FIELD_REAL_INF;
@@ -230,7 +230,7 @@ static void field_real_report(val_ctx *v, const char *ptr, int fault, const json
                               const char *unit)
 {
     switch (fault) {
-    case FIELD_REAL_NAN:
+    case FIELD_REAL_NOT_NUMBER:
         field_error(v, ptr, "must be a number%s, not %s", unit, field_type_name(x));
         break;
     case FIELD_REAL_INF:
