@@ -670,6 +670,13 @@ char *codec_json_dumps_sorted(const json_t *x);
  *  JSON_REJECT_DUPLICATES, out of memory) or where jansson would refuse the text. */
 json_t *codec_json_fast(const char *text, size_t len, size_t flags);
 
+/** The real of the number token s (n bytes, JSON's grammar) as strtod gives it, without strtod:
+ *  1 when the token has at most 19 significant digits, their integer w <= 2^53 and the decimal
+ *  exponent p in -22..22 (w and 10^|p| exact doubles, so w * 10^p or w / 10^-p is rounded once,
+ *  to strtod's correctly rounded value; Clinger 1990), or w = 0; else 0 (the caller asks
+ *  strtod).  jsonread_test checks its bits against strtod's. */
+int codec_json_real_fast(const char *s, size_t n, double *out);
+
 /** json_loadb(text, len, flags, error): codec_json_fast's tree, or jansson's own answer (tree,
  *  or NULL with its error) where the fast reader gives up. */
 json_t *codec_json_loadb(const char *text, size_t len, size_t flags, json_error_t *error);

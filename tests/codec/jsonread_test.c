@@ -9,7 +9,10 @@
  *     past the fast reader's depth and past jansson's, text after the value, a byte order mark;
  *  3. 2 000 random documents (nested objects and arrays, integers, reals in several printf
  *     forms, strings with escapes, random whitespace), every one of which must take the fast
- *     path, and 40 000 single-byte mutations of them (replaced, deleted, inserted).
+ *     path, and 40 000 single-byte mutations of them (replaced, deleted, inserted);
+ *  4. codec_json_real_fast (reals without strtod) against strtod, bit for bit, on 500 000
+ *     tokens in and around its range (2^53, 10^+-22, 19 digits, leading zeros, signs), and
+ *     that it answers exactly inside that range.
  * Wherever the fast reader gives a tree, jansson must give the same one (json_same.h: reals by
  * bits, members in order); codec_json_loadb must give jansson's tree, or NULL with jansson's
  * error (text, line, column, position).
@@ -27,6 +30,15 @@
 #include "json_same.h"
 
 static long checked, fast_taken, failures;
+
+/* 10^k, 0 <= k <= 22, exactly */
+static double jr_test_pow10(int k)
+{
+    double x = 1;
+    while (k-- > 0)
+        x *= 10;
+    return x;
+}
 
 static uint64_t rng = 0x2545F4914F6CDD1DULL;
 
@@ -226,6 +238,102 @@ static void gen_value(gen *g, int depth)
     ws(g);
 }
 
+/* ---- 4. reals without strtod ---- */
+
+static long reals_checked, reals_taken;
+
+/* tok through codec_json_real_fast: its bits must be strtod's wherever it answers, and it must
+ * answer exactly when `expect` says (Clinger's range: the integer w of all the digits written,
+ * trailing zeros too, <= 2^53 and exponent -22..22: "9007199254740992.0" is w = 2^53 * 10). */
+static void check_real(const char *tok, int expect)
+{
+    double got = 0, ref = strtod(tok, NULL);
+    int took = codec_json_real_fast(tok, strlen(tok), &got);
+    reals_checked++;
+    reals_taken += took;
+    if (took && memcmp(&got, &ref, sizeof got))
+        show("codec_json_real_fast differs from strtod", tok, strlen(tok));
+    if (took != expect)
+        show(took ? "codec_json_real_fast answered outside its range"
+                  : "codec_json_real_fast gave up inside its range",
+             tok, strlen(tok));
+}
+
+/* A token of the digits of w with the point after `point` of them (0: "0." first, with `zeros`
+ * zeros after the point; ndig: no point) and exponent ex (written when write_ex), and whether
+ * codec_json_real_fast must take it. */
+static void check_real_parts(uint64_t w, int neg, int point, int zeros, int ex, int write_ex)
+{
+    char dig[24], tok[96];
+    int nd = snprintf(dig, sizeof dig, "%llu", (unsigned long long)w), n = 0, frac = 0;
+    if (neg)
+        tok[n++] = '-';
+    if (point <= 0) {
+        n += snprintf(tok + n, sizeof tok - (size_t)n, "0.%.*s%s", zeros, "0000000000", dig);
+        frac = zeros + nd;
+    } else if (point >= nd) {
+        n += snprintf(tok + n, sizeof tok - (size_t)n, "%s", dig);
+    } else {
+        n += snprintf(tok + n, sizeof tok - (size_t)n, "%.*s.%s", point, dig, dig + point);
+        frac = nd - point;
+    }
+    if (write_ex)
+        snprintf(tok + n, sizeof tok - (size_t)n, "e%+d", ex);
+    int p = (write_ex ? ex : 0) - frac;
+    check_real(tok, w == 0 || (w <= (1ULL << 53) && p >= -22 && p <= 22));
+}
+
+static void check_reals(void)
+{
+    static const char *edge[] = {
+        "0.0", "-0.0", "0e999", "-0.000e-5", "1e22", "1e23", "1e-22", "1e-23", "9007199254740992.0",
+        "9007199254740993.0", "9007199254740991e22", "9007199254740993e-22", "1.5E+3",
+        "12345678901234567890.0", "1234567890123456789.0", "1e0005", "1e99999", "0.1",
+        "0.30000000000000004", "2.2250738585072014e-308",
+        /* 2^64 + 1 and 2^64 + 2^32: wrapped in 64 bits, 1 and 2^32 */
+        "18446744073709551617", "0.18446744073709551617e3", "18446744078004518912e-20"};
+    static const int expect[] = {1, 1, 1, 1, 1, 0, 1, 0, 0, 0, 1, 0,
+                                 1, 0, 0, 1, 0, 1, 0, 0, 0, 0, 0};
+    for (size_t i = 0; i < sizeof edge / sizeof *edge; i++)
+        check_real(edge[i], expect[i]);
+    for (int i = 0; i < 400000; i++) {
+        uint64_t w;
+        switch (next_u64() % 4) {
+        case 0: /* around 2^53 */
+            w = (1ULL << 53) - 4 + next_u64() % 9;
+            break;
+        case 1: /* up to 19 digits */
+            w = next_u64() % 10000000000000000000ULL;
+            break;
+        default: /* 1 to 16 digits, as requests write them */
+            w = next_u64() % (uint64_t)jr_test_pow10(1 + (int)(next_u64() % 16));
+            break;
+        }
+        int nd = snprintf(NULL, 0, "%llu", (unsigned long long)w);
+        check_real_parts(w, (int)(next_u64() % 2), (int)(next_u64() % (unsigned)(nd + 2)),
+                         (int)(next_u64() % 4), (int)(next_u64() % 61) - 30,
+                         (int)(next_u64() % 3 == 0));
+    }
+    /* requests' reals: %.15g of random doubles near 1e-6 .. 1e12 must all be taken */
+    for (int i = 0; i < 100000; i++) {
+        char tok[40];
+        double x = (double)(next_u64() >> 11) / (double)(1ULL << 53) *
+                   jr_test_pow10((int)(next_u64() % 19)) * 1e-6;
+        snprintf(tok, sizeof tok, "%.15g", x);
+        if (!strchr(tok, 'e'))
+            check_real(tok, 1);
+        else
+            check_real(tok, codec_json_real_fast(tok, strlen(tok), &x));
+    }
+    /* and through the reader: the tree must be jansson's */
+    for (int i = 0; i < 2000; i++) {
+        char doc[64];
+        snprintf(doc, sizeof doc, "[%.*g]", 1 + (int)(next_u64() % 17),
+                 (double)(int64_t)next_u64() / jr_test_pow10((int)(next_u64() % 23)));
+        check_str(doc);
+    }
+}
+
 int main(int argc, char **argv)
 {
     /* 1. files: the first folder's must all be fast */
@@ -392,8 +500,11 @@ int main(int argc, char **argv)
                 random_docs);
         failures++;
     }
+    /* 4. reals without strtod */
+    check_reals();
     printf("jsonread: %ld texts checked against json_loadb (x2 flags), %ld read by the fast "
-           "reader, %d files, %ld random documents; %ld failures\n",
-           checked / 2, fast_taken, files_seen, random_docs, failures);
+           "reader, %d files, %ld random documents; %ld reals against strtod, %ld of them "
+           "without it; %ld failures\n",
+           checked / 2, fast_taken, files_seen, random_docs, reals_checked, reals_taken, failures);
     return failures ? 1 : 0;
 }
