@@ -42,10 +42,11 @@ typedef struct plaus_member {
     double rout;             /* larger distance of its two ends from the spin axis, m */
     double q[PQ_N];          /* span means: mu (kg/m), EA (N), EI_flap, EI_edge (N m^2);
                                 EI_edge NAN for a planar member */
-    char *ptr[PQ_N];         /* pointer of the request field behind each (malloc'd), or NULL */
-    const char *field[PQ_N]; /* its name ("E" for EA of a material section, "I" ...) */
+    const char *field[PQ_N]; /* the request field behind each ("E" for EA of a material
+                                section, "I" ...), or NULL: none, no check */
+    unsigned at_station;     /* bit q: field[q] is the stations' (else the section's) */
+    const char *sname;       /* the member's section */
     int ea_stand_in;         /* EA is the section's, marked in its "stand_ins" (section.c) */
-    char name[96];           /* "member 3 ('arm')" or "the blade", for messages */
 } plaus_member;
 
 /* The whole request as the checks see it. */
@@ -162,18 +163,52 @@ static const char *plaus_section_field(sec_form f, int q)
     return (f == SEC_PLANAR ? planar : f == SEC_MATERIAL ? material : stiffness)[q];
 }
 
-/* The span means of member i and the pointers of their fields into *pm (pointers NULL on
- * NOMEM: w->nomem set). */
+/* The station keys of the span-mean quantities. */
+static const char *const plaus_station_key[PQ_N] = {"mass_per_length", "EA", "EI_flap", "EI_edge"};
+
+/* The pointer of the field behind quantity q of member pm (pm->field[q] not NULL), malloc'd;
+ * NULL on NOMEM (w->nomem set).  Written only for a warning (issue 27: writing four for every
+ * member, twice, was a tenth of a blade request's parse). */
+static char *plaus_ptr(plaus_ctx *c, const plaus_member *pm, int q)
+{
+    char *p, *base;
+
+    if (pm->at_station & (1u << q)) {
+        p = err_fmt("/structure/members/%zu/stations/0/%s", pm->i, plaus_station_key[q]);
+    } else {
+        base = err_ptr_key("/structure/sections", pm->sname);
+        p = base ? err_ptr_key(base, pm->field[q]) : NULL;
+        free(base);
+    }
+    if (!p)
+        c->w->nomem = 1;
+    return p;
+}
+
+/* "member 3 ('arm')" or "the blade", for messages, into name (96 chars). */
+static const char *plaus_name(const plaus_ctx *c, const plaus_member *pm, char name[96])
+{
+    const json_t *id;
+
+    if (c->w->blade) {
+        snprintf(name, 96, "the %s", c->w->blade == CODEC_FORM_TOWER ? "tower" : "blade");
+        return name;
+    }
+    id = json_object_get(json_array_get(json_object_get(req_structure(c->r), "members"), pm->i),
+                         "id");
+    snprintf(name, 96, "member %zu%s%.60s%s", pm->i, id ? " ('" : "",
+             id ? json_string_value(id) : "", id ? "')" : "");
+    return name;
+}
+
+/* The span means of member i and the fields behind them into *pm. */
 static void plaus_member_fill(plaus_ctx *c, size_t i, plaus_member *pm)
 {
     static const unsigned bit[PQ_N] = {SM_ST_MU, SM_ST_EA, SM_ST_EI_FLAP, SM_ST_EI_EDGE};
-    static const char *const station_key[PQ_N] = {"mass_per_length", "EA", "EI_flap", "EI_edge"};
     const sm_member *m = &c->st->members[i];
     const sm_section *s = &c->st->sections[m->section];
     const char *sname = req_section_name(c->r, m->section);
     const json_t *sec = json_object_get(json_object_get(req_structure(c->r), "sections"), sname);
-    const json_t *id = json_object_get(json_array_get(json_object_get(req_structure(c->r),
-                                                                      "members"), i), "id");
     sec_form f = sec_classify_as(sec, c->st->spatial);
     const json_t *x;
     double a[3], b[3];
@@ -192,40 +227,21 @@ static void plaus_member_fill(plaus_ctx *c, size_t i, plaus_member *pm)
     pm->q[PQ_EA] = c->st->spatial ? s->EA : s->E * s->A;
     pm->q[PQ_EI_FLAP] = c->st->spatial ? s->EI_flap : s->E * s->I;
     pm->q[PQ_EI_EDGE] = c->st->spatial ? s->EI_edge : NAN;
-    if (c->w->blade)
-        snprintf(pm->name, sizeof(pm->name), "the %s",
-                 c->w->blade == CODEC_FORM_TOWER ? "tower" : "blade");
-    else
-        snprintf(pm->name, sizeof(pm->name), "member %zu%s%.60s%s", i, id ? " ('" : "",
-                 id ? json_string_value(id) : "", id ? "')" : "");
+    pm->sname = sname;
     for (q = 0; q < PQ_N; q++) {
-        char *base;
         if (m->n_stations && (m->station_mask & bit[q])) {
             pm->q[q] = plaus_station_mean(m, q);
-            pm->field[q] = station_key[q];
-            pm->ptr[q] = err_fmt("/structure/members/%zu/stations/0/%s", i, station_key[q]);
-        } else if ((pm->field[q] = plaus_section_field(f, q))) {
-            base = err_ptr_key("/structure/sections", sname);
-            pm->ptr[q] = base ? err_ptr_key(base, pm->field[q]) : NULL;
-            free(base);
+            pm->field[q] = plaus_station_key[q];
+            pm->at_station |= 1u << q;
+        } else {
+            pm->field[q] = plaus_section_field(f, q);
         }
-        if (pm->field[q] && !pm->ptr[q])
-            c->w->nomem = 1;
     }
     if (!(m->n_stations && (m->station_mask & SM_ST_EA)))
         json_array_foreach(json_object_get(sec, "stand_ins"), k, x) {
             const char *name = json_string_value(x);
             pm->ea_stand_in |= name && !strcmp(name, "EA");
         }
-}
-
-/* Free the pointers of *pm. */
-static void plaus_member_done(plaus_member *pm)
-{
-    int q;
-
-    for (q = 0; q < PQ_N; q++)
-        free(pm->ptr[q]);
 }
 
 /* The pointer of a length: the blade's length, else joint j.  malloc'd; NULL on NOMEM. */
@@ -246,7 +262,7 @@ static int plaus_wave_speed(plaus_ctx *c, const plaus_member *pm, int ei_hi)
 {
     const warn_rule *r = &warn_rules[WARN_WAVE_SPEED];
     double cs = sqrt(pm->q[PQ_EA] / pm->q[PQ_MU]);
-    char slip[160], alt[224] = "", ea[96], b1[32], b2[32], note[96] = "";
+    char slip[160], alt[224] = "", ea[96], b1[32], b2[32], note[96] = "", name[96], *ptr;
     int on_ea, k;
 
     if (!(pm->q[PQ_MU] > 0 && pm->q[PQ_EA] > 0) || plaus_in(cs, r))
@@ -262,10 +278,13 @@ static int plaus_wave_speed(plaus_ctx *c, const plaus_member *pm, int ei_hi)
     else if (k > 0)
         snprintf(alt, sizeof(alt), " (or every stiffness /1e%d, as %s)", k,
                  plaus_slip_text(ea, sizeof(ea), "EA", -k));
-    warn_add(c->w, pm->ptr[on_ea ? PQ_EA : PQ_MU],
+    if (!(ptr = plaus_ptr(c, pm, on_ea ? PQ_EA : PQ_MU)))
+        return on_ea;
+    warn_add(c->w, ptr,
              "the axial wave speed sqrt(EA / mass_per_length) of %s is %.4g m/s, outside %s to "
              "%s m/s (any structural material; span means%s): likely slip: %s%s",
-             pm->name, cs, warn_g(b1, r->lo), warn_g(b2, r->hi), note, slip, alt);
+             plaus_name(c, pm, name), cs, warn_g(b1, r->lo), warn_g(b2, r->hi), note, slip, alt);
+    free(ptr);
     return on_ea;
 }
 
@@ -281,7 +300,7 @@ static void plaus_gyration(plaus_ctx *c, const plaus_member *pm, int q)
     double rg = sqrt(pm->q[q] / pm->q[PQ_EA]), lo = rg / pm->len, hi = rg / pm->beam;
     double x = hi > r->hi ? hi : lo, len = hi > r->hi ? pm->beam : pm->len;
     const char *what = q == PQ_EI_FLAP ? (c->st->spatial ? "EI_flap" : "EI") : "EI_edge";
-    char slip[160], b1[32], b2[32], *lp = NULL;
+    char slip[160], b1[32], b2[32], name[96], *lp;
 
     if (!(pm->q[q] > 0 && pm->q[PQ_EA] > 0 && pm->len > 0) || (!(lo < r->lo) && !(hi > r->hi)))
         return;
@@ -294,10 +313,13 @@ static void plaus_gyration(plaus_ctx *c, const plaus_member *pm, int q)
         plaus_slip_text(slip, sizeof(slip), "length", 3);
     } else {
         plaus_slip_text(slip, sizeof(slip), pm->field[q], plaus_slip(x, r, 0.5));
+        if (!(lp = plaus_ptr(c, pm, q)))
+            return;
     }
-    warn_add(c->w, lp ? lp : pm->ptr[q],
+    warn_add(c->w, lp,
              "the radius of gyration sqrt(%s / EA) of %s is %.4g m, %.3g times %s %.6g m, "
-             "outside %s to %s times (span means): likely slip: %s", what, pm->name, rg, x,
+             "outside %s to %s times (span means): likely slip: %s",
+             what, plaus_name(c, pm, name), rg, x,
              len > pm->len ? "the length of the beam it lies in," : "its length", len,
              warn_g(b1, r->lo), warn_g(b2, r->hi), slip);
     free(lp);
@@ -315,24 +337,27 @@ static int plaus_stand_in_wave(plaus_ctx *c, const plaus_member *pm)
 {
     const warn_rule *r = &warn_rules[WARN_WAVE_SPEED];
     double rg = warn_rules[WARN_GYRATION].typical * pm->len;
-    char slip[160], b1[32], b2[32];
+    char slip[160], b1[32], b2[32], name[96], *ptr;
     int q, slow = 0, warned = 0;
 
     for (q = PQ_EI_FLAP; q <= PQ_EI_EDGE && rg > 0 && pm->q[PQ_MU] > 0; q++) {
         double cs = sqrt(pm->q[q] / (rg * rg) / pm->q[PQ_MU]);
-        if (!(pm->q[q] > 0) || !pm->ptr[q] || plaus_in(cs, r))
+        if (!(pm->q[q] > 0) || !pm->field[q] || plaus_in(cs, r))
             continue;
         if (cs < r->lo) {
             slow = q;
             continue;
         }
         plaus_slip_text(slip, sizeof(slip), pm->field[q], plaus_slip(cs, r, 0.5));
-        warn_add(c->w, pm->ptr[q],
+        if (!(ptr = plaus_ptr(c, pm, q)))
+            return 1;
+        warn_add(c->w, ptr,
                  "the axial wave speed of %s, its stand-in EA read as %s / (%g x length)^2, is "
                  "%.4g m/s, outside %s to %s m/s (any structural material; span means): likely "
                  "slip: %s",
-                 pm->name, pm->field[q], warn_rules[WARN_GYRATION].typical, cs, warn_g(b1, r->lo),
-                 warn_g(b2, r->hi), slip);
+                 plaus_name(c, pm, name), pm->field[q], warn_rules[WARN_GYRATION].typical, cs,
+                 warn_g(b1, r->lo), warn_g(b2, r->hi), slip);
+        free(ptr);
         warned = 1;
     }
     if (slow && !warned) {
@@ -350,7 +375,7 @@ static int plaus_member_groups(plaus_ctx *c, const plaus_member *pm)
     const warn_rule *g = &warn_rules[WARN_GYRATION];
     int q, ei_hi = 0, on_ea;
 
-    if (!pm->ptr[PQ_MU] || !pm->ptr[PQ_EA])
+    if (!pm->field[PQ_MU] || !pm->field[PQ_EA])
         return 0;
     if (pm->ea_stand_in)
         return plaus_stand_in_wave(c, pm);
@@ -360,7 +385,7 @@ static int plaus_member_groups(plaus_ctx *c, const plaus_member *pm)
     on_ea = plaus_wave_speed(c, pm, ei_hi);
     if (!on_ea)
         for (q = PQ_EI_FLAP; q <= PQ_EI_EDGE; q++)
-            if (pm->ptr[q])
+            if (pm->field[q])
                 plaus_gyration(c, pm, q);
     return on_ea || !plaus_in(sqrt(pm->q[PQ_EA] / pm->q[PQ_MU]), &warn_rules[WARN_WAVE_SPEED]);
 }
@@ -436,18 +461,21 @@ static void plaus_strain(plaus_ctx *c, const plaus_member *pm)
 {
     const warn_rule *r = &warn_rules[WARN_STRAIN];
     double e = pm->q[PQ_MU] * c->omax * c->omax * pm->rout * pm->rout / pm->q[PQ_EA];
-    char slip[160], alt[128] = "", ea[96], b[32];
+    char slip[160], alt[128] = "", ea[96], b[32], name[96], *ptr;
     int k = plaus_slip(e, r, 1.0);
 
-    if (!(pm->q[PQ_EA] > 0) || !pm->ptr[PQ_MU] || pm->ea_stand_in || plaus_in(e, r))
+    if (!(pm->q[PQ_EA] > 0) || !pm->field[PQ_MU] || pm->ea_stand_in || plaus_in(e, r) ||
+        !(ptr = plaus_ptr(c, pm, PQ_MU)))
         return;
     plaus_slip_text(slip, sizeof(slip), pm->field[PQ_MU], k);
     if (k > 0)
         snprintf(alt, sizeof(alt), ", or %s", plaus_slip_text(ea, sizeof(ea), "EA", -k));
-    warn_add(c->w, pm->ptr[PQ_MU], "the centrifugal strain mass_per_length Omega^2 R^2 / EA of "
+    warn_add(c->w, ptr,
+             "the centrifugal strain mass_per_length Omega^2 R^2 / EA of "
              "%s is %.3g at %g rad/s (R %.4g m; span means), above %s: no structure stretches "
-             "so far: likely slip: %s%s", pm->name, e, c->omax, pm->rout, warn_g(b, r->hi), slip,
-             alt);
+             "so far: likely slip: %s%s",
+             plaus_name(c, pm, name), e, c->omax, pm->rout, warn_g(b, r->hi), slip, alt);
+    free(ptr);
 }
 
 /* Root of member i in the union-find forest up (path halving). */
@@ -566,17 +594,14 @@ void plaus_check(warn_list *w, const codec_request *r)
     plaus_radius_check(&c);
     for (i = 0; i < c.st->n_members && !w->nomem; i++) {
         plaus_member_fill(&c, (size_t)i, &pm);
-        if (!w->nomem)
-            quiet[i] = (unsigned char)plaus_member_groups(&c, &pm);
-        plaus_member_done(&pm);
+        quiet[i] = (unsigned char)plaus_member_groups(&c, &pm);
     }
     if (!w->nomem && c.omax * c.rmax > warn_rules[WARN_TIP_SPEED].hi)
         plaus_tip_speed(&c);
     for (i = 0; i < c.st->n_members && !w->nomem && !c.tip_warned && c.omax > 0; i++) {
         plaus_member_fill(&c, (size_t)i, &pm);
-        if (!w->nomem && !quiet[i])
+        if (!quiet[i])
             plaus_strain(&c, &pm);
-        plaus_member_done(&pm);
     }
     free(quiet);
     free(c.beam);
