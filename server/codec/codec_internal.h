@@ -162,6 +162,9 @@ int field_check_real(val_ctx *v, const json_t *x, const char *ptr, enum field_re
  */
 int field_real(val_ctx *v, const json_t *obj, const char *key, const char *base,
                json_t *canon, enum field_real_kind kind, const char *unit, double *out);
+/** field_real of the value x (NULL: missing) that obj[key] holds. */
+int field_real_at(val_ctx *v, const json_t *x, const char *key, const char *base, json_t *canon,
+                  enum field_real_kind kind, const char *unit, double *out);
 
 /**
  * Integer field obj[key] in [lo, hi]; when limit_name is set, a value over
@@ -179,6 +182,9 @@ int field_int(val_ctx *v, const json_t *obj, const char *key, const char *base,
  */
 int field_vector(val_ctx *v, const json_t *obj, const char *key, const char *base, int n,
                  enum field_real_kind kind, const char *shape, const char *unit, double *out);
+/** field_vector of the value x (NULL: missing) that obj[key] holds. */
+int field_vector_at(val_ctx *v, const json_t *x, const char *key, const char *base, int n,
+                    enum field_real_kind kind, const char *shape, const char *unit, double *out);
 
 /** A new JSON array of the n reals x, or NULL when out of memory. */
 json_t *field_reals(const double *x, int n);

@@ -109,14 +109,15 @@ void field_error_key(val_ctx *v, const char *base, const char *key, const char *
     free(p);
 }
 
-/* Set canon[key] = value (stolen); records NOMEM. */
+/* Set canon[key] = value (stolen); records NOMEM.  key is one of the program's names or a key
+ * of the request (which its parse has checked as UTF-8), so jansson need not check it again. */
 void field_set(val_ctx *v, json_t *canon, const char *key, json_t *value)
 {
     if (!canon) {
         json_decref(value);
         return;
     }
-    if (json_object_set_new(canon, key, value))
+    if (json_object_set_new_nocheck(canon, key, value))
         v->nomem = 1;
 }
 
@@ -269,7 +270,12 @@ int field_check_real(val_ctx *v, const json_t *x, const char *ptr, enum field_re
 int field_real(val_ctx *v, const json_t *obj, const char *key, const char *base,
                json_t *canon, enum field_real_kind kind, const char *unit, double *out)
 {
-    const json_t *x = json_object_get(obj, key);
+    return field_real_at(v, json_object_get(obj, key), key, base, canon, kind, unit, out);
+}
+
+int field_real_at(val_ctx *v, const json_t *x, const char *key, const char *base, json_t *canon,
+                  enum field_real_kind kind, const char *unit, double *out)
+{
     double d = 0;
     int fault;
 
@@ -425,12 +431,24 @@ const char *field_ref(val_ctx *v, const json_t *obj, const char *key, const char
 int field_vector(val_ctx *v, const json_t *obj, const char *key, const char *base, int n,
                  enum field_real_kind kind, const char *shape, const char *unit, double *out)
 {
-    const json_t *x = json_object_get(obj, key);
-    char *p = err_ptr_key(base, key);
+    return field_vector_at(v, json_object_get(obj, key), key, base, n, kind, shape, unit, out);
+}
+
+int field_vector_at(val_ctx *v, const json_t *x, const char *key, const char *base, int n,
+                    enum field_real_kind kind, const char *shape, const char *unit, double *out)
+{
+    char *p;
     size_t k;
     int ok = 1;
 
-    if (!p) {
+    if (json_is_array(x) && json_array_size(x) == (size_t)n) { /* valid: no pointers written */
+        for (k = 0; k < (size_t)n && ok; k++)
+            ok = !field_real_fault(json_array_get(x, k), kind, &out[k]);
+        if (ok)
+            return 1;
+        ok = 1;
+    }
+    if (!(p = err_ptr_key(base, key))) {
         v->nomem = 1;
         return 0;
     }

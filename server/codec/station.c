@@ -65,16 +65,55 @@ static const char *const stn_allowed[] = {
 /* Material-form keys: stations take the stiffness form only. */
 static const char *const stn_material[] = {"E", "G", "A", "I", "I_flap", "I_edge", "J", NULL};
 
+/* Index in stn_keys of the key (len bytes), STN_S for "s", STN_OTHER for any other key. */
+enum { STN_S = -1, STN_OTHER = -2 };
+static int stn_index(const char *key, size_t len)
+{
+    size_t k;
+
+    if (len == 1 && key[0] == 's')
+        return STN_S;
+    for (k = 0; k < STN_NKEYS; k++)
+        if (stn_keys[k].name[0] == key[0] && !strcmp(stn_keys[k].name, key))
+            return (int)k;
+    return STN_OTHER;
+}
+
+/* A station's values by key, from one walk over its members: no hash lookups (issue 27: a
+ * blade's request asked each station's table for each key some ten times over). */
+typedef struct stn_view {
+    const json_t *s;            /* "s", or NULL */
+    const json_t *v[STN_NKEYS]; /* stn_keys[k]'s value, or NULL */
+    unsigned mask;              /* bits of the keys present */
+    int other;                  /* some key is neither "s" nor a station key */
+} stn_view;
+
+static void stn_view_of(const json_t *st, stn_view *w)
+{
+    const char *key;
+    json_t *val;
+
+    memset(w, 0, sizeof(*w));
+    json_object_foreach((json_t *)st, key, val) {
+        int k = stn_index(key, strlen(key));
+        if (k == STN_S) {
+            w->s = val;
+        } else if (k == STN_OTHER) {
+            w->other = 1;
+        } else {
+            w->v[k] = val;
+            w->mask |= stn_keys[k].bit;
+        }
+    }
+}
+
 /* Mask of the station keys present in the object st (0 when not an object). */
 static unsigned stn_mask_of(const json_t *st)
 {
-    unsigned m = 0;
-    size_t k;
+    stn_view w;
 
-    for (k = 0; json_is_object(st) && k < STN_NKEYS; k++)
-        if (json_object_get(st, stn_keys[k].name))
-            m |= stn_keys[k].bit;
-    return m;
+    stn_view_of(st, &w); /* json_object_foreach: nothing for a value that is not an object */
+    return w.mask;
 }
 
 unsigned stn_keys_mask(const json_t *stations)
@@ -123,17 +162,18 @@ json_t *stn_cover(const json_t *members)
     return cover;
 }
 
-/* s of station j at p: a number in [0, 1], first 0, last 1, above the previous *prev. */
-static int stn_s(val_ctx *v, const json_t *st, const char *p, size_t j, size_t n, double *prev)
+/* s of station j at p (x its value, NULL when absent): a number in [0, 1], first 0, last 1,
+ * above the previous *prev. */
+static int stn_s(val_ctx *v, const json_t *x, const char *p, size_t j, size_t n, double *prev)
 {
     double s;
 
-    if (!json_object_get(st, "s")) {
+    if (!x) {
         field_error_key(v, p, "s", "required field 's' (the span fraction, 0 at the member's "
                         "'from' joint, 1 at 'to') is missing");
         return 0;
     }
-    if (!field_real(v, st, "s", p, NULL, FIELD_FINITE, "", &s))
+    if (!field_real_at(v, x, "s", p, NULL, FIELD_FINITE, "", &s))
         return 0;
     if (s < 0 || s > 1) {
         field_error_key(v, p, "s", "s = %g is outside [0, 1]: s is the span fraction (0 at "
@@ -160,18 +200,19 @@ static int stn_s(val_ctx *v, const json_t *st, const char *p, size_t j, size_t n
     return 1;
 }
 
-/* Keys of station st at p: unknown keys, the material form, and the keys of union missing. */
-static void stn_station_keys(val_ctx *v, const json_t *st, const char *p, unsigned all)
+/* Keys of station st (seen as w) at p: the material form, and the keys of union missing. */
+static void stn_station_keys(val_ctx *v, const json_t *st, const stn_view *w, const char *p,
+                             unsigned all)
 {
     size_t k;
 
-    for (k = 0; stn_material[k]; k++)
+    for (k = 0; w->other && stn_material[k]; k++)
         if (json_object_get(st, stn_material[k]))
             field_error_key(v, p, stn_material[k],
                             "stations give the stiffness form only: use EA, EI_flap, EI_edge, "
                             "GJ (N, N m^2) instead of '%s'", stn_material[k]);
     for (k = 0; k < STN_NKEYS; k++)
-        if ((all & stn_keys[k].bit) && !json_object_get(st, stn_keys[k].name))
+        if ((all & stn_keys[k].bit) && !w->v[k])
             field_error(v, p, "missing '%s': another station of this member gives it, so "
                         "every station must (the value is interpolated between stations)",
                         stn_keys[k].name);
@@ -183,21 +224,25 @@ static int stn_station(val_ctx *v, const json_t *st, const char *p, size_t j, si
 {
     size_t k, before = (size_t)codec_errors_count(v->errs);
     double s = 0, x[2];
+    stn_view w;
 
-    /* material keys get their own message (stn_station_keys) */
-    field_check_keys_but(v, st, p, stn_allowed, stn_material, "station");
-    stn_station_keys(v, st, p, all);
-    if (stn_s(v, st, p, j, n, prev))
+    stn_view_of(st, &w);
+    /* unknown keys (only where some key is not a station key); material keys get their own
+     * message (stn_station_keys) */
+    if (w.other)
+        field_check_keys_but(v, st, p, stn_allowed, stn_material, "station");
+    stn_station_keys(v, st, &w, p, all);
+    if (stn_s(v, w.s, p, j, n, prev))
         s = *prev;
     field_set(v, c, "s", json_real(s));
     for (k = 0; k < STN_NKEYS; k++) {
         const stn_key *q = &stn_keys[k];
-        if (!json_object_get(st, q->name))
+        if (!w.v[k])
             continue;
         if (q->n == 1)
-            field_real(v, st, q->name, p, c, q->kind, q->unit, NULL);
-        else if (field_vector(v, st, q->name, p, q->n, q->kind, "[edgewise, flapwise]", q->unit,
-                              x))
+            field_real_at(v, w.v[k], q->name, p, c, q->kind, q->unit, NULL);
+        else if (field_vector_at(v, w.v[k], q->name, p, q->n, q->kind, "[edgewise, flapwise]",
+                                 q->unit, x))
             field_set(v, c, q->name, field_reals(x, q->n));
     }
     return (size_t)codec_errors_count(v->errs) == before;
@@ -315,20 +360,26 @@ static double stn_value(const stn_key *q, double x)
 unsigned stn_fill(const json_t *stations, sm_station *out)
 {
     const json_t *st;
-    unsigned mask = stn_keys_mask(stations);
+    unsigned mask = 0;
     size_t j, k;
     int i;
 
     json_array_foreach(stations, j, st) {
+        stn_view w;
+        stn_view_of(st, &w);
+        mask |= w.mask;
         memset(&out[j], 0, sizeof(out[j]));
-        out[j].s = stn_num(st, "s", 0);
+        out[j].s = 0;
+        field_number(w.s, &out[j].s);
         for (k = 0; k < STN_NKEYS; k++) {
             const stn_key *q = &stn_keys[k];
-            double *dst = (double *)((char *)&out[j] + q->off);
-            const json_t *x = json_object_get(st, q->name);
-            for (i = 0; x && i < q->n; i++)
-                dst[i] = stn_value(q, q->n == 1 ? stn_num(st, q->name, 0)
-                                                : json_number_value(json_array_get(x, (size_t)i)));
+            double *dst = (double *)((char *)&out[j] + q->off), d = 0;
+            if (w.v[k] && q->n == 1) {
+                field_number(w.v[k], &d);
+                dst[0] = stn_value(q, d);
+            }
+            for (i = 0; w.v[k] && q->n > 1 && i < q->n; i++)
+                dst[i] = stn_value(q, json_number_value(json_array_get(w.v[k], (size_t)i)));
         }
     }
     return mask;
