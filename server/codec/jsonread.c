@@ -275,14 +275,19 @@ static json_t *jr_container(jr *r, int object)
                 key = own;
             }
             jr_ws(r);
-            if (r->p >= r->end || *r->p != ':' || (r->reject_dup && json_object_getn(c, key, klen)))
+            if (r->p >= r->end || *r->p != ':')
                 goto fail;
             r->p++;
         }
         json_t *v = jr_value(r);
         if (!v)
             goto fail;
+        size_t had = object ? json_object_size(c) : 0;
         if (object ? json_object_setn_new_nocheck(c, key, klen, v) : json_array_append_new(c, v))
+            goto fail;
+        /* a repeated key replaced the first one's value and left the size: jansson refuses it
+         * (one hash of the key, not a lookup and then an insert) */
+        if (object && r->reject_dup && json_object_size(c) == had)
             goto fail;
         free(own);
         own = NULL;
