@@ -122,9 +122,17 @@ typedef struct jt_member {
     const json_t *v;
 } jt_member;
 
+/* strcmp's order of two keys; most keys of an object differ in their first byte, compared here
+ * without a call */
+static inline int jt_keycmp(const char *a, const char *b)
+{
+    unsigned char x = (unsigned char)a[0], y = (unsigned char)b[0];
+    return x != y ? (int)x - (int)y : x ? strcmp(a + 1, b + 1) : 0;
+}
+
 static int jt_member_cmp(const void *a, const void *b)
 {
-    return strcmp(((const jt_member *)a)->key, ((const jt_member *)b)->key);
+    return jt_keycmp(((const jt_member *)a)->key, ((const jt_member *)b)->key);
 }
 
 /* An object with its keys sorted by strcmp, as jansson's JSON_SORT_KEYS writes it.  Objects of
@@ -146,7 +154,7 @@ static void jt_sorted(jt_out *o, const json_t *x)
         jt_member t = {key, v};
         size_t j = i++;
         if (n <= JT_SMALL) /* insertion */
-            for (; j > 0 && strcmp(mem[j - 1].key, key) > 0; j--)
+            for (; j > 0 && jt_keycmp(mem[j - 1].key, key) > 0; j--)
                 mem[j] = mem[j - 1];
         mem[j] = t;
     }
