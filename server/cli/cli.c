@@ -738,6 +738,11 @@ int main(int argc, char **argv)
      * page faults in a 101-speed sweep of the angled beam, 3 000 with these; DESIGN.md 2.1). */
     mallopt(M_MMAP_THRESHOLD, 4 << 20);
     mallopt(M_TRIM_THRESHOLD, 16 << 20);
+    /* No fastbins: a request's JSON trees are thousands of small blocks, and with fastbins
+     * every free that joins a large free block (64 kB and up) sweeps all of them again
+     * (malloc_consolidate: a fifth of a 720 kB blade request's parse, issue 27); without them
+     * a free joins its neighbours at once.  The thread caches (tcache) stay. */
+    mallopt(M_MXFAST, 0);
 
     if (argc < 2)
         return cli_usage("a command is required");
