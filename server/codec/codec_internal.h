@@ -649,20 +649,12 @@ int codec_numtext(char *buf, double x, int json);
  *  value that is not finite, or no 128-bit integers): numtext_test checks how seldom. */
 int codec_numtext_direct(double x);
 
-/** A placeholder for codec_json_dump_rows: the empty array `at` of a tree stands for the n rows
- *  of dof reals each at v (row-major), written [[v0, ..., v(dof-1)], ...] as the array of
- *  arrays of reals would be (a value that is not finite as null, result.c's res_real). */
-typedef struct codec_rows {
-    const json_t *at;
-    const double *v;
-    int n, dof;
-} codec_rows;
-
-/** codec_json_dump of x with the n_rows placeholders of rows written as their rows: the bytes of
- *  the tree with those arrays filled in, without a json_t a number (issue 27: building, writing
- *  and freeing them was half of a result's text).  0 or -1. */
-int codec_json_dump_rows(const json_t *x, json_dump_callback_t cb, void *data,
-                         const codec_rows *rows, int n_rows);
+/** The JSON string s (n bytes) appended to t as codec_json_dump writes it (jansson's escapes);
+ *  0, or -1 (out of memory, s not UTF-8). */
+int codec_text_json_string(codec_text *t, const char *s, size_t n);
+/** The real x appended to t as codec_json_dump writes a json_real (null when not finite, as
+ *  result.c writes such a number). */
+void codec_text_json_real(codec_text *t, double x);
 
 /** json_dumps(x, JSON_SORT_KEYS | JSON_COMPACT | JSON_REAL_PRECISION(17)): the same bytes,
  *  written by jsontext.c (keys sorted by strcmp as jansson does).  x: an object or an array.

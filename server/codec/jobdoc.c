@@ -17,10 +17,10 @@
 
 /* ----------------------------------------------------------- text buffer */
 
-void codec_text_put(codec_text *t, const char *s, size_t n)
+char *codec_text_room(codec_text *t, size_t n)
 {
     if (t->nomem)
-        return;
+        return NULL;
     if (t->len + n + 1 > t->cap) {
         size_t ncap = t->cap ? t->cap : 1024;
         char *np;
@@ -29,12 +29,21 @@ void codec_text_put(codec_text *t, const char *s, size_t n)
         np = realloc(t->p, ncap);
         if (!np) {
             t->nomem = 1;
-            return;
+            return NULL;
         }
         t->p = np;
         t->cap = ncap;
     }
-    memcpy(t->p + t->len, s, n);
+    return t->p + t->len;
+}
+
+void codec_text_put(codec_text *t, const char *s, size_t n)
+{
+    char *q = codec_text_room(t, n);
+
+    if (!q)
+        return;
+    memcpy(q, s, n);
     t->len += n;
     t->p[t->len] = '\0';
 }

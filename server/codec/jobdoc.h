@@ -37,6 +37,10 @@ typedef struct codec_text {
 /** Append n bytes of s. */
 void codec_text_put(codec_text *t, const char *s, size_t n);
 
+/** Room for n more bytes and the NUL, grown as codec_text_put grows it (doubling): where to
+ *  write them (then add what was written to len and put the NUL), or NULL out of memory. */
+char *codec_text_room(codec_text *t, size_t n);
+
 /** Append the NUL-terminated s. */
 void codec_text_puts(codec_text *t, const char *s);
 

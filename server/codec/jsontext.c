@@ -25,8 +25,6 @@ typedef struct jt_out {
     void *data;
     int err;
     int sort; /* JSON_SORT_KEYS: an object's keys in strcmp order (jansson's compare_keys) */
-    const codec_rows *rows; /* placeholders (codec_json_dump_rows) */
-    int n_rows;
 } jt_out;
 
 static void jt_flush(jt_out *o)
@@ -90,30 +88,6 @@ static void jt_real(jt_out *o, double x)
     if (sizeof o->b - o->n < CODEC_NUMTEXT_MAX)
         jt_flush(o);
     o->n += (size_t)codec_numtext(o->b + o->n, x, 1);
-}
-
-/* The rows of placeholder x when it is one (1), else 0. */
-static int jt_rows(jt_out *o, const json_t *x)
-{
-    const codec_rows *r = NULL;
-    for (int i = 0; i < o->n_rows && !r; i++)
-        if (o->rows[i].at == x)
-            r = &o->rows[i];
-    if (!r)
-        return 0;
-    jt_put(o, "[", 1);
-    for (int k = 0; k < r->n; k++) {
-        const double *v = r->v + (size_t)r->dof * (size_t)k;
-        jt_put(o, k > 0 ? ",[" : "[", k > 0 ? 2 : 1);
-        for (int j = 0; j < r->dof; j++) {
-            if (j > 0)
-                jt_put(o, ",", 1);
-            jt_real(o, v[j]);
-        }
-        jt_put(o, "]", 1);
-    }
-    jt_put(o, "]", 1);
-    return 1;
 }
 
 /* A member of an object being written with its keys sorted. */
@@ -198,8 +172,6 @@ static void jt_value(jt_out *o, const json_t *x)
         break;
     }
     case JSON_ARRAY:
-        if (o->n_rows && json_array_size(x) == 0 && jt_rows(o, x))
-            break;
         jt_put(o, "[", 1);
         for (size_t i = 0; i < json_array_size(x); i++) {
             if (i > 0)
@@ -231,9 +203,8 @@ static void jt_value(jt_out *o, const json_t *x)
     }
 }
 
-/* The dump of x (object or array) with keys sorted or not, and n_rows placeholders. */
-static int jt_dump(const json_t *x, int sort, json_dump_callback_t cb, void *data,
-                   const codec_rows *rows, int n_rows)
+/* The dump of x (object or array) with keys sorted or not. */
+static int jt_dump(const json_t *x, int sort, json_dump_callback_t cb, void *data)
 {
     jt_out o;
     if (!json_is_object(x) && !json_is_array(x))
@@ -243,8 +214,6 @@ static int jt_dump(const json_t *x, int sort, json_dump_callback_t cb, void *dat
     o.data = data;
     o.err = 0;
     o.sort = sort;
-    o.rows = rows;
-    o.n_rows = n_rows;
     jt_value(&o, x);
     jt_flush(&o);
     return o.err ? -1 : 0;
@@ -252,13 +221,7 @@ static int jt_dump(const json_t *x, int sort, json_dump_callback_t cb, void *dat
 
 int codec_json_dump(const json_t *x, json_dump_callback_t cb, void *data)
 {
-    return jt_dump(x, 0, cb, data, NULL, 0);
-}
-
-int codec_json_dump_rows(const json_t *x, json_dump_callback_t cb, void *data,
-                         const codec_rows *rows, int n_rows)
-{
-    return jt_dump(x, 0, cb, data, rows, n_rows);
+    return jt_dump(x, 0, cb, data);
 }
 
 /* json_dump_callback into a codec_text; -1 when out of memory. */
@@ -272,11 +235,36 @@ static int jt_text(const char *buffer, size_t size, void *data)
 char *codec_json_dumps_sorted(const json_t *x)
 {
     codec_text t = {NULL, 0, 0, 0};
-    if (jt_dump(x, 1, jt_text, &t, NULL, 0) || t.nomem || !t.p) {
+    if (jt_dump(x, 1, jt_text, &t) || t.nomem || !t.p) {
         free(t.p);
         return NULL;
     }
     return t.p;
+}
+
+int codec_text_json_string(codec_text *t, const char *s, size_t n)
+{
+    if (jt_plain(s, n)) {
+        codec_text_put(t, "\"", 1);
+        codec_text_put(t, s, n);
+        codec_text_put(t, "\"", 1);
+        return t->nomem ? -1 : 0;
+    }
+    json_t *x = json_stringn(s, n); /* jansson's escapes and UTF-8 check, as jt_string */
+    int rc = !x || json_dump_callback(x, jt_text, t, JSON_ENCODE_ANY);
+    json_decref(x);
+    return rc || t->nomem ? -1 : 0;
+}
+
+void codec_text_json_real(codec_text *t, double x)
+{
+    char num[CODEC_NUMTEXT_MAX];
+
+    if (!isfinite(x)) {
+        codec_text_put(t, "null", 4);
+        return;
+    }
+    codec_text_put(t, num, (size_t)codec_numtext(num, x, 1));
 }
 
 static int jt_file(const char *buffer, size_t size, void *data)

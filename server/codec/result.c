@@ -30,10 +30,13 @@
  * appended likewise (frequencies and shapes are unchanged).
  *
  * Large results (issue 23 item 9): the daemon stores the text of the
- * document, so codec_result_text writes it one case at a time (each case's
- * tree is built, dumped and freed) instead of building the whole tree and
- * dumping it: the text is the only whole copy held, with the same bytes as
- * json_dumps(codec_result_encode's document, CODEC_RESULT_DUMP).
+ * document, so codec_result_text writes it one case at a time instead of
+ * building the whole tree and dumping it: the text is the only whole copy
+ * held, with the same bytes as json_dumps(codec_result_encode's document,
+ * CODEC_RESULT_DUMP).  A case is described once (res_case and the functions
+ * it calls) to a res_out, which builds its tree for codec_result_encode or
+ * writes its text straight away for codec_result_text (issue 27: no tree of
+ * a case at all).
  */
 #include "codec_internal.h"
 
@@ -82,96 +85,246 @@ static int res_node_dof(const sm_case *c)
     return c->node_dof == 6 ? 6 : 3; /* only 3 and 6 exist: never read past the arrays */
 }
 
-/* The placeholders of a case written as text (codec_rows): NULL in a tree. */
-typedef struct res_rx {
-    codec_rows *rows;
-    int n, cap;
-} res_rx;
+/*
+ * Where a case is written (issue 27): a tree (t NULL; the containers open, c[0] the case) for
+ * codec_result_encode, or straight into text t (compact, the bytes jansson's dump of that tree
+ * with CODEC_RESULT_DUMP gives) for codec_result_text.  The case's functions below describe
+ * the document once for both; building, dumping and freeing a tree of ~50 blocks a mode was
+ * half of a 12-element blade's result text.  size_units.c compares the two for every part.
+ */
+#define RES_DEPTH 8
+typedef struct res_out {
+    codec_text *t;         /* text, or NULL: a tree */
+    json_t *c[RES_DEPTH];  /* tree: the open containers */
+    int count[RES_DEPTH];  /* text: members written in each open container */
+    char close[RES_DEPTH]; /* text: '}' or ']' */
+    int depth;
+    int nomem; /* a tree's allocation failed (text: t->nomem) */
+} res_out;
 
-/* [[x, y, phi], ...] from n rows of dof reals each; with rx, an empty array that stands for
- * them in the text (codec_json_dump_rows). */
-static json_t *res_rows(const double *v, int n, int dof, res_rx *rx)
+/* Text: the separator and key of the next member of the innermost container. */
+static void ro_key(res_out *o, const char *key)
 {
-    json_t *a = json_array();
-    int k;
-
-    if (!a)
-        return NULL;
-    if (rx) {
-        if (rx->n >= rx->cap) { /* cannot happen: res_case_text counts them */
-            json_decref(a);
-            return NULL;
-        }
-        rx->rows[rx->n++] = (codec_rows){a, v, n, dof};
-        return a;
+    if (o->depth > 0 && o->count[o->depth - 1]++)
+        codec_text_put(o->t, ",", 1);
+    if (key) {
+        if (codec_text_json_string(o->t, key, strlen(key)))
+            o->nomem = 1;
+        codec_text_put(o->t, ":", 1);
     }
-    for (k = 0; k < n; k++)
-        if (json_array_append_new(a, res_reals(v + (size_t)dof * (size_t)k, dof)))
-            goto fail;
-    return a;
-fail:
-    json_decref(a);
-    return NULL;
+}
+
+/* Tree: v (stolen; NULL: out of memory) as member key of the innermost container. */
+static void ro_tree(res_out *o, const char *key, json_t *v)
+{
+    json_t *in = o->depth > 0 ? o->c[o->depth - 1] : NULL;
+
+    if (!v || !in || (key ? json_object_set_new(in, key, v) : json_array_append_new(in, v)))
+        o->nomem = 1;
+}
+
+/* Open an object (object 1) or array as member key (NULL in an array). */
+static void ro_open(res_out *o, const char *key, int object)
+{
+    if (o->depth >= RES_DEPTH) { /* cannot happen: a case is 5 deep */
+        o->nomem = 1;
+        return;
+    }
+    if (o->t) {
+        ro_key(o, key);
+        codec_text_put(o->t, object ? "{" : "[", 1);
+        o->close[o->depth] = object ? '}' : ']';
+        o->count[o->depth++] = 0;
+        return;
+    }
+    json_t *x = object ? json_object() : json_array();
+    if (o->depth > 0)
+        ro_tree(o, key, json_incref(x));
+    o->c[o->depth++] = x;
+    if (!x)
+        o->nomem = 1;
+}
+
+/* Close the innermost container (a tree's root stays in c[0]). */
+static void ro_close(res_out *o)
+{
+    if (o->depth <= 0)
+        return;
+    o->depth--;
+    if (o->t)
+        codec_text_put(o->t, &o->close[o->depth], 1);
+    else if (o->depth > 0)
+        json_decref(o->c[o->depth]); /* its parent holds it */
+}
+
+/* A real (null when not finite, as res_real). */
+static void ro_real(res_out *o, const char *key, double x)
+{
+    if (o->t) {
+        ro_key(o, key);
+        codec_text_json_real(o->t, x);
+    } else {
+        ro_tree(o, key, res_real(x));
+    }
+}
+
+static void ro_int(res_out *o, const char *key, long long v)
+{
+    if (o->t) {
+        char num[24];
+        ro_key(o, key);
+        codec_text_put(o->t, num,
+                       (size_t)snprintf(num, sizeof num, "%" JSON_INTEGER_FORMAT, (json_int_t)v));
+    } else {
+        ro_tree(o, key, json_integer((json_int_t)v));
+    }
+}
+
+/* null, true or false (lit 0, 1, 2). */
+static void ro_lit(res_out *o, const char *key, int lit)
+{
+    static const char *const text[] = {"null", "true", "false"};
+
+    if (o->t) {
+        ro_key(o, key);
+        codec_text_puts(o->t, text[lit]);
+    } else {
+        ro_tree(o, key, lit == 0 ? json_null() : json_boolean(lit == 1));
+    }
+}
+
+static void ro_null(res_out *o, const char *key)
+{
+    ro_lit(o, key, 0);
+}
+
+static void ro_bool(res_out *o, const char *key, int b)
+{
+    ro_lit(o, key, b ? 1 : 2);
+}
+
+static void ro_string(res_out *o, const char *key, const char *s)
+{
+    if (o->t) {
+        ro_key(o, key);
+        if (codec_text_json_string(o->t, s, strlen(s)))
+            o->nomem = 1;
+    } else {
+        ro_tree(o, key, json_string(s));
+    }
+}
+
+/* Text: [v0,v1,...] from n reals at q (room made: n (CODEC_NUMTEXT_MAX + 1) + 2); the end. */
+static char *ro_text_reals(char *q, const double *v, int n)
+{
+    *q++ = '[';
+    for (int k = 0; k < n; k++) {
+        if (k > 0)
+            *q++ = ',';
+        if (isfinite(v[k])) {
+            q += codec_numtext(q, v[k], 1);
+        } else {
+            memcpy(q, "null", 4);
+            q += 4;
+        }
+    }
+    *q++ = ']';
+    return q;
+}
+
+/* [[x, y, phi], ...] from rows of dof reals each (rows < 0: one row [v0, ...] of dof reals);
+ * text written in place, its room made once (the numbers are most of a result). */
+static void ro_block(res_out *o, const char *key, const double *v, int rows, int dof)
+{
+    if (o->t) {
+        int n = rows < 0 ? 1 : rows;
+        char *q;
+        ro_key(o, key);
+        if (!(q = codec_text_room(o->t,
+                                  2 + (size_t)n * ((size_t)dof * (CODEC_NUMTEXT_MAX + 1) + 3))))
+            return;
+        char *start = q;
+        if (rows < 0) {
+            q = ro_text_reals(q, v, dof);
+        } else {
+            *q++ = '[';
+            for (int k = 0; k < rows; k++) {
+                if (k > 0)
+                    *q++ = ',';
+                q = ro_text_reals(q, v + (size_t)dof * (size_t)k, dof);
+            }
+            *q++ = ']';
+        }
+        o->t->len += (size_t)(q - start);
+        o->t->p[o->t->len] = '\0';
+        return;
+    }
+    ro_open(o, key, 0);
+    for (int k = 0; k < (rows < 0 ? dof : rows); k++) {
+        if (rows < 0) {
+            ro_real(o, NULL, v[k]);
+            continue;
+        }
+        ro_open(o, NULL, 0);
+        for (int j = 0; j < dof; j++)
+            ro_real(o, NULL, v[(size_t)dof * (size_t)k + (size_t)j]);
+        ro_close(o);
+    }
+    ro_close(o);
+}
+
+/* [v0, v1, ...] from n reals. */
+static void ro_reals(res_out *o, const char *key, const double *v, int n)
+{
+    ro_block(o, key, v, -1, n);
+}
+
+/* [[x, y, phi], ...] from n rows of dof reals each. */
+static void ro_rows(res_out *o, const char *key, const double *v, int n, int dof)
+{
+    ro_block(o, key, v, n, dof);
 }
 
 /* case.equilibrium */
-static json_t *res_equilibrium(const codec_request *r, const sm_model *m, const sm_case *c,
-                               res_rx *rx)
+static void res_equilibrium(const codec_request *r, const sm_model *m, const sm_case *c, res_out *o)
 {
-    json_t *e = json_object(), *joints = NULL;
     int j, nj = codec_request_structure(r)->n_joints, dof = res_node_dof(c);
 
-    if (!e)
-        return NULL;
-    if (json_object_set_new(e, "converged", json_boolean(c->converged)) ||
-        json_object_set_new(e, "iterations", json_integer(c->iterations)) ||
-        json_object_set_new(e, "residual", res_real(c->residual)))
-        goto fail;
+    ro_open(o, "equilibrium", 1);
+    ro_bool(o, "converged", c->converged);
+    ro_int(o, "iterations", c->iterations);
+    ro_real(o, "residual", c->residual);
     if (c->nodes && c->n_nodes > 0) {
-        joints = json_object();
-        if (!joints)
-            goto fail;
+        ro_open(o, "joints", 1);
         for (j = 0; j < nj; j++) {
             int node = sm_model_joint_node(m, j);
-            if (node < 0 || node >= c->n_nodes)
-                continue;
-            if (json_object_set_new(joints, codec_request_joint_name(r, j),
-                                    res_reals(c->nodes + (size_t)dof * (size_t)node, dof)))
-                goto fail;
+            if (node >= 0 && node < c->n_nodes)
+                ro_reals(o, codec_request_joint_name(r, j), c->nodes + (size_t)dof * (size_t)node,
+                         dof);
         }
-        if (json_object_set_new(e, "joints", joints))
-            goto fail_set;
-        joints = NULL;
-        if (json_object_set_new(e, "nodes", res_rows(c->nodes, c->n_nodes, dof, rx)))
-            goto fail;
+        ro_close(o);
+        ro_rows(o, "nodes", c->nodes, c->n_nodes, dof);
     }
-    if (c->axial_force && c->n_elements > 0 &&
-        json_object_set_new(e, "axial_force", res_reals(c->axial_force, c->n_elements)))
-        goto fail;
-    if (c->nodes && c->n_nodes > 0 &&
-        json_object_set_new(e, "max_frame_rotation", res_real(c->max_frame_rotation)))
-        goto fail;
-    return e;
-fail:
-    json_decref(joints);
-fail_set:
-    json_decref(e);
-    return NULL;
-}
-
-/* Frequency f (rad/s) per revolution at omega: f / omega, null at rest. */
-static json_t *res_per_rev(double f, double omega)
-{
-    return omega > 0 ? res_real(f / omega) : json_null();
+    if (c->axial_force && c->n_elements > 0)
+        ro_reals(o, "axial_force", c->axial_force, c->n_elements);
+    if (c->nodes && c->n_nodes > 0)
+        ro_real(o, "max_frame_rotation", c->max_frame_rotation);
+    ro_close(o);
 }
 
 /* {"axial", "edge", "flap", "torsion"} (planar: {"axial", "bending"}) from 4 fractions. */
-static json_t *res_parts(const double *f, int spatial)
+static void res_parts(res_out *o, const char *key, const double *f, int spatial)
 {
-    if (!spatial)
-        return json_pack("{s:o, s:o}", "axial", res_real(f[0]), "bending", res_real(f[1]));
-    return json_pack("{s:o, s:o, s:o, s:o}", "axial", res_real(f[0]), "edge", res_real(f[1]),
-                     "flap", res_real(f[2]), "torsion", res_real(f[3]));
+    ro_open(o, key, 1);
+    ro_real(o, "axial", f[0]);
+    if (!spatial) {
+        ro_real(o, "bending", f[1]);
+    } else {
+        ro_real(o, "edge", f[1]);
+        ro_real(o, "flap", f[2]);
+        ro_real(o, "torsion", f[3]);
+    }
+    ro_close(o);
 }
 
 char *codec_mode_label(const codec_request *r, int kind, int ordinal, char *buf, size_t size)
@@ -200,9 +353,9 @@ char *codec_mode_label(const codec_request *r, int kind, int ordinal, char *buf,
  * DESIGN.md 9.1, appended to mode k: "label", "label_confidence", "energy" {"kinetic",
  * "strain", and "support" for a model with supports (DESIGN.md 8.7)}, "tracked_index", "tracking_flag" ("crossing", "veering" or null) and
  * "tracking_partner" (the other tracked index of the flagged pair, or null).  Nothing for a
- * case the core gave no labels (hand-built results).  Returns 0, or -1 out of memory.
+ * case the core gave no labels (hand-built results).
  */
-static int res_trust(const codec_request *r, json_t *md, const sm_case *c, int k)
+static void res_trust(const codec_request *r, res_out *o, const sm_case *c, int k)
 {
     char lab[32];
     int spatial = res_node_dof(c) == 6, flag;
@@ -211,114 +364,104 @@ static int res_trust(const codec_request *r, json_t *md, const sm_case *c, int k
     if (c->label_kind && c->energy) {
         f = c->energy + (size_t)k * SM_ENERGY_PARTS;
         codec_mode_label(r, c->label_kind[k], c->label_ordinal[k], lab, sizeof(lab));
-        if (json_object_set_new(md, "label", json_string(lab)) ||
-            json_object_set_new(md, "label_confidence", res_real(c->label_confidence[k])) ||
-            json_object_set_new(md, "energy", json_pack("{s:o, s:o}", "kinetic",
-                                                        res_parts(f, spatial), "strain",
-                                                        res_parts(f + 4, spatial))))
-            return -1;
-        if (c->support_share && /* DESIGN.md 8.7: only models with supports */
-            json_object_set_new(json_object_get(md, "energy"), "support",
-                                res_real(c->support_share[k])))
-            return -1;
+        ro_string(o, "label", lab);
+        ro_real(o, "label_confidence", c->label_confidence[k]);
+        ro_open(o, "energy", 1);
+        res_parts(o, "kinetic", f, spatial);
+        res_parts(o, "strain", f + 4, spatial);
+        if (c->support_share) /* DESIGN.md 8.7: only models with supports */
+            ro_real(o, "support", c->support_share[k]);
+        ro_close(o);
     }
     if (c->tracked_index) {
         flag = c->track_flag[k];
-        if (json_object_set_new(md, "tracked_index", json_integer(c->tracked_index[k])) ||
-            json_object_set_new(md, "tracking_flag",
-                                flag == SM_TRACK_CROSSING  ? json_string("crossing")
-                                : flag == SM_TRACK_VEERING ? json_string("veering")
-                                                           : json_null()) ||
-            json_object_set_new(md, "tracking_partner",
-                                flag ? json_integer(c->track_partner[k]) : json_null()))
-            return -1;
+        ro_int(o, "tracked_index", c->tracked_index[k]);
+        if (flag == SM_TRACK_CROSSING || flag == SM_TRACK_VEERING)
+            ro_string(o, "tracking_flag", flag == SM_TRACK_CROSSING ? "crossing" : "veering");
+        else
+            ro_null(o, "tracking_flag");
+        if (flag)
+            ro_int(o, "tracking_partner", c->track_partner[k]);
+        else
+            ro_null(o, "tracking_partner");
     }
-    return 0;
 }
 
 /* One mode of a case. */
-static json_t *res_mode(const codec_request *r, const sm_case *c, int k, int shapes, res_rx *rx)
+static void res_mode(const codec_request *r, const sm_case *c, int k, int shapes, res_out *o)
 {
     int dof = res_node_dof(c);
     size_t stride = (size_t)dof * (size_t)c->n_nodes;
-    json_t *md = json_object(), *shape;
     double mac = c->mac_to_previous ? c->mac_to_previous[k] : -1;
     int prev = c->previous_index ? c->previous_index[k] : -1;
 
-    if (!md)
-        return NULL;
-    if (json_object_set_new(md, "frequency_rad_s", res_real(c->frequency[k])) ||
-        json_object_set_new(md, "frequency_hz", res_real(c->frequency[k] / CODEC_TWO_PI)) ||
-        json_object_set_new(md, "eigenvalue", json_pack("[o, o]", res_real(c->eig_re[k]),
-                                                        res_real(c->eig_im[k]))) ||
-        json_object_set_new(md, "mac_to_previous", mac < 0 ? json_null() : res_real(mac)) ||
-        json_object_set_new(md, "previous_index", prev < 0 ? json_null() : json_integer(prev)))
-        goto fail;
+    ro_open(o, NULL, 1);
+    ro_real(o, "frequency_rad_s", c->frequency[k]);
+    ro_real(o, "frequency_hz", c->frequency[k] / CODEC_TWO_PI);
+    ro_open(o, "eigenvalue", 0);
+    ro_real(o, NULL, c->eig_re[k]);
+    ro_real(o, NULL, c->eig_im[k]);
+    ro_close(o);
+    if (mac < 0)
+        ro_null(o, "mac_to_previous");
+    else
+        ro_real(o, "mac_to_previous", mac);
+    if (prev < 0)
+        ro_null(o, "previous_index");
+    else
+        ro_int(o, "previous_index", prev);
     if (shapes && c->shape_re) {
-        shape = json_object();
-        if (json_object_set_new(md, "shape", shape))
-            goto fail;
-        if (json_object_set_new(shape, "re",
-                                res_rows(c->shape_re + k * stride, c->n_nodes, dof, rx)))
-            goto fail;
-        if (c->shape_im &&
-            json_object_set_new(shape, "im",
-                                res_rows(c->shape_im + k * stride, c->n_nodes, dof, rx)))
-            goto fail;
+        ro_open(o, "shape", 1);
+        ro_rows(o, "re", c->shape_re + k * stride, c->n_nodes, dof);
+        if (c->shape_im)
+            ro_rows(o, "im", c->shape_im + k * stride, c->n_nodes, dof);
+        ro_close(o);
     }
-    if (json_object_set_new(md, "per_rev", res_per_rev(c->frequency[k], c->omega)) ||
-        res_trust(r, md, c, k))
-        goto fail;
-    if (c->error_estimate &&
-        json_object_set_new(md, "error_estimate", res_real(c->error_estimate[k])))
-        goto fail;
-    return md;
-fail:
-    json_decref(md);
-    return NULL;
+    if (c->omega > 0) /* per_rev: frequency / omega, null at rest */
+        ro_real(o, "per_rev", c->frequency[k] / c->omega);
+    else
+        ro_null(o, "per_rev");
+    res_trust(r, o, c, k);
+    if (c->error_estimate)
+        ro_real(o, "error_estimate", c->error_estimate[k]);
+    ro_close(o);
 }
 
-/* One case (speed), rpm its speed in rev/min; rx: res_rows's. */
-static json_t *res_case(const codec_request *r, const sm_model *m, const sm_case *c, double rpm,
-                        res_rx *rx)
+/* One case (speed), rpm its speed in rev/min, into o. */
+static void res_case(const codec_request *r, const sm_model *m, const sm_case *c, double rpm,
+                     res_out *o)
 {
-    json_t *o = json_object(), *modes;
     int k, shapes = codec_request_options(r)->mode_shapes;
 
-    if (!o)
-        return NULL;
-    if (json_object_set_new(o, "omega", res_real(c->omega)) ||
-        json_object_set_new(o, "status", json_string(codec_case_status_name(c->status))) ||
-        json_object_set_new(o, "equilibrium", res_equilibrium(r, m, c, rx)))
-        goto fail;
-    if (c->status != SM_CASE_NO_EQUILIBRIUM && c->status != SM_CASE_EIGEN_FAILED &&
-        json_object_set_new(o, "stability",
-                            json_pack("{s:b, s:i}", "stable", c->stable,
-                                      "negative_eigenvalues", c->negative_eigenvalues)))
-        goto fail;
-    modes = json_array();
-    if (json_object_set_new(o, "modes", modes))
-        goto fail;
+    ro_open(o, NULL, 1);
+    ro_real(o, "omega", c->omega);
+    ro_string(o, "status", codec_case_status_name(c->status));
+    res_equilibrium(r, m, c, o);
+    if (c->status != SM_CASE_NO_EQUILIBRIUM && c->status != SM_CASE_EIGEN_FAILED) {
+        ro_open(o, "stability", 1);
+        ro_bool(o, "stable", c->stable);
+        ro_int(o, "negative_eigenvalues", c->negative_eigenvalues);
+        ro_close(o);
+    }
+    ro_open(o, "modes", 0);
     for (k = 0; k < c->n_modes; k++)
-        if (json_array_append_new(modes, res_mode(r, c, k, shapes, rx)))
-            goto fail;
-    if (c->warning[0] &&
-        json_object_set_new(o, "warnings", json_pack("[s]", c->warning)))
-        goto fail;
-    if (c->status != SM_CASE_SOLVED &&
-        json_object_set_new(o, "diagnostics",
-                            json_pack("{s:i, s:o, s:o, s:s}", "iterations", c->iterations,
-                                      "residual", res_real(c->residual), "last_omega",
-                                      res_real(c->last_omega), "message",
-                                      c->message[0] ? c->message
-                                                    : codec_case_status_name(c->status))))
-        goto fail;
-    if (json_object_set_new(o, "rpm", res_real(rpm)))
-        goto fail;
-    return o;
-fail:
-    json_decref(o);
-    return NULL;
+        res_mode(r, c, k, shapes, o);
+    ro_close(o);
+    if (c->warning[0]) {
+        ro_open(o, "warnings", 0);
+        ro_string(o, NULL, c->warning);
+        ro_close(o);
+    }
+    if (c->status != SM_CASE_SOLVED) {
+        ro_open(o, "diagnostics", 1);
+        ro_int(o, "iterations", c->iterations);
+        ro_real(o, "residual", c->residual);
+        ro_real(o, "last_omega", c->last_omega);
+        ro_string(o, "message", c->message[0] ? c->message : codec_case_status_name(c->status));
+        ro_close(o);
+    }
+    ro_real(o, "rpm", rpm);
+    ro_close(o);
 }
 
 /* The id of member i in the canonical request: "blade" for the blade form, else its "id" or
@@ -526,14 +669,14 @@ static int res_tail(json_t *doc, const codec_request *r, const sm_result *res)
     return res_critical_speeds(doc, r, res) || res_divergence_speeds(doc, res) ? -1 : 0;
 }
 
-/* Case i of res, with its rpm (as the request gave it, else from omega); rx: res_rows's. */
-static json_t *res_case_at(const codec_request *r, const sm_model *m, const sm_result *res, int i,
-                           res_rx *rx)
+/* Case i of res, with its rpm (as the request gave it, else from omega), into o. */
+static void res_case_at(const codec_request *r, const sm_model *m, const sm_result *res, int i,
+                        res_out *o)
 {
     int n_rpm;
     const double *rpm = codec_request_rpm(r, &n_rpm);
 
-    return res_case(r, m, &res->cases[i], i < n_rpm ? rpm[i] : NAN, rx);
+    res_case(r, m, &res->cases[i], i < n_rpm ? rpm[i] : NAN, o);
 }
 
 int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
@@ -546,9 +689,16 @@ int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
     cases = json_array();
     if (!doc || json_object_set_new(doc, "cases", cases))
         goto fail;
-    for (i = 0; i < res->n_cases; i++)
-        if (json_array_append_new(cases, res_case_at(r, m, res, i, NULL)))
+    for (i = 0; i < res->n_cases; i++) {
+        res_out o = {0};
+        res_case_at(r, m, res, i, &o);
+        if (o.nomem) {
+            json_decref(o.c[0]);
             goto fail;
+        }
+        if (json_array_append_new(cases, o.c[0]))
+            goto fail;
+    }
     if (res_tail(doc, r, res))
         goto fail;
     *out = doc;
@@ -591,22 +741,15 @@ static int res_text_head(codec_text *t, const codec_request *r, const sm_model *
     return t->nomem ? -1 : 0;
 }
 
-/* Case i as text: its tree with placeholders for the node and shape rows (res_rows), dumped
- * with them written in; 0 or -1. */
+/* Case i as text (res_out: no tree); 0 or -1. */
 static int res_case_text(codec_text *t, const codec_request *r, const sm_model *m,
                          const sm_result *res, int i)
 {
-    res_rx rx = {NULL, 0, 1 + 2 * (res->cases[i].n_modes > 0 ? res->cases[i].n_modes : 0)};
-    json_t *x;
-    int rc = -1;
+    res_out o = {0};
 
-    rx.rows = malloc((size_t)rx.cap * sizeof *rx.rows);
-    x = rx.rows ? res_case_at(r, m, res, i, &rx) : NULL;
-    if (x)
-        rc = codec_json_dump_rows(x, res_put, t, rx.rows, rx.n);
-    json_decref(x);
-    free(rx.rows);
-    return rc || t->nomem ? -1 : 0;
+    o.t = t;
+    res_case_at(r, m, res, i, &o);
+    return o.nomem || t->nomem ? -1 : 0;
 }
 
 /* Cases [from, to) (each after the first of the document with its ","); 0 or -1. */
