@@ -62,23 +62,6 @@ static json_t *res_real(double x)
     return isfinite(x) ? json_real(x) : json_null();
 }
 
-/* [a, b, ...] from n reals. */
-static json_t *res_reals(const double *v, int n)
-{
-    json_t *a = json_array();
-    int k;
-
-    if (!a)
-        return NULL;
-    for (k = 0; k < n; k++)
-        if (json_array_append_new(a, res_real(v[k])))
-            goto fail;
-    return a;
-fail:
-    json_decref(a);
-    return NULL;
-}
-
 /* Values per node of case c: node_dof (3 planar, 6 spatial). */
 static int res_node_dof(const sm_case *c)
 {
@@ -464,19 +447,22 @@ static void res_case(const codec_request *r, const sm_model *m, const sm_case *c
     ro_close(o);
 }
 
-/* The id of member i in the canonical request: "blade" for the blade form, else its "id" or
- * null. */
-static json_t *res_member_id(const codec_request *r, int i)
+/* The id of member i in the canonical request: "blade" for the blade form, else its "id" (a
+ * string) or null. */
+static void res_member_id(const codec_request *r, int i, res_out *o)
 {
     const json_t *canon = codec_request_canonical(r);
     const json_t *mems = json_object_get(json_object_get(canon, "structure"), "members");
-    const json_t *id = json_object_get(json_array_get(mems, (size_t)i), "id");
+    const char *id = json_string_value(json_object_get(json_array_get(mems, (size_t)i), "id"));
 
     if (json_object_get(canon, "blade"))
-        return json_string("blade");
-    if (json_object_get(canon, "tower"))
-        return json_string("tower");
-    return id ? json_deep_copy(id) : json_null();
+        ro_string(o, "id", "blade");
+    else if (json_object_get(canon, "tower"))
+        ro_string(o, "id", "tower");
+    else if (id)
+        ro_string(o, "id", id);
+    else
+        ro_null(o, "id");
 }
 
 /*
@@ -485,71 +471,72 @@ static json_t *res_member_id(const codec_request *r, int i)
  * twist ([e1, e2, e3], 9 numbers, hub frame), its FE nodes from `from` (s = 0) to `to` (s = 1),
  * their span fractions and the structural twist there (degrees, about e1 from e2, e3).
  */
-static json_t *res_member_layout(const codec_request *r, const sm_model *m, int i)
+static void res_member_layout(const codec_request *r, const sm_model *m, int i, res_out *o)
 {
     int n = sm_model_member_nodes(m, i, 0, NULL, NULL, NULL), k;
     int *nodes = NULL;
     double *s = NULL, *tw = NULL, ax[9], a[3], b[3];
-    json_t *o = NULL, *jn, *js, *jt;
 
-    if (n < 2)
-        return json_null();
+    if (n < 2) {
+        ro_null(o, NULL);
+        return;
+    }
     nodes = malloc((size_t)n * sizeof *nodes);
     s = malloc((size_t)n * sizeof *s);
     tw = malloc((size_t)n * sizeof *tw);
     if (!nodes || !s || !tw || sm_model_member_nodes(m, i, n, nodes, s, tw) != n ||
-        sm_model_member_axes(m, i, ax) != SM_OK)
+        sm_model_member_axes(m, i, ax) != SM_OK) {
+        o->nomem = 1;
         goto done;
+    }
     sm_model_node_position3(m, nodes[0], a);
     sm_model_node_position3(m, nodes[n - 1], b);
-    o = json_pack("{s:i, s:o, s:f, s:o, s:[], s:[], s:[]}", "member", i, "id",
-                  res_member_id(r, i), "length",
-                  sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
-                       (b[2] - a[2]) * (b[2] - a[2])),
-                  "axes", res_reals(ax, 9), "nodes", "s", "twist_deg");
-    jn = json_object_get(o, "nodes");
-    js = json_object_get(o, "s");
-    jt = json_object_get(o, "twist_deg");
-    for (k = 0; o && k < n; k++)
-        if (json_array_append_new(jn, json_integer(nodes[k])) ||
-            json_array_append_new(js, res_real(s[k])) ||
-            json_array_append_new(jt, res_real(tw[k] / CODEC_RAD_PER_DEG))) {
-            json_decref(o);
-            o = NULL;
-        }
+    ro_open(o, NULL, 1);
+    ro_int(o, "member", i);
+    res_member_id(r, i, o);
+    ro_real(o, "length",
+            sqrt((b[0] - a[0]) * (b[0] - a[0]) + (b[1] - a[1]) * (b[1] - a[1]) +
+                 (b[2] - a[2]) * (b[2] - a[2])));
+    ro_reals(o, "axes", ax, 9);
+    ro_open(o, "nodes", 0);
+    for (k = 0; k < n; k++)
+        ro_int(o, NULL, nodes[k]);
+    ro_close(o);
+    ro_reals(o, "s", s, n);
+    for (k = 0; k < n; k++)
+        tw[k] /= CODEC_RAD_PER_DEG;
+    ro_reals(o, "twist_deg", tw, n);
+    ro_close(o);
 done:
     free(nodes);
     free(s);
     free(tw);
-    return o;
 }
 
 /* The "model" object: sizes, and for a spatial model "spatial" and "dof_per_node", and with
  * mode shapes "members" (res_member_layout). */
-static json_t *res_model(const codec_request *r, const sm_model *m, const sm_model_info *info)
+static void res_model(const codec_request *r, const sm_model *m, const sm_model_info *info,
+                      res_out *o)
 {
     const sm_structure *st = codec_request_structure(r);
-    json_t *o = json_pack("{s:i, s:i, s:i, s:i}", "nodes", info->nodes, "elements",
-                          info->elements, "frames", info->frames, "coordinates",
-                          info->coordinates), *mems;
     int i;
 
-    if (o && st->spatial &&
-        (json_object_set_new(o, "spatial", json_true()) ||
-         json_object_set_new(o, "dof_per_node", json_integer(6))))
-        goto fail;
-    if (o && st->spatial && codec_request_options(r)->mode_shapes) {
-        mems = json_array();
-        if (json_object_set_new(o, "members", mems))
-            goto fail;
-        for (i = 0; i < st->n_members; i++)
-            if (json_array_append_new(mems, res_member_layout(r, m, i)))
-                goto fail;
+    ro_open(o, "model", 1);
+    ro_int(o, "nodes", info->nodes);
+    ro_int(o, "elements", info->elements);
+    ro_int(o, "frames", info->frames);
+    ro_int(o, "coordinates", info->coordinates);
+    if (st->spatial) {
+        ro_bool(o, "spatial", 1);
+        ro_int(o, "dof_per_node", 6);
     }
-    return o;
-fail:
-    json_decref(o);
-    return NULL;
+    if (st->spatial && codec_request_options(r)->mode_shapes) {
+        ro_open(o, "members", 0);
+        for (i = 0; i < st->n_members; i++)
+            res_member_layout(r, m, i, o);
+        ro_close(o);
+    }
+    ro_close(o);
 }
 
 /* One critical speed (DESIGN.md 9.1). */
@@ -618,22 +605,18 @@ static int res_divergence_speeds(json_t *doc, const sm_result *res)
     return 0;
 }
 
-/* The document's members before "cases": "solver" and "model"; a new object, or NULL. */
-static json_t *res_head(const codec_request *r, const sm_model *m)
+/* The document's members before "cases", "solver" and "model", into the open document o. */
+static void res_head(const codec_request *r, const sm_model *m, res_out *o)
 {
-    json_t *doc = json_object();
     sm_model_info info;
 
     sm_model_get_info(m, &info);
-    if (doc && (json_object_set_new(doc, "solver",
-                                    json_pack("{s:s, s:s, s:s}", "name", "spinmodal", "version",
-                                              SM_VERSION, "request_sha256",
-                                              codec_request_sha256(r))) ||
-                json_object_set_new(doc, "model", res_model(r, m, &info)))) {
-        json_decref(doc);
-        return NULL;
-    }
-    return doc;
+    ro_open(o, "solver", 1);
+    ro_string(o, "name", "spinmodal");
+    ro_string(o, "version", SM_VERSION);
+    ro_string(o, "request_sha256", codec_request_sha256(r));
+    ro_close(o);
+    res_model(r, m, &info, o);
 }
 
 /*
@@ -682,10 +665,19 @@ static void res_case_at(const codec_request *r, const sm_model *m, const sm_resu
 int codec_result_encode(json_t **out, const codec_request *r, const sm_model *m,
                         const sm_result *res)
 {
-    json_t *doc = res_head(r, m), *cases;
+    json_t *doc, *cases;
+    res_out head = {0};
     int i;
 
     *out = NULL;
+    ro_open(&head, NULL, 1);
+    res_head(r, m, &head);
+    ro_close(&head);
+    doc = head.c[0];
+    if (head.nomem) {
+        json_decref(doc);
+        return SM_NOMEM;
+    }
     cases = json_array();
     if (!doc || json_object_set_new(doc, "cases", cases))
         goto fail;
@@ -734,11 +726,13 @@ static int res_dump(codec_text *t, json_t *x)
  */
 static int res_text_head(codec_text *t, const codec_request *r, const sm_model *m)
 {
-    if (res_dump(t, res_head(r, m)))
-        return -1;
-    t->len--; /* the head's "}" */
+    res_out o = {0};
+
+    o.t = t;
+    ro_open(&o, NULL, 1);
+    res_head(r, m, &o); /* the document stays open: its "}" is the tail's */
     codec_text_puts(t, ",\"cases\":[");
-    return t->nomem ? -1 : 0;
+    return o.nomem || t->nomem ? -1 : 0;
 }
 
 /* Case i as text (res_out: no tree); 0 or -1. */
