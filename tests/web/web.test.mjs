@@ -1683,11 +1683,29 @@ async function run() {
     await page.textContent('#job-status'));
     const prog = await page.evaluate(() => [document.getElementById('progress').value, document.getElementById('progress').max]);
     ok(prog[0] > 0 && prog[1] === 1001, 'progress bar follows the job', JSON.stringify(prog));
+    // DELETE's answer (the job as it was when the cancel was asked: running) held back until the
+    // page's poll has seen the job end: the late answer must not take the page back to
+    // "running" with Solve disabled (a race CI once lost under AddressSanitizer)
+    let heldBack = false;
+    const isJob = (url) => /\/v1\/analyses\/[^/]+$/.test(url.pathname);
+    const holdDelete = async (route) => {
+      if (route.request().method() !== 'DELETE') return route.continue();
+      const resp = await route.fetch();
+      await waitFor(page, () => ['done', 'failed', 'canceled'].includes(document.body.dataset.jobState), null,
+        'the poll to see the job end', 60000);
+      heldBack = true;
+      return route.fulfill({response: resp});
+    };
+    await page.route(isJob, holdDelete);
     await page.click('#cancel');
     ok(await waitFor(page, () => ['done', 'failed', 'canceled'].includes(document.body.dataset.jobState), null,
       'the job to stop', 60000), 'the long job stops');
+    for (let i = 0; i < 600 && !heldBack; i++) await sleep(scaledMs(100));
+    await sleep(scaledMs(500)); // the page takes the held answer
+    await page.unroute(isJob, holdDelete);
     const st2 = await page.evaluate(() => document.body.dataset.jobState);
-    ok(st2 === 'canceled', 'cancel: the job is canceled', st2);
+    ok(heldBack && st2 === 'canceled', 'cancel: the job is canceled, and stays so after DELETE answers late', st2);
+    ok(!await page.isDisabled('#submit'), 'cancel: Solve is enabled again');
     await shot(page, '03-canceled.png');
 
     // a sweep with speeds without equilibrium (single frame at β = 90°, DESIGN.md §1.3)

@@ -191,9 +191,14 @@ export function initJobs() {
   $('cancel').addEventListener('click', async () => {
     if (!S.job) return;
     $('cancel').disabled = true;
-    const r = await api.cancel(S.job.id).catch((e) => ({errors: [{message: e.message}]}));
-    if (r.doc) showJob(r.doc);
-    else setStatus(`cancel failed: ${r.errors.map((e) => e.message).join('; ')}`, 'bad');
+    const id = S.job.id;
+    const r = await api.cancel(id).catch((e) => ({errors: [{message: e.message}]}));
+    // The poll may have seen the job end while DELETE was on its way: its answer (the job as
+    // it was when the cancel was asked, "running") must not overwrite that last state, or the
+    // page would stay "running" with Solve disabled (CI saw it once under AddressSanitizer).
+    if (r.doc) {
+      if (!(S.job && S.job.id === id && TERMINAL.has(S.job.state))) showJob(r.doc);
+    } else setStatus(`cancel failed: ${r.errors.map((e) => e.message).join('; ')}`, 'bad');
   });
   $('past-jobs').addEventListener('focus', refreshJobs);
   $('past-jobs').addEventListener('pointerdown', refreshJobs);
