@@ -21,6 +21,7 @@
  *   request.c   canonical text, SHA-256, the core's arrays           req_
  *   diag.c      core diagnostics -> pointers, codec_model_new        diag_
  *   result.c    the result document (DESIGN.md section 4)            res_
+ *   resout.c    result.c's writer: a tree or straight into text      ro_
  *   csv.c       the result's frequency table as CSV                  csv_
  *   problem.c   RFC 9457 problem documents                           (no helpers)
  *   jsonread.c  a request's text as jansson's tree, read faster      jr_
@@ -660,6 +661,36 @@ void codec_text_json_real(codec_text *t, double x);
  *  written by jsontext.c (keys sorted by strcmp as jansson does).  x: an object or an array.
  *  Returns the malloc'd text, or NULL (out of memory, a string not valid UTF-8). */
 char *codec_json_dumps_sorted(const json_t *x);
+
+/* ======================================================= resout.c: ro_ */
+
+/** Where result.c writes (resout.c): a tree (t NULL: the containers open, c[0] the outermost,
+ *  which the caller owns after its ro_close) or text t (compact, the bytes codec_json_dump gives
+ *  of that tree).  Zero-initialise it; set t for text. */
+#define RES_DEPTH 8
+typedef struct res_out {
+    codec_text *t;         /* text, or NULL: a tree */
+    json_t *c[RES_DEPTH];  /* tree: the open containers */
+    int count[RES_DEPTH];  /* text: members written in each open container */
+    char close[RES_DEPTH]; /* text: '}' or ']' */
+    int depth;
+    int nomem; /* a tree's allocation failed (text: t->nomem) */
+} res_out;
+
+/** Open an object (object 1) or an array as member key of the innermost container (key NULL in
+ *  an array or outermost). */
+void ro_open(res_out *o, const char *key, int object);
+/** Close the innermost container. */
+void ro_close(res_out *o);
+/** Members of the innermost container (key NULL in an array): a real (null when not finite),
+ *  an integer, null, a boolean, a string; an array of n reals; an array of n rows of dof reals. */
+void ro_real(res_out *o, const char *key, double x);
+void ro_int(res_out *o, const char *key, long long v);
+void ro_null(res_out *o, const char *key);
+void ro_bool(res_out *o, const char *key, int b);
+void ro_string(res_out *o, const char *key, const char *s);
+void ro_reals(res_out *o, const char *key, const double *v, int n);
+void ro_rows(res_out *o, const char *key, const double *v, int n, int dof);
 
 /* ====================================================== jsonread.c: jr_ */
 
