@@ -148,55 +148,51 @@ static char *ro_text_reals(char *q, const double *v, int n)
     return q;
 }
 
-/* [[x, y, phi], ...] from rows of dof reals each (rows < 0: one row [v0, ...] of dof reals);
- * text written in place, its room made once (the numbers are most of a result). */
-static void ro_block(res_out *o, const char *key, const double *v, int rows, int dof)
+/* Text: [[x, y, phi], ...] from rows of dof reals each (rows < 0: the one row [v0, ...] of dof
+ * reals), written in place with its room made once (the numbers are most of a result). */
+static void ro_text_block(res_out *o, const char *key, const double *v, int rows, int dof)
+{
+    size_t n = rows < 0 ? 1 : (size_t)rows;
+    char *q, *start;
+
+    ro_key(o, key);
+    if (!(q = start = codec_text_room(o->t, 2 + n * ((size_t)dof * (CODEC_NUMTEXT_MAX + 1) + 3))))
+        return;
+    if (rows < 0) {
+        q = ro_text_reals(q, v, dof);
+    } else {
+        *q++ = '[';
+        for (int k = 0; k < rows; k++) {
+            if (k > 0)
+                *q++ = ',';
+            q = ro_text_reals(q, v + (size_t)dof * (size_t)k, dof);
+        }
+        *q++ = ']';
+    }
+    o->t->len += (size_t)(q - start);
+    o->t->p[o->t->len] = '\0';
+}
+
+void ro_reals(res_out *o, const char *key, const double *v, int n)
 {
     if (o->t) {
-        int n = rows < 0 ? 1 : rows;
-        char *q;
-        ro_key(o, key);
-        if (!(q = codec_text_room(o->t,
-                                  2 + (size_t)n * ((size_t)dof * (CODEC_NUMTEXT_MAX + 1) + 3))))
-            return;
-        char *start = q;
-        if (rows < 0) {
-            q = ro_text_reals(q, v, dof);
-        } else {
-            *q++ = '[';
-            for (int k = 0; k < rows; k++) {
-                if (k > 0)
-                    *q++ = ',';
-                q = ro_text_reals(q, v + (size_t)dof * (size_t)k, dof);
-            }
-            *q++ = ']';
-        }
-        o->t->len += (size_t)(q - start);
-        o->t->p[o->t->len] = '\0';
+        ro_text_block(o, key, v, -1, n);
         return;
     }
     ro_open(o, key, 0);
-    for (int k = 0; k < (rows < 0 ? dof : rows); k++) {
-        if (rows < 0) {
-            ro_real(o, NULL, v[k]);
-            continue;
-        }
-        ro_open(o, NULL, 0);
-        for (int j = 0; j < dof; j++)
-            ro_real(o, NULL, v[(size_t)dof * (size_t)k + (size_t)j]);
-        ro_close(o);
-    }
+    for (int k = 0; k < n; k++)
+        ro_real(o, NULL, v[k]);
     ro_close(o);
 }
 
-/* [v0, v1, ...] from n reals. */
-void ro_reals(res_out *o, const char *key, const double *v, int n)
-{
-    ro_block(o, key, v, -1, n);
-}
-
-/* [[x, y, phi], ...] from n rows of dof reals each. */
 void ro_rows(res_out *o, const char *key, const double *v, int n, int dof)
 {
-    ro_block(o, key, v, n, dof);
+    if (o->t) {
+        ro_text_block(o, key, v, n, dof);
+        return;
+    }
+    ro_open(o, key, 0);
+    for (int k = 0; k < n; k++)
+        ro_reals(o, NULL, v + (size_t)dof * (size_t)k, dof);
+    ro_close(o);
 }

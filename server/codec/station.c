@@ -65,13 +65,13 @@ static const char *const stn_allowed[] = {
 /* Material-form keys: stations take the stiffness form only. */
 static const char *const stn_material[] = {"E", "G", "A", "I", "I_flap", "I_edge", "J", NULL};
 
-/* Index in stn_keys of the key (len bytes), STN_S for "s", STN_OTHER for any other key. */
+/* Index in stn_keys of the key, STN_S for "s", STN_OTHER for any other key. */
 enum { STN_S = -1, STN_OTHER = -2 };
-static int stn_index(const char *key, size_t len)
+static int stn_index(const char *key)
 {
     size_t k;
 
-    if (len == 1 && key[0] == 's')
+    if (key[0] == 's' && !key[1])
         return STN_S;
     for (k = 0; k < STN_NKEYS; k++)
         if (stn_keys[k].name[0] == key[0] && !strcmp(stn_keys[k].name, key))
@@ -95,7 +95,7 @@ static void stn_view_of(const json_t *st, stn_view *w)
 
     memset(w, 0, sizeof(*w));
     json_object_foreach((json_t *)st, key, val) {
-        int k = stn_index(key, strlen(key));
+        int k = stn_index(key);
         if (k == STN_S) {
             w->s = val;
         } else if (k == STN_OTHER) {
@@ -369,17 +369,13 @@ unsigned stn_fill(const json_t *stations, sm_station *out)
         stn_view_of(st, &w);
         mask |= w.mask;
         memset(&out[j], 0, sizeof(out[j]));
-        out[j].s = 0;
-        field_number(w.s, &out[j].s);
+        out[j].s = json_number_value(w.s); /* canonical: reals (0 when absent) */
         for (k = 0; k < STN_NKEYS; k++) {
             const stn_key *q = &stn_keys[k];
-            double *dst = (double *)((char *)&out[j] + q->off), d = 0;
-            if (w.v[k] && q->n == 1) {
-                field_number(w.v[k], &d);
-                dst[0] = stn_value(q, d);
-            }
-            for (i = 0; w.v[k] && q->n > 1 && i < q->n; i++)
-                dst[i] = stn_value(q, json_number_value(json_array_get(w.v[k], (size_t)i)));
+            double *dst = (double *)((char *)&out[j] + q->off);
+            for (i = 0; w.v[k] && i < q->n; i++)
+                dst[i] = stn_value(
+                    q, json_number_value(q->n == 1 ? w.v[k] : json_array_get(w.v[k], (size_t)i)));
         }
     }
     return mask;
